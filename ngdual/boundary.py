@@ -1,0 +1,195 @@
+"""Coarse boundary meshes and the multiplier spaces on Gamma_N, Gamma_C and A_C.
+
+The multipliers live on meshes coarser than the trace of T_h (Section 3.2):
+phi, lambda_t, lambda_n on h~ = 2h (P1, zero at the end points of their
+boundary part) and nu on h^ = h~ or 2h~ (P0). A coarse mesh is built from the
+fine boundary edges of a boundary part: the edges are ordered into chains and
+grouped ``factor`` at a time, so every fine edge lies entirely on one coarse
+edge (the nesting assumed in Section 3.2) and h~ ~ factor * h locally, on
+uniform and on locally refined meshes alike.
+
+A coarse P1 function is represented by its values at the fine boundary
+vertices: :meth:`CoarseMesh.p1_prolongation` is the matrix mapping coarse
+nodal values to the nodal values of the fine trace space, through which all
+forms assembled by NGSolve on the fine trace are restricted to the coarse space.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import ngsolve as ngs
+import numpy as np
+import scipy.sparse as sp
+
+
+@dataclass(frozen=True)
+class Chain:
+    """A connected piece of a boundary part: fine vertices in order along it."""
+
+    vertices: np.ndarray
+    points: np.ndarray
+    closed: bool
+
+    @property
+    def arclength(self) -> np.ndarray:
+        """Arc length at every vertex (for a closed chain the first vertex is repeated)."""
+        pts = np.vstack([self.points, self.points[:1]]) if self.closed else self.points
+        return np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
+
+    @property
+    def n_edges(self) -> int:
+        return len(self.vertices) if self.closed else len(self.vertices) - 1
+
+
+def boundary_chains(mesh: ngs.Mesh, labels: list[str]) -> list[Chain]:
+    """Order the fine boundary edges carrying one of ``labels`` into chains."""
+    wanted = set(labels)
+    segments = [tuple(v.nr for v in el.vertices) for el in mesh.Elements(ngs.BND)
+                if el.mat in wanted]
+    neighbours: dict[int, list[int]] = {}
+    for a, b in segments:
+        neighbours.setdefault(a, []).append(b)
+        neighbours.setdefault(b, []).append(a)
+    coords = {v.nr: v.point for v in mesh.vertices}
+    unvisited, chains = set(neighbours), []
+    while unvisited:
+        ends = sorted(v for v in unvisited if len(neighbours[v]) == 1)
+        start = ends[0] if ends else min(unvisited)
+        order, prev = [start], None
+        unvisited.discard(start)
+        while True:
+            nxt = [w for w in neighbours[order[-1]] if w != prev and w in unvisited]
+            if not nxt:
+                break
+            prev = order[-1]
+            order.append(nxt[0])
+            unvisited.discard(nxt[0])
+        closed = not ends
+        verts = np.array(order)
+        chains.append(Chain(verts, np.array([coords[v] for v in verts]), closed))
+    return chains
+
+
+def _group(n_edges: int, factor: int) -> np.ndarray:
+    """Positions 0..n_edges of the coarse nodes when grouping ``factor`` edges at a time."""
+    q, r = divmod(n_edges, factor)
+    if q == 0:
+        return np.array([0, n_edges])
+    nodes = list(range(0, q * factor + 1, factor))
+    if r:
+        # a short remainder joins the last group, a long one becomes its own edge
+        if 2 * r >= factor:
+            nodes.append(n_edges)
+        else:
+            nodes[-1] = n_edges
+    return np.array(nodes)
+
+
+@dataclass(frozen=True)
+class CoarseMesh:
+    """A coarse 1D mesh on a boundary part, nested in the fine boundary edges.
+
+    ``nodes[c]`` holds the positions (indices into ``chains[c].vertices``,
+    position ``n_edges`` meaning the chain's end) of the coarse nodes of chain c.
+    """
+
+    chains: tuple[Chain, ...]
+    nodes: tuple[np.ndarray, ...]
+
+    @classmethod
+    def from_fine(cls, mesh: ngs.Mesh, labels: list[str], factor: int) -> "CoarseMesh":
+        """Group the fine boundary edges of ``labels`` ``factor`` at a time."""
+        chains = tuple(boundary_chains(mesh, labels))
+        return cls(chains, tuple(_group(c.n_edges, factor) for c in chains))
+
+    def coarsened(self, factor: int) -> "CoarseMesh":
+        """Group this mesh's edges ``factor`` at a time (h^ = factor * h~, nested)."""
+        return CoarseMesh(self.chains,
+                          tuple(n[_group(len(n) - 1, factor)] for n in self.nodes))
+
+    @property
+    def n_edges(self) -> int:
+        return sum(len(n) - 1 for n in self.nodes)
+
+    def _interior(self, c: int) -> np.ndarray:
+        """Coarse node positions carrying a dof: all but the ends of an open chain."""
+        n = self.nodes[c]
+        return n[:-1] if self.chains[c].closed else n[1:-1]
+
+    @property
+    def n_p1_dofs(self) -> int:
+        """dim of the coarse P1 space vanishing at the ends of every open chain."""
+        return sum(len(self._interior(c)) for c in range(len(self.chains)))
+
+    def node_points(self) -> np.ndarray:
+        """Coordinates of the coarse P1 dofs, in dof order."""
+        out = []
+        for c, chain in enumerate(self.chains):
+            pos = self._interior(c) % len(chain.vertices)
+            out.append(chain.points[pos])
+        return np.vstack(out) if out else np.zeros((0, 2))
+
+    def edge_lengths(self) -> np.ndarray:
+        """Lengths of all coarse edges, chain by chain."""
+        return np.concatenate([np.diff(ch.arclength[n]) for ch, n in zip(self.chains, self.nodes)])
+
+    def p1_prolongation(self, fine_dof_of_vertex, n_fine: int) -> sp.csr_matrix:
+        """Matrix of the coarse P1 hats evaluated at the fine vertices.
+
+        Parameters
+        ----------
+        fine_dof_of_vertex : callable
+            Maps a fine vertex number to its dof in the fine trace space.
+        n_fine : int
+            Number of dofs of the fine trace space.
+
+        Returns
+        -------
+        scipy.sparse.csr_matrix of shape (n_fine, n_p1_dofs).
+        """
+        rows, cols, vals = [], [], []
+        offset = 0
+        for c, chain in enumerate(self.chains):
+            s, nodes = chain.arclength, self.nodes[c]
+            interior = self._interior(c)
+            dof_of_pos = {int(p): offset + k for k, p in enumerate(interior)}
+            offset += len(interior)
+            for e in range(len(nodes) - 1):
+                a, b = nodes[e], nodes[e + 1]
+                for p in range(a, b + 1):
+                    if p == b and (b != nodes[-1] or chain.closed):
+                        continue  # a shared node belongs to the next edge
+                    t = (s[p] - s[a]) / (s[b] - s[a])
+                    fine = fine_dof_of_vertex(int(chain.vertices[p % len(chain.vertices)]))
+                    for pos, w in ((a, 1 - t), (b, t)):
+                        key = int(pos) % chain.n_edges if chain.closed else int(pos)
+                        if key in dof_of_pos and w > 0:
+                            rows.append(fine)
+                            cols.append(dof_of_pos[key])
+                            vals.append(w)
+        return sp.csr_matrix((vals, (rows, cols)), shape=(n_fine, offset))
+
+    def p1_mass_stiffness(self) -> tuple[np.ndarray, np.ndarray]:
+        """Dense P1 mass M and arc-length stiffness L on the coarse dofs."""
+        n = self.n_p1_dofs
+        mass, stiff = np.zeros((n, n)), np.zeros((n, n))
+        offset = 0
+        for c, chain in enumerate(self.chains):
+            interior = [int(p) for p in self._interior(c)]
+            local = {p: offset + k for k, p in enumerate(interior)}
+            if chain.closed:
+                local[chain.n_edges] = local[0]
+            offset += len(interior)
+            s, nodes = chain.arclength, self.nodes[c]
+            for e in range(len(nodes) - 1):
+                ell = s[nodes[e + 1]] - s[nodes[e]]
+                ends = [local.get(int(nodes[e])), local.get(int(nodes[e + 1]))]
+                me = ell / 6 * np.array([[2, 1], [1, 2]])
+                ke = np.array([[1, -1], [-1, 1]]) / ell
+                for i, gi in enumerate(ends):
+                    for j, gj in enumerate(ends):
+                        if gi is not None and gj is not None:
+                            mass[gi, gj] += me[i, j]
+                            stiff[gi, gj] += ke[i, j]
+        return mass, stiff

@@ -1,0 +1,229 @@
+"""The bilinear and linear forms of (3.62) and the assembled block system (3.97)/(3.103).
+
+All forms are NGSolve integrals on the fine mesh T_h; the multipliers phi,
+lambda_t, lambda_n are assembled in the fine P1 trace spaces and restricted to
+their coarse meshes by the prolongation of :mod:`ngdual.boundary`
+(``K = P^T K_fine P``). The unknown vector is ordered
+
+    [sigma | u, eta, phi, lambda_t | lambda_n]
+
+so that, with the index sets of :class:`DiscreteProblem`,
+``A = K[sigma, sigma]``, ``B = K[sigma, mult]``, ``C_n = K[sigma, lam_n]`` and
+the right-hand side is ``(g, b)`` as in (3.103).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import ngsolve as ngs
+import numpy as np
+import scipy.sparse as sp
+
+from . import peers
+from .boundary import CoarseMesh
+from .expr import Expression
+from .scene import Scene
+
+TRACE_BONUS_ORDER = 6
+
+
+def _boundary_regex(labels: list[str]) -> str:
+    return "|".join(labels)
+
+
+def _trace_space(mesh: ngs.Mesh, labels: list[str]) -> ngs.FESpace:
+    """Fine P1 trace space on the boundary part ``labels`` (compressed)."""
+    return ngs.Compress(ngs.H1(mesh, order=1, definedon=mesh.Boundaries(_boundary_regex(labels))))
+
+
+def _vertex_dof(space: ngs.FESpace):
+    def dof(v: int) -> int:
+        return space.GetDofNrs(ngs.NodeId(ngs.VERTEX, v))[0]
+    return dof
+
+
+@dataclass
+class Spaces:
+    """Fine component spaces, the coarse boundary meshes and their prolongations.
+
+    Building this object assembles nothing: it is all that DOF counting needs.
+    """
+
+    mesh: ngs.Mesh
+    components: dict[str, ngs.FESpace]
+    neumann: CoarseMesh | None
+    contact: CoarseMesh | None
+    friction: CoarseMesh | None
+    prolongations: dict[str, sp.csr_matrix] = field(default_factory=dict)
+
+    @classmethod
+    def build(cls, scene: Scene, mesh: ngs.Mesh) -> "Spaces":
+        comps = peers.peers_spaces(mesh)
+        factor = scene.contact.htilde_factor
+        neumann = contact = friction = None
+        prolong = {}
+        if scene.labels("neumann"):
+            neumann = CoarseMesh.from_fine(mesh, scene.labels("neumann"), factor)
+            space = _trace_space(mesh, scene.labels("neumann"))
+            comps["phi1"] = comps["phi2"] = space
+            prolong["phi1"] = prolong["phi2"] = neumann.p1_prolongation(_vertex_dof(space),
+                                                                        space.ndof)
+        if scene.has_contact:
+            contact = CoarseMesh.from_fine(mesh, scene.labels("contact"), factor)
+            space = _trace_space(mesh, scene.labels("contact"))
+            comps["lam_t"] = comps["lam_n"] = space
+            prolong["lam_t"] = prolong["lam_n"] = contact.p1_prolongation(_vertex_dof(space),
+                                                                          space.ndof)
+            if scene.has_friction:
+                friction = contact.coarsened(scene.contact.hhat_factor)
+        return cls(mesh, comps, neumann, contact, friction, prolong)
+
+    def coarse_ndof(self, name: str) -> int:
+        if name in self.prolongations:
+            return self.prolongations[name].shape[1]
+        return self.components[name].ndof
+
+    def dofs(self) -> dict[str, int]:
+        """Degrees of freedom per space, named as in Table 3.1 (L: nu on h^)."""
+        n = self.coarse_ndof
+        return {"X": sum(n(c) for c in peers.STRESS),
+                "M": n("u1") + n("u2"),
+                "S": n("eta"),
+                "N": n("phi1") + n("phi2") if self.neumann else 0,
+                "C": n("lam_n") if self.contact else 0,
+                "L": self.friction.n_edges if self.friction else 0}
+
+
+@dataclass
+class DiscreteProblem:
+    """The assembled discrete problem (3.62) without friction terms.
+
+    Attributes
+    ----------
+    K : scipy.sparse.csr_matrix
+        Symmetric matrix of all unknowns (sigma, u, eta, phi, lambda_t, lambda_n).
+    F : numpy.ndarray
+        Right-hand side (g, -f, 0, t0, 0, 0).
+    blocks : dict[str, slice]
+        Position of every component in the unknown vector.
+    """
+
+    scene: Scene
+    spaces: Spaces
+    fes: ngs.FESpace
+    names: list[str]
+    P: sp.csr_matrix
+    K: sp.csr_matrix
+    F: np.ndarray
+    blocks: dict[str, slice]
+    assemble_seconds: float
+
+    def index(self, *names: str) -> np.ndarray:
+        """Indices of the listed components in the unknown vector."""
+        present = [n for n in names if n in self.blocks]
+        if not present:
+            return np.zeros(0, dtype=int)
+        return np.concatenate([np.arange(self.blocks[n].start, self.blocks[n].stop)
+                               for n in present])
+
+    @property
+    def sigma(self) -> np.ndarray:
+        return self.index(*peers.STRESS)
+
+    @property
+    def mult(self) -> np.ndarray:
+        """u, eta, phi, lambda_t: the unknowns of the fixed saddle-point matrix."""
+        return self.index("u1", "u2", "eta", "phi1", "phi2", "lam_t")
+
+    @property
+    def lam_n(self) -> np.ndarray:
+        return self.index("lam_n")
+
+    @property
+    def saddle(self) -> np.ndarray:
+        """sigma followed by mult: the rows and columns of [[A, B], [B^T, 0]]."""
+        return np.concatenate([self.sigma, self.mult])
+
+    def block(self, rows: np.ndarray, cols: np.ndarray) -> sp.csr_matrix:
+        return self.K[rows][:, cols].tocsr()
+
+    def to_fine(self, x: np.ndarray) -> np.ndarray:
+        """Coefficients of the fine product space from a coarse unknown vector."""
+        return self.P @ x
+
+
+def _forms(scene: Scene, fes: ngs.FESpace, names: list[str]):
+    """Bilinear form of all couplings in (3.62) and the right-hand side."""
+    mesh = fes.mesh
+    trial = dict(zip(names, fes.TrialFunction()))
+    test = dict(zip(names, fes.TestFunction()))
+    lam, mu = scene.material.lame
+    n = ngs.specialcf.normal(2)
+    t = ngs.CF((n[1], -n[0]))
+
+    def parts(f):
+        sig = peers.stress(f["r1"], f["r2"], f["b1"], f["b2"])
+        return (sig, peers.stress_divergence(f["r1"], f["r2"]),
+                peers.stress_traction(f["r1"], f["r2"]), ngs.CF((f["u1"], f["u2"])), f["eta"])
+
+    sig, div_sig, trac_sig, u, eta = parts(trial)
+    tau, div_tau, trac_tau, v, xi = parts(test)
+    a = ngs.BilinearForm(fes)
+    a += ngs.InnerProduct(peers.compliance(sig, lam, mu), tau) * ngs.dx      # a~(sigma, tau)
+    a += (u * div_tau + v * div_sig) * ngs.dx                                 # b(u, tau)
+    a += (eta * peers.asym(tau) + xi * peers.asym(sig)) * ngs.dx              # s(eta, tau)
+    rhs = ngs.LinearForm(fes)
+    f = ngs.CF(tuple(Expression(e).coefficient() for e in scene.loads.body_force))
+    rhs += -f * v * ngs.dx                                                    # -f(v)
+    ds_d = ngs.ds(definedon=mesh.Boundaries(_boundary_regex(scene.labels("dirichlet"))),
+                  bonus_intorder=TRACE_BONUS_ORDER)
+    u_d = ngs.CF(tuple(Expression(e).coefficient() for e in scene.loads.displacement))
+    rhs += u_d * trac_tau * ds_d                                              # prescribed u on Gamma_D
+    if "phi1" in names:
+        ds_n = ngs.ds(definedon=mesh.Boundaries(_boundary_regex(scene.labels("neumann"))),
+                      bonus_intorder=TRACE_BONUS_ORDER)
+        phi, psi = ngs.CF((trial["phi1"], trial["phi2"])), ngs.CF((test["phi1"], test["phi2"]))
+        a += (phi * trac_tau + psi * trac_sig) * ds_n                         # d_N(phi, tau)
+        t0 = ngs.CF(tuple(Expression(e).coefficient() for e in scene.loads.traction))
+        rhs += t0 * psi * ds_n                                                # t0(psi)
+    if "lam_n" in names:
+        ds_c = ngs.ds(definedon=mesh.Boundaries(_boundary_regex(scene.labels("contact"))),
+                      bonus_intorder=TRACE_BONUS_ORDER)
+        a += (trial["lam_t"] * (t * trac_tau) + test["lam_t"] * (t * trac_sig)) * ds_c  # d_Ct
+        a += (trial["lam_n"] * (n * trac_tau) + test["lam_n"] * (n * trac_sig)) * ds_c  # d_Cn
+        gap = Expression(scene.contact.gap).coefficient()
+        rhs += gap * (n * trac_tau) * ds_c                                    # g(tau)
+    return a, rhs
+
+
+def _to_scipy(mat) -> sp.csr_matrix:
+    rows, cols, vals = mat.COO()
+    return sp.csr_matrix((np.asarray(vals), (np.asarray(rows), np.asarray(cols))),
+                         shape=(mat.height, mat.width))
+
+
+def assemble(scene: Scene, mesh: ngs.Mesh) -> DiscreteProblem:
+    """Assemble the block system of (3.62) for ``scene`` on ``mesh``."""
+    start = time.perf_counter()
+    spaces = Spaces.build(scene, mesh)
+    names = list(spaces.components)
+    fes = ngs.FESpace([spaces.components[n] for n in names])
+    a, rhs = _forms(scene, fes, names)
+    with ngs.TaskManager():
+        a.Assemble()
+        rhs.Assemble()
+    blocks_p, blocks, offset = [], {}, 0
+    for name in names:
+        p = spaces.prolongations.get(name)
+        p = sp.identity(spaces.components[name].ndof, format="csr") if p is None else p
+        blocks_p.append(p)
+        blocks[name] = slice(offset, offset + p.shape[1])
+        offset += p.shape[1]
+    P = sp.block_diag(blocks_p, format="csr")
+    K = (P.T @ _to_scipy(a.mat) @ P).tocsr()
+    K.eliminate_zeros()
+    F = P.T @ rhs.vec.FV().NumPy()
+    return DiscreteProblem(scene, spaces, fes, names, P, K, F, blocks,
+                           time.perf_counter() - start)

@@ -1,0 +1,94 @@
+"""Meshes: the structured mesh of Example 3.46 and netgen meshes of labelled polygons.
+
+Level k of Example 3.46 is the rectangle [-4,4]x[-1,1] cut into 8x2 unit
+squares, each split by its diagonal from lower-left to upper-right, refined
+k-1 times uniformly (every triangle into four). Red refinement of that mesh is
+again the structured mesh with the same diagonal direction, so level k is
+built directly as 8*2^(k-1) x 2*2^(k-1) squares; this gives the DOF counts of
+Table 3.1 exactly.
+"""
+
+from __future__ import annotations
+
+import ngsolve as ngs
+import numpy as np
+from netgen.geom2d import SplineGeometry
+from netgen.meshing import Element1D, Element2D, FaceDescriptor, MeshPoint
+from netgen.meshing import Mesh as NetgenMesh
+from netgen.meshing import Pnt
+
+from .scene import Geometry
+
+THESIS_LABELS = ("bottom", "right", "top", "left")
+
+
+def thesis_mesh(level: int) -> ngs.Mesh:
+    """The structured mesh of Example 3.46 on ``level`` (1 = 32 triangles).
+
+    >>> thesis_mesh(1).ne
+    32
+    """
+    if level < 1:
+        raise ValueError(f"level must be >= 1, got {level}")
+    k = 2 ** (level - 1)
+    nx, ny = 8 * k, 2 * k
+    xs, ys = np.linspace(-4, 4, nx + 1), np.linspace(-1, 1, ny + 1)
+    m = NetgenMesh(dim=2)
+    pid = [[m.Add(MeshPoint(Pnt(xs[i], ys[j], 0))) for j in range(ny + 1)] for i in range(nx + 1)]
+    m.Add(FaceDescriptor(surfnr=1, domin=1, domout=0, bc=1))
+    m.SetMaterial(1, "body")
+    for i in range(nx):
+        for j in range(ny):
+            a, b, c, d = pid[i][j], pid[i + 1][j], pid[i + 1][j + 1], pid[i][j + 1]
+            m.Add(Element2D(1, [a, b, c]))
+            m.Add(Element2D(1, [a, c, d]))
+    # counter-clockwise segments, so the body lies to their left
+    for i in range(nx):
+        m.Add(Element1D([pid[i][0], pid[i + 1][0]], index=1))
+        m.Add(Element1D([pid[i + 1][ny], pid[i][ny]], index=3))
+    for j in range(ny):
+        m.Add(Element1D([pid[nx][j], pid[nx][j + 1]], index=2))
+        m.Add(Element1D([pid[0][j + 1], pid[0][j]], index=4))
+    for index, label in enumerate(THESIS_LABELS, start=1):
+        m.SetBCName(index - 1, label)
+    return ngs.Mesh(m)
+
+
+def polygon_mesh(points, labels, maxh: float, level: int = 1) -> ngs.Mesh:
+    """A netgen mesh of the counter-clockwise polygon ``points`` with side labels.
+
+    Side ``i`` (from ``points[i]`` to ``points[i+1]``) gets boundary label
+    ``labels[i]``; ``level`` k applies k-1 uniform refinements.
+    """
+    geo = SplineGeometry()
+    ids = [geo.AppendPoint(float(x), float(y)) for x, y in points]
+    for i, label in enumerate(labels):
+        geo.Append(["line", ids[i], ids[(i + 1) % len(ids)]], bc=label, leftdomain=1,
+                   rightdomain=0)
+    mesh = ngs.Mesh(geo.GenerateMesh(maxh=maxh))
+    refine_uniformly(mesh, level - 1)
+    return mesh
+
+
+def refine_uniformly(mesh: ngs.Mesh, times: int) -> ngs.Mesh:
+    """Refine every triangle into four, ``times`` times (in place)."""
+    for _ in range(times):
+        mesh.Refine()
+    return mesh
+
+
+def build_mesh(geometry: Geometry, level: int | None = None) -> ngs.Mesh:
+    """The mesh of a scene geometry on ``level`` (default: the geometry's own level)."""
+    level = geometry.level if level is None else level
+    if geometry.kind == "thesis-3.46":
+        return thesis_mesh(level)
+    return polygon_mesh(geometry.points, geometry.labels, geometry.maxh, level)
+
+
+def mesh_size(mesh: ngs.Mesh) -> float:
+    """The largest triangle diameter h (the first column of Table 3.1)."""
+    pts = np.array([v.point for v in mesh.vertices])
+    tri = np.array([[v.nr for v in el.vertices] for el in mesh.Elements(ngs.VOL)])
+    p = pts[tri]
+    edges = np.linalg.norm(p - np.roll(p, 1, axis=1), axis=2)
+    return float(edges.max())

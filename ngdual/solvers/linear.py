@@ -1,0 +1,50 @@
+"""One sparse LU factorisation of the fixed saddle-point matrix, reused for every solve.
+
+The matrix [[A, B], [B^T, 0]] of Algorithms 3.38/3.41 never changes during the
+iteration, so it is factorised once (NGSolve's UMFPACK by default, SciPy's
+SuperLU as an alternative) and every Uzawa step costs one forward/back solve.
+"""
+
+from __future__ import annotations
+
+import time
+
+import ngsolve as ngs
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+BACKENDS = ("umfpack", "superlu")
+
+
+class Factorization:
+    """LU factors of a square sparse matrix.
+
+    >>> import scipy.sparse as sp
+    >>> Factorization(sp.identity(3, format="csr")).solve(np.ones(3))
+    array([1., 1., 1.])
+    """
+
+    def __init__(self, matrix: sp.spmatrix, backend: str = "umfpack"):
+        if backend not in BACKENDS:
+            raise ValueError(f"unknown backend {backend!r}; use one of {BACKENDS}")
+        start = time.perf_counter()
+        self.backend, self.shape = backend, matrix.shape
+        if backend == "umfpack":
+            coo = matrix.tocoo()
+            self._mat = ngs.la.SparseMatrixd.CreateFromCOO(
+                coo.row.astype(np.int64).tolist(), coo.col.astype(np.int64).tolist(),
+                coo.data.tolist(), matrix.shape[0], matrix.shape[1])
+            self._inv = self._mat.Inverse(inverse="umfpack")
+            self._rhs, self._sol = self._mat.CreateColVector(), self._mat.CreateColVector()
+        else:
+            self._lu = spla.splu(matrix.tocsc())
+        self.seconds = time.perf_counter() - start
+
+    def solve(self, rhs: np.ndarray) -> np.ndarray:
+        """Solve with the stored factors."""
+        if self.backend == "superlu":
+            return self._lu.solve(np.asarray(rhs, dtype=float))
+        self._rhs.FV().NumPy()[:] = rhs
+        self._sol.data = self._inv * self._rhs
+        return self._sol.FV().NumPy().copy()

@@ -1,0 +1,37 @@
+"""What every solver returns: the coarse unknown vector and an honest account of the iteration."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..forms import DiscreteProblem
+
+
+class ConvergenceError(RuntimeError):
+    """An iteration that diverged or stagnated; ``history`` holds its residuals."""
+
+    def __init__(self, message: str, history: list[float]):
+        super().__init__(message)
+        self.history = history
+
+
+@dataclass
+class Solution:
+    """A discrete solution of (3.62) with its iteration record.
+
+    ``x`` is ordered like ``problem.K``: (sigma, u, eta, phi, lambda_t, lambda_n).
+    """
+
+    problem: DiscreteProblem
+    x: np.ndarray
+    converged: bool
+    method: str
+    iterations: dict = field(default_factory=lambda: {"outer": 0, "inner": 0})
+    residuals: dict = field(default_factory=dict)
+    history: list = field(default_factory=list)
+    timings: dict = field(default_factory=dict)
+
+    def part(self, *names: str) -> np.ndarray:
+        return self.x[self.problem.index(*names)]

@@ -1,0 +1,120 @@
+"""Algorithm 3.38: the Uzawa algorithm for contact without friction, and the linear solve.
+
+Each step solves the fixed saddle-point system
+
+    [[A, B], [B^T, 0]] (sigma^i, (u, eta, phi, lambda_t)^i) = (g - C_n lambda_n^{i-1}, b)
+
+with one factorisation made before the loop, then updates
+lambda_n^i = P^+(lambda_n^{i-1} + rho Phi(sigma^i)) (step 4, as the QP of
+Remark 3.40). It stops on the thesis' relative increment (step 5); the
+residual of the discrete variational inequality is reported alongside.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Callable
+
+import numpy as np
+
+from ..forms import DiscreteProblem
+from .linear import Factorization
+from .projections import NonnegativeProjection, metric_matrix
+from .result import ConvergenceError, Solution
+
+DIVERGENCE_FACTOR = 1e6
+
+
+def solve_linear(problem: DiscreteProblem, backend: str = "umfpack") -> Solution:
+    """One saddle-point solve: the whole problem when there is no contact boundary."""
+    saddle = problem.saddle
+    fact = Factorization(problem.block(saddle, saddle), backend)
+    start = time.perf_counter()
+    x = np.zeros(problem.K.shape[0])
+    x[saddle] = fact.solve(problem.F[saddle])
+    solve_s = time.perf_counter() - start
+    return Solution(problem, x, True, "linear",
+                    timings={"assemble": problem.assemble_seconds, "factorize": fact.seconds,
+                             "solve": solve_s})
+
+
+def contact_residuals(lam: np.ndarray, traction: np.ndarray,
+                      projection: NonnegativeProjection) -> dict:
+    """Residuals of the discrete VI (3.103): lambda_n >= 0, C_n^T sigma <= 0, complementarity.
+
+    ``traction`` is C_n^T sigma (the normal stress tested with the coarse hats).
+    All values are relative, so 0 means exact and 1e-8 is at solver tolerance.
+    """
+    lam_scale = np.max(np.abs(lam)) or 1.0
+    tr_scale = np.max(np.abs(traction)) or 1.0
+    return {
+        "lambda_n_negative": float(max(0.0, -lam.min(initial=0.0)) / lam_scale),
+        "sigma_n_positive": float(max(0.0, traction.max(initial=0.0)) / tr_scale),
+        "complementarity": float(abs(lam @ traction)
+                                 / ((np.linalg.norm(lam) * np.linalg.norm(traction)) or 1.0)),
+        "natural": projection.residual(lam, traction),
+    }
+
+
+def uzawa(problem: DiscreteProblem, rho: float = 1.0, eps: float = 1e-8, max_iter: int = 2000,
+          metric: str = "h12", backend: str = "umfpack",
+          progress: Callable[[int, float], None] | None = None) -> Solution:
+    """Algorithm 3.38 for the frictionless contact problem (3.68).
+
+    Parameters
+    ----------
+    rho : float
+        Dimensionless step length (the metric carries the elastic modulus).
+    eps : float
+        Tolerance on the relative increment of step 5.
+    metric : {"h12", "euclidean"}
+        Metric W of the projection P^+ (see :mod:`ngdual.solvers.projections`).
+    progress : callable, optional
+        Called as ``progress(iteration, increment)`` after every step.
+
+    Raises
+    ------
+    ConvergenceError
+        If the increments grow by a factor 1e6 (rho too large) or become NaN.
+    """
+    saddle, i_lam = problem.saddle, problem.lam_n
+    n_sigma = len(problem.sigma)
+    fact = Factorization(problem.block(saddle, saddle), backend)
+    C_n = problem.block(problem.sigma, i_lam)
+    modulus = problem.scene.material.plane_strain_modulus
+    projection = NonnegativeProjection(metric_matrix(problem.spaces.contact, modulus, metric))
+
+    start = time.perf_counter()
+    rhs = problem.F[saddle].copy()
+    g = rhs[:n_sigma].copy()
+    lam = np.zeros(len(i_lam))
+    y_prev = np.zeros(len(saddle))
+    history, converged = [], False
+    for it in range(1, max_iter + 1):
+        rhs[:n_sigma] = g - C_n @ lam
+        y = fact.solve(rhs)                                            # step 3
+        traction = C_n.T @ y[:n_sigma]
+        lam_new = projection(projection.matvec(lam) + rho * traction)  # step 4
+        change = np.sqrt(np.sum((y - y_prev) ** 2) + np.sum((lam_new - lam) ** 2))
+        size = np.sqrt(np.sum(y**2) + np.sum(lam_new**2)) or 1.0
+        history.append(float(change / size))
+        if progress:
+            progress(it, history[-1])
+        if not np.isfinite(history[-1]) or history[-1] > DIVERGENCE_FACTOR * history[0]:
+            raise ConvergenceError(f"Uzawa diverged at step {it} (rho = {rho} too large?)",
+                                   history)
+        y_prev = y
+        if history[-1] <= eps:                                          # step 5
+            converged = True
+            break
+        lam = lam_new
+    # (y, lam) is a consistent pair: y solves the linear system with lam exactly
+    x = np.zeros(problem.K.shape[0])
+    x[saddle], x[i_lam] = y, lam
+    residuals = {"increment": history[-1], **contact_residuals(lam, C_n.T @ y[:n_sigma],
+                                                                projection)}
+    return Solution(problem, x, converged, f"uzawa-{metric}",
+                    iterations={"outer": it, "inner": 0}, residuals=residuals,
+                    history=history,
+                    timings={"assemble": problem.assemble_seconds, "factorize": fact.seconds,
+                             "solve": time.perf_counter() - start})
