@@ -1,0 +1,239 @@
+"""Post-processing: fields, norms (Tables 3.2/3.3), traces on Gamma_C, contact counts, records.
+
+Sign conventions (Theorem 3.10): u is the displacement, phi = -u on Gamma_N,
+lambda_n = g - u_n (so lambda_n - g = -u_n and lambda_n = 0 where the gap is
+closed) and lambda_t = -u_t on Gamma_C.
+"""
+
+from __future__ import annotations
+
+import platform
+from dataclasses import dataclass
+from importlib import metadata
+
+import ngsolve as ngs
+import numpy as np
+
+from . import __version__, peers
+from .expr import Expression
+from .solvers.result import Solution
+
+CONTACT_TOL = 1e-8
+
+
+@dataclass
+class Fields:
+    """NGSolve views of a solution on the fine mesh."""
+
+    gf: ngs.GridFunction
+    sigma: ngs.CoefficientFunction
+    div_sigma: ngs.CoefficientFunction
+    u: ngs.CoefficientFunction
+    eta: ngs.CoefficientFunction
+    phi: ngs.CoefficientFunction | None
+    lam_t: ngs.CoefficientFunction | None
+    lam_n: ngs.CoefficientFunction | None
+
+
+def fields(solution: Solution) -> Fields:
+    """Fine-mesh GridFunction and coefficient functions of every unknown."""
+    pb = solution.problem
+    gf = ngs.GridFunction(pb.fes)
+    gf.vec.FV().NumPy()[:] = pb.to_fine(solution.x)
+    c = dict(zip(pb.names, gf.components))
+    sigma = peers.stress(c["r1"], c["r2"], c["b1"], c["b2"])
+    div_sigma = peers.stress_divergence(c["r1"], c["r2"])
+    phi = ngs.CF((c["phi1"], c["phi2"])) if "phi1" in c else None
+    return Fields(gf, sigma, div_sigma, ngs.CF((c["u1"], c["u2"])), c["eta"], phi,
+                  c.get("lam_t"), c.get("lam_n"))
+
+
+def _boundary_integral(cf, mesh: ngs.Mesh, labels: list[str]) -> float:
+    return float(ngs.Integrate(cf, mesh, ngs.BND, definedon=mesh.Boundaries("|".join(labels))))
+
+
+def norms(solution: Solution) -> dict:
+    """Norms of Tables 3.2/3.3: ||sigma|| in H(div), the others in L^2."""
+    f = fields(solution)
+    pb = solution.problem
+    mesh, scene = pb.fes.mesh, pb.scene
+    out = {
+        "sigma_X": np.sqrt(ngs.Integrate(ngs.InnerProduct(f.sigma, f.sigma)
+                                         + f.div_sigma * f.div_sigma, mesh)),
+        "u": np.sqrt(ngs.Integrate(f.u * f.u, mesh)),
+        "eta": np.sqrt(ngs.Integrate(f.eta * f.eta, mesh)),
+        "phi": np.sqrt(_boundary_integral(f.phi * f.phi, mesh, scene.labels("neumann")))
+        if f.phi is not None else 0.0,
+        "lam_t": 0.0, "lam_n": 0.0, "nu": None,
+    }
+    if f.lam_n is not None:
+        out["lam_t"] = np.sqrt(_boundary_integral(f.lam_t * f.lam_t, mesh,
+                                                  scene.labels("contact")))
+        out["lam_n"] = np.sqrt(_boundary_integral(f.lam_n * f.lam_n, mesh,
+                                                  scene.labels("contact")))
+    return {k: (float(v) if v is not None else None) for k, v in out.items()}
+
+
+def von_mises(sigma, nu: float) -> ngs.CoefficientFunction:
+    """Plane-strain von Mises stress (Section 3.4, below Fig. 3.11), sigma_12 symmetrised."""
+    s11, s22, s12 = sigma[0, 0], sigma[1, 1], 0.5 * (sigma[0, 1] + sigma[1, 0])
+    return ngs.sqrt((nu**2 - nu + 1) * (s11**2 + s22**2) + (2 * nu**2 - 2 * nu - 1) * s11 * s22
+                    + 3 * s12**2)
+
+
+@dataclass
+class ContactTraces:
+    """Traces on Gamma_C, chain by chain concatenated, ordered along the boundary.
+
+    Edge quantities (sigma_n, sigma_t: constant per fine edge for RT_0) are given
+    at edge midpoints ``edge_xy``; nodal ones at the fine vertices ``node_xy``.
+    ``coarse_*`` refer to the h~ contact mesh dofs.
+    """
+
+    edge_xy: np.ndarray
+    edge_length: np.ndarray
+    sigma_n: np.ndarray
+    sigma_t: np.ndarray
+    edge_active: np.ndarray
+    node_xy: np.ndarray
+    lam_n: np.ndarray
+    lam_t: np.ndarray
+    gap: np.ndarray
+    coarse_xy: np.ndarray
+    coarse_lam_n: np.ndarray
+    coarse_lam_t: np.ndarray
+    coarse_in_contact: np.ndarray
+
+
+def _in_contact(lam_n: np.ndarray) -> np.ndarray:
+    scale = max(float(np.max(np.abs(lam_n), initial=0.0)), 1e-300)
+    return lam_n <= CONTACT_TOL * scale
+
+
+def contact_traces(solution: Solution) -> ContactTraces:
+    """sigma_n, sigma_t, lambda_n - g, lambda_t along Gamma_C."""
+    pb = solution.problem
+    mesh, contact = pb.fes.mesh, pb.spaces.contact
+    f = fields(solution)
+    sigma = f.sigma
+    lam_n_c, lam_t_c = solution.part("lam_n"), solution.part("lam_t")
+    in_contact = _in_contact(lam_n_c)
+    gap = Expression(pb.scene.contact.gap)
+    # fine nodal values of the coarse P1 multipliers
+    p = pb.spaces.prolongations["lam_n"]
+    fine_n, fine_t = p @ lam_n_c, p @ lam_t_c
+    space = pb.spaces.components["lam_n"]
+
+    edge_xy, edge_len, s_n, s_t, active, node_xy, ln, lt = ([] for _ in range(8))
+    offset = 0
+    for c, chain in enumerate(contact.chains):
+        interior = contact._interior(c)
+        contact_pos = {int(q) for q, flag in zip(interior, in_contact[offset:offset + len(interior)])
+                       if flag}
+        offset += len(interior)
+        nodes = contact.nodes[c]
+        verts = np.append(chain.vertices, chain.vertices[0]) if chain.closed else chain.vertices
+        pts = np.vstack([chain.points, chain.points[:1]]) if chain.closed else chain.points
+        for k in range(len(verts) - 1):
+            a, b = pts[k], pts[k + 1]
+            mid = 0.5 * (a + b)
+            tangent = (b - a) / np.linalg.norm(b - a)
+            # outward normal: rotate the tangent; fix its sign by a probe into the domain
+            normal = np.array([tangent[1], -tangent[0]])
+            probe = mid - 1e-6 * np.linalg.norm(b - a) * normal
+            if not mesh.Contains(*probe):
+                normal = -normal
+            tvec = np.array([normal[1], -normal[0]])
+            st = np.array(sigma(mesh(*(mid - 1e-9 * normal)))).reshape(2, 2)
+            traction = st @ normal
+            edge_xy.append(mid)
+            edge_len.append(np.linalg.norm(b - a))
+            s_n.append(normal @ traction)
+            s_t.append(tvec @ traction)
+            e = np.searchsorted(nodes, k, side="right") - 1
+            active.append(int(nodes[e]) in contact_pos or int(nodes[e + 1]) in contact_pos)
+        for v, xy in zip(verts, pts):
+            dof = space.GetDofNrs(ngs.NodeId(ngs.VERTEX, int(v)))[0]
+            node_xy.append(xy)
+            ln.append(fine_n[dof])
+            lt.append(fine_t[dof])
+    node_xy = np.array(node_xy)
+    coarse_xy = contact.node_points()
+    return ContactTraces(np.array(edge_xy), np.array(edge_len), np.array(s_n), np.array(s_t),
+                         np.array(active, dtype=bool), node_xy, np.array(ln), np.array(lt),
+                         gap.numpy(node_xy[:, 0], node_xy[:, 1]), coarse_xy, lam_n_c, lam_t_c,
+                         in_contact)
+
+
+def contact_summary(solution: Solution) -> dict:
+    """Nodes in contact (lambda_n = 0 on the h~ mesh), stick/slip among them, and F_abs.
+
+    F_abs = int_{A_C} |sigma_n| + |sigma_t| ds over the active part A_C: the
+    h~ edges with a node in contact.
+    """
+    if solution.problem.spaces.contact is None:
+        return {"nodes_in_contact": 0, "stick_nodes": 0, "slip_nodes": 0, "F_abs": 0.0}
+    tr = contact_traces(solution)
+    lam_t = tr.coarse_lam_t
+    scale = max(float(np.max(np.abs(lam_t), initial=0.0)), 1e-300)
+    stick = tr.coarse_in_contact & (np.abs(lam_t) <= CONTACT_TOL * scale)
+    f_abs = np.sum(tr.edge_length * (np.abs(tr.sigma_n) + np.abs(tr.sigma_t)) * tr.edge_active)
+    return {"nodes_in_contact": int(tr.coarse_in_contact.sum()), "stick_nodes": int(stick.sum()),
+            "slip_nodes": int((tr.coarse_in_contact & ~stick).sum()), "F_abs": float(f_abs)}
+
+
+def versions() -> dict:
+    """Versions of ngdual and the packages it depends on."""
+    out = {"ngdual": __version__, "python": platform.python_version(),
+           "platform": platform.platform()}
+    for pkg in ("ngsolve", "netgen-mesher", "numpy", "scipy", "cvxpy", "clarabel", "matplotlib"):
+        try:
+            out[pkg] = metadata.version(pkg)
+        except metadata.PackageNotFoundError:
+            out[pkg] = None
+    return out
+
+
+def result_record(solution: Solution) -> dict:
+    """The result record of SPEC section 6 (plain JSON-serialisable data)."""
+    pb = solution.problem
+    timings = {k: float(solution.timings.get(k, 0.0))
+               for k in ("assemble", "factorize", "solve", "total")}
+    return {
+        "scene": pb.scene.name,
+        "level": getattr(pb, "level", None),
+        "converged": bool(solution.converged),
+        "method": solution.method,
+        "dofs": pb.spaces.dofs(),
+        "norms": norms(solution),
+        "contact": contact_summary(solution),
+        "iterations": {k: int(v) for k, v in solution.iterations.items()},
+        "residuals": {k: float(v) for k, v in solution.residuals.items()},
+        "timings_s": timings,
+        "parameters": pb.scene.to_dict(),
+        "versions": versions(),
+    }
+
+
+def write_vtk(solution: Solution, filename: str) -> str:
+    """Write sigma, u, eta and the von Mises stress for ParaView; returns the file name."""
+    f = fields(solution)
+    pb = solution.problem
+    nu = pb.scene.material.nu
+    out = ngs.VTKOutput(pb.fes.mesh,
+                        coefs=[f.sigma[0, 0], f.sigma[0, 1], f.sigma[1, 0], f.sigma[1, 1],
+                               f.u, f.eta, von_mises(f.sigma, nu)],
+                        names=["sigma_11", "sigma_12", "sigma_21", "sigma_22", "u", "eta",
+                               "von_mises"],
+                        filename=str(filename), subdivision=0)
+    out.Do()
+    return str(filename) + ".vtu"
+
+
+def element_values(mesh: ngs.Mesh, cf) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Vertex coordinates, triangles and the value of ``cf`` at every centroid (for plots)."""
+    points = np.array([v.point for v in mesh.vertices])
+    triangles = np.array([[v.nr for v in el.vertices] for el in mesh.Elements(ngs.VOL)])
+    centroids = points[triangles].mean(axis=1)
+    mips = mesh(centroids[:, 0], centroids[:, 1])
+    return points, triangles, np.asarray(cf(mips)).ravel()
