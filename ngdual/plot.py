@@ -41,7 +41,8 @@ def plot_contact_traces(traces, path: Path, title: str = "") -> Path:
         ax.set_ylabel(label)
         ax.grid(alpha=0.3)
     contact = traces.coarse_xy[traces.coarse_in_contact, 0]
-    axes[1, 0].plot(contact, np.zeros_like(contact) - 0, "rv", ms=4, label="node in contact")
+    level = np.interp(contact, x_node[order], (traces.lam_n - traces.gap)[order])
+    axes[1, 0].plot(contact, level, "rv", ms=4, label=r"$\tilde h$-node in contact")
     axes[1, 0].legend(loc="best")
     for ax in axes[1]:
         ax.set_xlabel(r"$x_1$ on $\Gamma_C$ [length]")
