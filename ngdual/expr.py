@@ -41,7 +41,9 @@ def _check(node: ast.AST, text: str) -> None:
         if isinstance(sub, ast.Call):
             if isinstance(sub.func, ast.Name) and sub.func.id in _FUNCTIONS and not sub.keywords:
                 continue
-            raise ExpressionError(f"unsupported call in {text!r}")
+            name = sub.func.id if isinstance(sub.func, ast.Name) else ast.unparse(sub.func)
+            raise ExpressionError(f"unknown name {name!r} in {text!r} "
+                                  f"(functions: {', '.join(_FUNCTIONS)})")
         raise ExpressionError(f"unsupported syntax {type(sub).__name__} in {text!r}")
 
 

@@ -1,0 +1,43 @@
+"""`ngdual solve` prints the table and writes result.json with the fields of SPEC section 6."""
+
+import json
+
+from ngdual.cli import main
+
+KEYS = {"scene", "level", "converged", "dofs", "norms", "contact", "iterations", "residuals",
+        "timings_s", "versions"}
+
+
+def test_solve_writes_the_result_record(tmp_path, capsys):
+    assert main(["solve", "thesis-3.46-frictionless", "--level", "2", "--out", str(tmp_path),
+                 "--vtk"]) == 0
+    out = capsys.readouterr().out
+    assert "sigma_X=" in out and "nodes_in_contact=" in out
+    record = json.loads((tmp_path / "result.json").read_text())
+    assert KEYS <= set(record)
+    assert record["level"] == 2 and record["converged"] is True
+    assert set(record["dofs"]) == {"X", "M", "S", "N", "C", "L"}
+    assert record["dofs"]["X"] == 680
+    assert set(record["norms"]) == {"sigma_X", "u", "eta", "phi", "lam_t", "lam_n", "nu"}
+    assert record["norms"]["nu"] is None
+    assert set(record["contact"]) == {"nodes_in_contact", "stick_nodes", "slip_nodes", "F_abs"}
+    assert set(record["timings_s"]) == {"assemble", "factorize", "solve", "total"}
+    assert record["versions"]["ngsolve"] and record["versions"]["ngdual"]
+    assert record["contact"]["nodes_in_contact"] > 0
+    for name in ("von_mises.png", "contact_traces.png", "solution.vtu"):
+        assert (tmp_path / name).stat().st_size > 0
+    assert not list(tmp_path.glob("*.tmp"))
+
+
+def test_scene_without_contact_is_one_linear_solve(tmp_path):
+    assert main(["solve", "thesis-3.46-frictionless", "--level", "1", "--out", str(tmp_path),
+                 "--no-plots", "--set", "boundary.contact=[]",
+                 "--set", "boundary.dirichlet=['left', 'right', 'bottom']"]) == 0
+    record = json.loads((tmp_path / "result.json").read_text())
+    assert record["method"] == "linear" and record["dofs"]["C"] == 0
+
+
+def test_dofs_command_prints_table_3_1(capsys):
+    assert main(["dofs", "thesis-3.46-frictionless", "--levels", "1", "2"]) == 0
+    out = capsys.readouterr().out
+    assert "680" in out and "180" in out

@@ -1,0 +1,84 @@
+"""Bad scenes fail at validation with one line naming the field; the CLI exits 2, writes nothing."""
+
+import pytest
+
+from ngdual.cli import main
+from ngdual.scene import SceneError, load_scene, shipped_scenes
+
+BAD = [
+    (["boundary.contact=['floor']"], "boundary.contact", "unknown boundary label"),
+    (["boundary.dirichlet=['left']"], "boundary", "'right' has no condition"),
+    (["boundary.neumann=['top', 'right']", "boundary.dirichlet=['left']"], "boundary",
+     "touches"),
+    (["material.E=0"], "material.E", "positive"),
+    (["material.E=-2e5"], "material.E", "positive"),
+    (["material.nu=0.5"], "material.nu", "(-1, 0.5)"),
+    (["material.nu=-1"], "material.nu", "(-1, 0.5)"),
+    (["friction.mu=-0.1"], "friction.mu", ">= 0"),
+    (["contact.gap='x - 1'"], "contact.gap", "negative gap"),
+    (["contact.gap='foo(x)'"], "contact.gap", "unknown name"),
+    (["friction.law='stick'"], "friction.law", "unknown friction law"),
+    (["solver.eps=0"], "solver.eps", "positive"),
+    (["solver.rho=-1"], "solver.rho", "positive"),
+    (["solver.rho1=0"], "solver.rho1", "positive"),
+    (["solver.eps2=-1e-6"], "solver.eps2", "positive"),
+    (["solver.max_iter=0"], "solver.max_iter", "positive"),
+    (["solver.metric='l2'"], "solver.metric", "unknown metric"),
+    (["contact.hhat_factor=3"], "contact.hhat_factor", "must be 1"),
+    (["material.youngs=1"], "material.youngs", "unknown key"),
+    (["loads.traction=['0']"], "loads.traction", "pair"),
+    (["geometry.level=0"], "geometry.level", "positive"),
+]
+
+
+@pytest.mark.parametrize("overrides, field, words", BAD)
+def test_bad_scene_raises_one_line_error_naming_the_field(overrides, field, words):
+    with pytest.raises(SceneError) as info:
+        load_scene("thesis-3.46-frictionless", overrides)
+    message = str(info.value)
+    assert info.value.field == field
+    assert message.startswith(field + ":")
+    assert words in message
+    assert "\n" not in message
+
+
+@pytest.mark.parametrize("overrides, field, words", BAD[:6])
+def test_cli_exits_2_and_writes_no_result(tmp_path, capsys, overrides, field, words):
+    args = ["solve", "thesis-3.46-frictionless", "--level", "1", "--out", str(tmp_path)]
+    for item in overrides:
+        args += ["--set", item]
+    assert main(args) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and field in err
+    assert not any(tmp_path.iterdir())
+
+
+def test_unknown_scene_name_lists_the_shipped_ones():
+    with pytest.raises(SceneError, match="thesis-3.46-frictionless"):
+        load_scene("thesis-3.46-nonexistent")
+
+
+def test_polygon_must_be_counter_clockwise(tmp_path):
+    path = tmp_path / "cw.toml"
+    path.write_text("""
+[geometry]
+kind = "polygon"
+points = [[0, 0], [0, 1], [1, 1], [1, 0]]
+labels = ["a", "b", "c", "d"]
+[boundary]
+dirichlet = ["a", "b", "c", "d"]
+""")
+    with pytest.raises(SceneError, match="geometry.points"):
+        load_scene(path)
+
+
+@pytest.mark.parametrize("name", shipped_scenes())
+def test_every_shipped_scene_loads_and_validates(name):
+    scene = load_scene(name)
+    assert scene.name == name
+
+
+def test_friction_without_contact_is_rejected():
+    with pytest.raises(SceneError, match="friction.law"):
+        load_scene("thesis-3.46-coulomb", ["boundary.contact=[]",
+                                           "boundary.dirichlet=['left', 'right', 'bottom']"])
