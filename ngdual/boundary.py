@@ -117,6 +117,16 @@ class CoarseMesh:
         n = self.nodes[c]
         return n[:-1] if self.chains[c].closed else n[1:-1]
 
+    def _ends(self, c: int) -> np.ndarray:
+        """Positions of the end nodes of chain c (none for a closed chain)."""
+        n = self.nodes[c]
+        return n[:0] if self.chains[c].closed else n[[0, -1]]
+
+    def end_points(self) -> np.ndarray:
+        """Coordinates of the end nodes of all open chains, in the order of ``ends=True``."""
+        pts = [self.chains[c].points[self._ends(c)] for c in range(len(self.chains))]
+        return np.vstack(pts) if pts else np.zeros((0, 2))
+
     @property
     def n_p1_dofs(self) -> int:
         """dim of the coarse P1 space vanishing at the ends of every open chain."""
@@ -134,8 +144,12 @@ class CoarseMesh:
         """Lengths of all coarse edges, chain by chain."""
         return np.concatenate([np.diff(ch.arclength[n]) for ch, n in zip(self.chains, self.nodes)])
 
-    def p1_prolongation(self, fine_dof_of_vertex, n_fine: int) -> sp.csr_matrix:
+    def p1_prolongation(self, fine_dof_of_vertex, n_fine: int, ends: bool = False
+                        ) -> sp.csr_matrix:
         """Matrix of the coarse P1 hats evaluated at the fine vertices.
+
+        With ``ends=True`` only the hats of the chain end nodes (excluded from the
+        space, but needed to lift non-zero end values) are returned.
 
         Parameters
         ----------
@@ -152,9 +166,9 @@ class CoarseMesh:
         offset = 0
         for c, chain in enumerate(self.chains):
             s, nodes = chain.arclength, self.nodes[c]
-            interior = self._interior(c)
-            dof_of_pos = {int(p): offset + k for k, p in enumerate(interior)}
-            offset += len(interior)
+            carriers = self._ends(c) if ends else self._interior(c)
+            dof_of_pos = {int(p): offset + k for k, p in enumerate(carriers)}
+            offset += len(carriers)
             for e in range(len(nodes) - 1):
                 a, b = nodes[e], nodes[e + 1]
                 for p in range(a, b + 1):

@@ -104,7 +104,10 @@ class Expression:
         """The NGSolve ``CoefficientFunction`` of this formula."""
         import ngsolve as ngs
 
-        value = eval(self._code, {"__builtins__": {}}, _ngsolve_namespace())
+        # NGSolve's unary functions import lazily, so __import__ must be reachable;
+        # user text cannot name it (the parse check allows only whitelisted names)
+        value = eval(self._code, {"__builtins__": {"__import__": __import__}},
+                     _ngsolve_namespace())
         return value if isinstance(value, ngs.CoefficientFunction) else ngs.CF(float(value))
 
     def is_zero(self) -> bool:

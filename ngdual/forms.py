@@ -57,19 +57,22 @@ class Spaces:
     contact: CoarseMesh | None
     friction: CoarseMesh | None
     prolongations: dict[str, sp.csr_matrix] = field(default_factory=dict)
+    end_hats: dict[str, sp.csr_matrix] = field(default_factory=dict)
 
     @classmethod
     def build(cls, scene: Scene, mesh: ngs.Mesh) -> "Spaces":
         comps = peers.peers_spaces(mesh)
         factor = scene.contact.htilde_factor
         neumann = contact = friction = None
-        prolong = {}
+        prolong, end_hats = {}, {}
         if scene.labels("neumann"):
             neumann = CoarseMesh.from_fine(mesh, scene.labels("neumann"), factor)
             space = _trace_space(mesh, scene.labels("neumann"))
             comps["phi1"] = comps["phi2"] = space
             prolong["phi1"] = prolong["phi2"] = neumann.p1_prolongation(_vertex_dof(space),
                                                                         space.ndof)
+            end_hats["phi1"] = end_hats["phi2"] = neumann.p1_prolongation(
+                _vertex_dof(space), space.ndof, ends=True)
         if scene.has_contact:
             contact = CoarseMesh.from_fine(mesh, scene.labels("contact"), factor)
             space = _trace_space(mesh, scene.labels("contact"))
@@ -78,7 +81,7 @@ class Spaces:
                                                                           space.ndof)
             if scene.has_friction:
                 friction = contact.coarsened(scene.contact.hhat_factor)
-        return cls(mesh, comps, neumann, contact, friction, prolong)
+        return cls(mesh, comps, neumann, contact, friction, prolong, end_hats)
 
     def coarse_ndof(self, name: str) -> int:
         if name in self.prolongations:
@@ -106,6 +109,9 @@ class DiscreteProblem:
         Symmetric matrix of all unknowns (sigma, u, eta, phi, lambda_t, lambda_n).
     F : numpy.ndarray
         Right-hand side (g, -f, 0, t0, 0, 0).
+    lift : numpy.ndarray
+        Fine coefficients of the known end values phi = -u_D at the ends of
+        Gamma_N (zero for the homogeneous Dirichlet data of the thesis).
     blocks : dict[str, slice]
         Position of every component in the unknown vector.
     """
@@ -118,7 +124,9 @@ class DiscreteProblem:
     K: sp.csr_matrix
     F: np.ndarray
     blocks: dict[str, slice]
+    lift: np.ndarray
     assemble_seconds: float
+    level: int | None = None
 
     def index(self, *names: str) -> np.ndarray:
         """Indices of the listed components in the unknown vector."""
@@ -151,7 +159,7 @@ class DiscreteProblem:
 
     def to_fine(self, x: np.ndarray) -> np.ndarray:
         """Coefficients of the fine product space from a coarse unknown vector."""
-        return self.P @ x
+        return self.P @ x + self.lift
 
 
 def _forms(scene: Scene, fes: ngs.FESpace, names: list[str]):
@@ -222,8 +230,23 @@ def assemble(scene: Scene, mesh: ngs.Mesh) -> DiscreteProblem:
         blocks[name] = slice(offset, offset + p.shape[1])
         offset += p.shape[1]
     P = sp.block_diag(blocks_p, format="csr")
-    K = (P.T @ _to_scipy(a.mat) @ P).tocsr()
+    K_fine = _to_scipy(a.mat)
+    K = (P.T @ K_fine @ P).tocsr()
     K.eliminate_zeros()
-    F = P.T @ rhs.vec.FV().NumPy()
-    return DiscreteProblem(scene, spaces, fes, names, P, K, F, blocks,
+    lift = _end_lift(scene, spaces, fes, names)
+    F = P.T @ (rhs.vec.FV().NumPy() - K_fine @ lift)
+    return DiscreteProblem(scene, spaces, fes, names, P, K, F, blocks, lift,
                            time.perf_counter() - start)
+
+
+def _end_lift(scene: Scene, spaces: Spaces, fes: ngs.FESpace, names: list[str]) -> np.ndarray:
+    """phi = -u_D at the ends of Gamma_N, where the coarse P1 space has no dofs."""
+    lift = np.zeros(fes.ndof)
+    if spaces.neumann is None:
+        return lift
+    ends = spaces.neumann.end_points()
+    for comp, formula in zip(("phi1", "phi2"), scene.loads.displacement):
+        values = -Expression(formula).numpy(ends[:, 0], ends[:, 1])
+        rng = fes.Range(names.index(comp))
+        lift[rng.start:rng.stop] = spaces.end_hats[comp] @ values
+    return lift

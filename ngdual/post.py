@@ -201,7 +201,7 @@ def result_record(solution: Solution) -> dict:
                for k in ("assemble", "factorize", "solve", "total")}
     return {
         "scene": pb.scene.name,
-        "level": getattr(pb, "level", None),
+        "level": pb.level,
         "converged": bool(solution.converged),
         "method": solution.method,
         "dofs": pb.spaces.dofs(),

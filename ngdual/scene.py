@@ -342,6 +342,19 @@ def _contact_points(scene: Scene, per_side: int = 401) -> tuple[np.ndarray, np.n
     return xy[:, 0], xy[:, 1]
 
 
+def _validate_contact_ends(scene: Scene, u_d: list[Expression]) -> None:
+    """lambda_t, lambda_n vanish at the ends of Gamma_C (C_h~ of (3.61)), so must u_D there."""
+    ends = np.array([p for label, a, b in scene.geometry.sides()
+                     if label in scene.labels("contact") for p in (a, b)])
+    if not len(ends):
+        return
+    values = np.abs(np.concatenate([e.numpy(ends[:, 0], ends[:, 1]) for e in u_d]))
+    if values.max() > 1e-12:
+        raise SceneError("loads.displacement", "the prescribed displacement must vanish where "
+                                               "Gamma_D meets Gamma_C (the contact multipliers "
+                                               "are zero at the ends of Gamma_C)")
+
+
 def validate(scene: Scene) -> None:
     """Raise :class:`SceneError` for the first problem found in ``scene``."""
     _validate_geometry(scene.geometry)
@@ -352,7 +365,8 @@ def validate(scene: Scene) -> None:
         raise SceneError("material.nu", f"Poisson's ratio must lie in (-1, 0.5), got {mat.nu!r}")
     _pair(scene.loads.body_force, "loads.body_force")
     _pair(scene.loads.traction, "loads.traction")
-    _pair(scene.loads.displacement, "loads.displacement")
+    u_d = _pair(scene.loads.displacement, "loads.displacement")
+    _validate_contact_ends(scene, u_d)
 
     con, fr, sol = scene.contact, scene.friction, scene.solver
     gap = _expression(con.gap, "contact.gap")

@@ -82,3 +82,21 @@ def test_friction_without_contact_is_rejected():
     with pytest.raises(SceneError, match="friction.law"):
         load_scene("thesis-3.46-coulomb", ["boundary.contact=[]",
                                            "boundary.dirichlet=['left', 'right', 'bottom']"])
+
+
+def test_formulas_with_transcendental_functions_assemble():
+    from ngdual.expr import Expression
+    import ngsolve as ngs
+
+    cf = Expression("sin(x) + exp(y) * cos(pi*x) + sqrt(abs(x)) + log(2) + atan(y)").coefficient()
+    mesh = __import__("ngdual.mesh", fromlist=["x"]).thesis_mesh(1)
+    value = cf(mesh(0.5, 0.25))
+    expected = Expression("sin(x) + exp(y) * cos(pi*x) + sqrt(abs(x)) + log(2) + atan(y)").numpy(
+        __import__("numpy").array([0.5]), __import__("numpy").array([0.25]))[0]
+    assert abs(value - expected) < 1e-12
+    assert isinstance(cf, ngs.CoefficientFunction)
+
+
+def test_nonzero_displacement_at_the_ends_of_gamma_c_is_rejected():
+    with pytest.raises(SceneError, match="loads.displacement"):
+        load_scene("thesis-3.46-frictionless", ["loads.displacement=['0.001', '0']"])

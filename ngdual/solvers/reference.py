@@ -1,0 +1,129 @@
+"""A reference solver independent of Algorithm 3.38: the frictionless problem as one convex QP.
+
+The algebraic problem (3.103), i.e. the discrete variational inequality (3.68)
+without friction, is the KKT system of
+
+    min_sigma 1/2 sigma^T A sigma - g^T sigma   s.t.  B^T sigma = b,  C_n^T sigma <= 0,
+
+with the multipliers (u, eta, phi, lambda_t) of the equalities and lambda_n >= 0
+of the inequalities. Here the QP is solved directly by Clarabel's interior-point
+method through cvxpy and then polished once on the active set it found, so
+nothing is shared with the Uzawa iteration or its saddle-point factorisation.
+"""
+
+from __future__ import annotations
+
+import time
+
+import cvxpy as cp
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from ..forms import DiscreteProblem
+from .result import Solution
+
+CLARABEL_TOLERANCES = {"tol_gap_abs": 1e-12, "tol_gap_rel": 1e-12, "tol_feas": 1e-12,
+                       "tol_ktratio": 1e-10, "max_iter": 500}
+FEASIBILITY_TOL = 1e-10
+
+
+def solve_qp(problem: DiscreteProblem) -> Solution:
+    """Solve (3.103), the algebraic form of (3.68), as one convex QP in sigma (Clarabel via cvxpy).
+
+    The QP is posed in scaled variables so that its numbers are O(1): the
+    compliance block is multiplied by the plane-strain modulus E* and sigma is
+    measured in the stress unit ``s = max(max|b|, E* max|g|)``. Then
+    ``sigma = s z``, and the multipliers of the scaled QP give
+    ``(u, eta, phi, lambda_t, lambda_n) = (s / E*) * (duals)``.
+
+    Returns
+    -------
+    Solution
+        ``x`` ordered like ``problem.K``; ``residuals`` holds the relative
+        stationarity residual ||A sigma + B y + C_n lambda_n - g|| / (||g|| + ||A sigma||),
+        the equality residual, the three contact residuals of (3.103) and
+        ``polished`` (1.0 if the active-set polish was accepted).
+    """
+    i_sigma, i_mult, i_lam = problem.sigma, problem.mult, problem.lam_n
+    A = problem.block(i_sigma, i_sigma)
+    B = problem.block(i_sigma, i_mult)
+    C_n = problem.block(i_sigma, i_lam)
+    g, b = problem.F[i_sigma], problem.F[i_mult]
+    modulus = problem.scene.material.plane_strain_modulus
+    stress = max(np.max(np.abs(b), initial=0.0), modulus * np.max(np.abs(g), initial=0.0)) or 1.0
+    A_s, g_s, b_s = modulus * A, modulus / stress * g, b / stress
+
+    start = time.perf_counter()
+    z = cp.Variable(len(i_sigma))
+    equality, contact = B.T @ z == b_s, C_n.T @ z <= 0
+    qp = cp.Problem(cp.Minimize(0.5 * cp.quad_form(z, A_s, assume_PSD=True) - g_s @ z),
+                    [equality, contact])
+    qp.solve(solver=cp.CLARABEL, **CLARABEL_TOLERANCES)
+    if z.value is None:
+        raise RuntimeError(f"Clarabel returned no solution (status {qp.status!r})")
+    # cvxpy's Lagrangian is f + y^T (B^T z - b) + lambda^T C_n^T z, the sign of (3.103)
+    scaled = (z.value, equality.dual_value, np.maximum(contact.dual_value, 0.0))
+    qp_s = time.perf_counter() - start
+
+    start = time.perf_counter()
+    polished = _polish(A_s, B, C_n, g_s, b_s, *scaled)
+    polish_s = time.perf_counter() - start
+    z_v, y_v, lam_v = polished if polished is not None else scaled
+
+    x = np.zeros(problem.K.shape[0])
+    x[i_sigma] = stress * z_v
+    x[i_mult] = stress / modulus * y_v
+    x[i_lam] = stress / modulus * lam_v
+    residuals = {**_residuals(A, B, C_n, g, b, x[i_sigma], x[i_mult], x[i_lam]),
+                 "polished": float(polished is not None)}
+    converged = polished is not None or qp.status == cp.OPTIMAL
+    return Solution(problem, x, converged, "reference-qp", iterations={"outer": 0, "inner": 0},
+                    residuals=residuals,
+                    timings={"assemble": problem.assemble_seconds, "qp": qp_s,
+                             "polish": polish_s, "solve": qp_s + polish_s})
+
+
+def _polish(A, B, C_n, g, b, z, y, lam):
+    """Solve the KKT system with C_n^T sigma = 0 imposed where lambda_n > 0, else None.
+
+    A constraint counts as active where its multiplier is relatively larger
+    than its slack (the usual interior-point identification). The result is
+    accepted only if it satisfies lambda_n >= 0 and C_n^T sigma <= 0: then it
+    meets every KKT condition of the strictly convex QP, so it is the solution
+    whichever active set was guessed.
+    """
+    slack = -(C_n.T @ z)
+    active = lam / (np.max(lam, initial=0.0) or 1.0) > slack / (np.max(slack, initial=0.0) or 1.0)
+    C_a = C_n[:, active]
+    n_s, n_m, n_a = len(z), B.shape[1], int(active.sum())
+    kkt = sp.bmat([[A, B, C_a], [B.T, None, None], [C_a.T, None, None]], format="csc")
+    sol = spla.spsolve(kkt, np.concatenate([g, b, np.zeros(n_a)]))
+    z_p, y_p = sol[:n_s], sol[n_s:n_s + n_m]
+    lam_p = np.zeros_like(lam)
+    lam_p[active] = sol[n_s + n_m:]
+    traction = C_n.T @ z_p
+    if not np.all(np.isfinite(sol)):
+        return None
+    if lam_p.min(initial=0.0) < -FEASIBILITY_TOL * (np.max(np.abs(lam_p), initial=0.0) or 1.0):
+        return None
+    if traction.max(initial=0.0) > FEASIBILITY_TOL * (np.max(np.abs(traction), initial=0.0) or 1.0):
+        return None
+    return z_p, y_p, np.maximum(lam_p, 0.0)
+
+
+def _residuals(A, B, C_n, g, b, sigma, y, lam) -> dict:
+    """Relative residuals of (3.103): stationarity, equalities, sign conditions, complementarity."""
+    traction = C_n.T @ sigma
+    a_sigma = A @ sigma
+    lam_scale = np.max(np.abs(lam), initial=0.0) or 1.0
+    tr_scale = np.max(np.abs(traction), initial=0.0) or 1.0
+    return {
+        "stationarity": float(np.linalg.norm(a_sigma + B @ y + C_n @ lam - g)
+                              / ((np.linalg.norm(g) + np.linalg.norm(a_sigma)) or 1.0)),
+        "equality": float(np.linalg.norm(B.T @ sigma - b) / (np.linalg.norm(b) or 1.0)),
+        "lambda_n_negative": float(max(0.0, -lam.min(initial=0.0)) / lam_scale),
+        "sigma_n_positive": float(max(0.0, traction.max(initial=0.0)) / tr_scale),
+        "complementarity": float(abs(lam @ traction)
+                                 / ((np.linalg.norm(lam) * np.linalg.norm(traction)) or 1.0)),
+    }
