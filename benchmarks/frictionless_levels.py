@@ -41,7 +41,8 @@ def main() -> None:
         print(json.dumps(one_level(args.one, args.metric)))
         return
     rows = []
-    print(f"machine: {platform.processor() or platform.machine()}, python {platform.python_version()}")
+    machine = platform.processor() or platform.machine()
+    print(f"machine: {machine}, python {platform.python_version()}")
     print(f"{'lvl':>3} {'unknowns':>9} {'its':>4} {'assemble':>9} {'factor':>8} {'iterate':>8} "
           f"{'total':>8} {'RSS MB':>7} {'sigma_X':>12} {'u':>11} {'eta':>11} {'phi':>11} "
           f"{'lam_t':>11} {'lam_n':>11}")

@@ -98,12 +98,12 @@ class CoarseMesh:
     nodes: tuple[np.ndarray, ...]
 
     @classmethod
-    def from_fine(cls, mesh: ngs.Mesh, labels: list[str], factor: int) -> "CoarseMesh":
+    def from_fine(cls, mesh: ngs.Mesh, labels: list[str], factor: int) -> CoarseMesh:
         """Group the fine boundary edges of ``labels`` ``factor`` at a time."""
         chains = tuple(boundary_chains(mesh, labels))
         return cls(chains, tuple(_group(c.n_edges, factor) for c in chains))
 
-    def coarsened(self, factor: int) -> "CoarseMesh":
+    def coarsened(self, factor: int) -> CoarseMesh:
         """Group this mesh's edges ``factor`` at a time (h^ = factor * h~, nested)."""
         return CoarseMesh(self.chains,
                           tuple(n[_group(len(n) - 1, factor)] for n in self.nodes))

@@ -60,7 +60,7 @@ class Spaces:
     end_hats: dict[str, sp.csr_matrix] = field(default_factory=dict)
 
     @classmethod
-    def build(cls, scene: Scene, mesh: ngs.Mesh) -> "Spaces":
+    def build(cls, scene: Scene, mesh: ngs.Mesh) -> Spaces:
         comps = peers.peers_spaces(mesh)
         factor = scene.contact.htilde_factor
         neumann = contact = friction = None
@@ -188,7 +188,7 @@ def _forms(scene: Scene, fes: ngs.FESpace, names: list[str]):
     ds_d = ngs.ds(definedon=mesh.Boundaries(_boundary_regex(scene.labels("dirichlet"))),
                   bonus_intorder=TRACE_BONUS_ORDER)
     u_d = ngs.CF(tuple(Expression(e).coefficient() for e in scene.loads.displacement))
-    rhs += u_d * trac_tau * ds_d                                              # prescribed u on Gamma_D
+    rhs += u_d * trac_tau * ds_d                                              # u = u_D on Gamma_D
     if "phi1" in names:
         ds_n = ngs.ds(definedon=mesh.Boundaries(_boundary_regex(scene.labels("neumann"))),
                       bonus_intorder=TRACE_BONUS_ORDER)

@@ -13,9 +13,8 @@ from __future__ import annotations
 import ngsolve as ngs
 import numpy as np
 from netgen.geom2d import SplineGeometry
-from netgen.meshing import Element1D, Element2D, FaceDescriptor, MeshPoint
+from netgen.meshing import Element1D, Element2D, FaceDescriptor, MeshPoint, Pnt
 from netgen.meshing import Mesh as NetgenMesh
-from netgen.meshing import Pnt
 
 from .scene import Geometry
 

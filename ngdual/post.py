@@ -128,8 +128,8 @@ def contact_traces(solution: Solution) -> ContactTraces:
     offset = 0
     for c, chain in enumerate(contact.chains):
         interior = contact._interior(c)
-        contact_pos = {int(q) for q, flag in zip(interior, in_contact[offset:offset + len(interior)])
-                       if flag}
+        flags = in_contact[offset:offset + len(interior)]
+        contact_pos = {int(q) for q, flag in zip(interior, flags) if flag}
         offset += len(interior)
         nodes = contact.nodes[c]
         verts = np.append(chain.vertices, chain.vertices[0]) if chain.closed else chain.vertices

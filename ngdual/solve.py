@@ -7,7 +7,7 @@ contact, no friction -> Algorithm 3.38 (Uzawa)
 from __future__ import annotations
 
 import time
-from typing import Callable
+from collections.abc import Callable
 
 from .forms import assemble
 from .mesh import build_mesh

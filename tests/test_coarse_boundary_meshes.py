@@ -1,7 +1,7 @@
 """Coarse boundary meshes: nesting, zero end values, P1 partition of unity."""
 
-import numpy as np
 import ngsolve as ngs
+import numpy as np
 
 from ngdual.boundary import CoarseMesh, boundary_chains
 from ngdual.forms import _trace_space, _vertex_dof

@@ -85,8 +85,9 @@ def test_friction_without_contact_is_rejected():
 
 
 def test_formulas_with_transcendental_functions_assemble():
-    from ngdual.expr import Expression
     import ngsolve as ngs
+
+    from ngdual.expr import Expression
 
     cf = Expression("sin(x) + exp(y) * cos(pi*x) + sqrt(abs(x)) + log(2) + atan(y)").coefficient()
     mesh = __import__("ngdual.mesh", fromlist=["x"]).thesis_mesh(1)

@@ -2,7 +2,8 @@
 
 Remark 3.40: step 4 of Algorithm 3.38 is the convex QP
 
-    lambda_n = argmin_{chi >= 0} 1/2 chi^T W chi - chi^T c,   c = W lambda_n^{i-1} + rho C_n^T sigma^i,
+    lambda_n = argmin_{chi >= 0} 1/2 chi^T W chi - chi^T c,
+    c = W lambda_n^{i-1} + rho C_n^T sigma^i,
 
 with W the matrix of the metric. Two metrics are offered:
 

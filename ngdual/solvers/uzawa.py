@@ -13,7 +13,7 @@ residual of the discrete variational inequality is reported alongside.
 from __future__ import annotations
 
 import time
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 
