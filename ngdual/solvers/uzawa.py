@@ -56,6 +56,58 @@ def contact_residuals(lam: np.ndarray, traction: np.ndarray,
     }
 
 
+class ContactLoop:
+    """Steps 3-5 of Algorithm 3.38 (the inner loop, steps 4-7, of Algorithm 3.41).
+
+    Holds what never changes during an iteration: the factorised saddle-point
+    matrix, C_n, the projection P^+ and g. :meth:`run` iterates for a given
+    right-hand side of the (u, eta, phi, lambda_t) rows, warm-started from lambda_n.
+    """
+
+    def __init__(self, problem: DiscreteProblem, metric: str, backend: str = "umfpack"):
+        self.problem = problem
+        self.saddle, self.n_sigma = problem.saddle, len(problem.sigma)
+        self.fact = Factorization(problem.block(self.saddle, self.saddle), backend)
+        self.C_n = problem.block(problem.sigma, problem.lam_n)
+        modulus = problem.scene.material.plane_strain_modulus
+        self.projection = NonnegativeProjection(
+            metric_matrix(problem.spaces.contact, modulus, metric))
+        self.g = problem.F[problem.sigma]
+
+    def run(self, b: np.ndarray, lam: np.ndarray, rho: float, eps: float, max_iter: int,
+            progress: Callable[[int, float], None] | None = None):
+        """Iterate until the relative increment is <= eps.
+
+        Returns ``(y, lam, iterations, history, converged)`` where y = (sigma,
+        u, eta, phi, lambda_t) solves the linear system with ``lam`` exactly.
+        """
+        rhs = np.concatenate([self.g, b])
+        y_prev = np.zeros(len(self.saddle))
+        history, converged = [], False
+        for it in range(1, max_iter + 1):
+            rhs[:self.n_sigma] = self.g - self.C_n @ lam
+            y = self.fact.solve(rhs)                                            # step 3
+            traction = self.C_n.T @ y[:self.n_sigma]
+            lam_new = self.projection(self.projection.matvec(lam) + rho * traction)  # step 4
+            change = np.sqrt(np.sum((y - y_prev) ** 2) + np.sum((lam_new - lam) ** 2))
+            size = np.sqrt(np.sum(y**2) + np.sum(lam_new**2)) or 1.0
+            history.append(float(change / size))
+            if progress:
+                progress(it, history[-1])
+            if not np.isfinite(history[-1]) or history[-1] > DIVERGENCE_FACTOR * history[0]:
+                raise ConvergenceError(f"Uzawa diverged at step {it} (rho = {rho} too large?)",
+                                       history)
+            y_prev = y
+            if history[-1] <= eps:                                              # step 5
+                converged = True
+                break
+            lam = lam_new
+        return y, lam, it, history, converged
+
+    def residuals(self, y: np.ndarray, lam: np.ndarray) -> dict:
+        return contact_residuals(lam, self.C_n.T @ y[:self.n_sigma], self.projection)
+
+
 def uzawa(problem: DiscreteProblem, rho: float = 1.0, eps: float = 1e-8, max_iter: int = 2000,
           metric: str = "h12", backend: str = "umfpack",
           progress: Callable[[int, float], None] | None = None) -> Solution:
@@ -77,44 +129,17 @@ def uzawa(problem: DiscreteProblem, rho: float = 1.0, eps: float = 1e-8, max_ite
     ConvergenceError
         If the increments grow by a factor 1e6 (rho too large) or become NaN.
     """
-    saddle, i_lam = problem.saddle, problem.lam_n
-    n_sigma = len(problem.sigma)
-    fact = Factorization(problem.block(saddle, saddle), backend)
-    C_n = problem.block(problem.sigma, i_lam)
-    modulus = problem.scene.material.plane_strain_modulus
-    projection = NonnegativeProjection(metric_matrix(problem.spaces.contact, modulus, metric))
-
+    loop = ContactLoop(problem, metric, backend)
     start = time.perf_counter()
-    rhs = problem.F[saddle].copy()
-    g = rhs[:n_sigma].copy()
-    lam = np.zeros(len(i_lam))
-    y_prev = np.zeros(len(saddle))
-    history, converged = [], False
-    for it in range(1, max_iter + 1):
-        rhs[:n_sigma] = g - C_n @ lam
-        y = fact.solve(rhs)                                            # step 3
-        traction = C_n.T @ y[:n_sigma]
-        lam_new = projection(projection.matvec(lam) + rho * traction)  # step 4
-        change = np.sqrt(np.sum((y - y_prev) ** 2) + np.sum((lam_new - lam) ** 2))
-        size = np.sqrt(np.sum(y**2) + np.sum(lam_new**2)) or 1.0
-        history.append(float(change / size))
-        if progress:
-            progress(it, history[-1])
-        if not np.isfinite(history[-1]) or history[-1] > DIVERGENCE_FACTOR * history[0]:
-            raise ConvergenceError(f"Uzawa diverged at step {it} (rho = {rho} too large?)",
-                                   history)
-        y_prev = y
-        if history[-1] <= eps:                                          # step 5
-            converged = True
-            break
-        lam = lam_new
-    # (y, lam) is a consistent pair: y solves the linear system with lam exactly
+    lam0 = np.zeros(len(problem.lam_n))
+    y, lam, its, history, converged = loop.run(problem.F[problem.mult], lam0, rho, eps,
+                                               max_iter, progress)
     x = np.zeros(problem.K.shape[0])
-    x[saddle], x[i_lam] = y, lam
-    residuals = {"increment": history[-1], **contact_residuals(lam, C_n.T @ y[:n_sigma],
-                                                                projection)}
+    x[problem.saddle], x[problem.lam_n] = y, lam
+    residuals = {"increment": history[-1], **loop.residuals(y, lam)}
     return Solution(problem, x, converged, f"uzawa-{metric}",
-                    iterations={"outer": it, "inner": 0}, residuals=residuals,
+                    iterations={"outer": its, "inner": 0}, residuals=residuals,
                     history=history,
-                    timings={"assemble": problem.assemble_seconds, "factorize": fact.seconds,
+                    timings={"assemble": problem.assemble_seconds,
+                             "factorize": loop.fact.seconds,
                              "solve": time.perf_counter() - start})
