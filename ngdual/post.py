@@ -64,7 +64,7 @@ def norms(solution: Solution) -> dict:
         "eta": np.sqrt(ngs.Integrate(f.eta * f.eta, mesh)),
         "phi": np.sqrt(_boundary_integral(f.phi * f.phi, mesh, scene.labels("neumann")))
         if f.phi is not None else 0.0,
-        "lam_t": 0.0, "lam_n": 0.0, "nu": None,
+        "lam_t": 0.0, "lam_n": 0.0, "nu": solution.nu_l2,
     }
     if f.lam_n is not None:
         out["lam_t"] = np.sqrt(_boundary_integral(f.lam_t * f.lam_t, mesh,

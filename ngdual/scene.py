@@ -138,7 +138,7 @@ class Solver:
     eps: float = 1e-8
     max_iter: int = 2000
     rho1: float = 1.0
-    rho2: float = 1.0
+    rho2: float = 2.0
     eps1: float = 1e-8
     eps2: float = 1e-6
     loop_order: str = "friction-outer"

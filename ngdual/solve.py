@@ -2,6 +2,7 @@
 
 no contact boundary  -> one linear saddle-point solve
 contact, no friction -> Algorithm 3.38 (Uzawa)
+Tresca / Coulomb     -> Algorithm 3.41 / Remark 3.45 (nested Uzawa)
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ from collections.abc import Callable
 from .forms import assemble
 from .mesh import build_mesh
 from .scene import Scene
+from .solvers.nested import nested_uzawa
 from .solvers.result import Solution
 from .solvers.uzawa import solve_linear, uzawa
 
@@ -29,7 +31,10 @@ def solve_scene(scene: Scene, level: int | None = None,
         solution = uzawa(problem, rho=s.rho, eps=s.eps, max_iter=s.max_iter, metric=s.metric,
                          progress=progress)
     else:
-        raise NotImplementedError(f"friction law {scene.friction.law!r} is not implemented yet "
-                                  "(scene loads and validates; see the friction issue)")
+        s = scene.solver
+        solution = nested_uzawa(problem, scene.friction.law, mu_f=scene.friction.mu,
+                                rho1=s.rho1, rho2=s.rho2, eps1=s.eps1, eps2=s.eps2,
+                                max_iter=s.max_iter, metric=s.metric, loop_order=s.loop_order,
+                                progress=progress)
     solution.timings["total"] = time.perf_counter() - start
     return solution

@@ -22,6 +22,8 @@ class Solution:
     """A discrete solution of (3.62) with its iteration record.
 
     ``x`` is ordered like ``problem.K``: (sigma, u, eta, phi, lambda_t, lambda_n).
+    With friction, ``nu`` holds the h^ values of nu and ``friction_bound`` the
+    final F per fine Gamma_C edge.
     """
 
     problem: DiscreteProblem
@@ -32,6 +34,9 @@ class Solution:
     residuals: dict = field(default_factory=dict)
     history: list = field(default_factory=list)
     timings: dict = field(default_factory=dict)
+    nu: np.ndarray | None = None
+    friction_bound: np.ndarray | None = None
+    nu_l2: float | None = None
 
     def part(self, *names: str) -> np.ndarray:
         return self.x[self.problem.index(*names)]

@@ -1,0 +1,161 @@
+"""Friction terms on Gamma_C: nu on the h^ mesh, q(kappa, mu) = int F kappa mu ds, F of (3.123).
+
+nu is piecewise constant on the h^ edges (L_h^ of (3.61)); F is taken
+piecewise constant on the fine edges of T_h along Gamma_C: for Tresca the mean
+of the given bound on each fine edge, for Coulomb (Remark 3.45, (3.123))
+F|_e^ = mu_f / n^ sum_{e in e^} |sigma_n|_e on every h^ edge. With that,
+
+    (Q_F)_{ji} = q(mu_i, kappa_j) = sum_{e in e^_j} F_e |e| (mu_i(a_e) + mu_i(b_e)) / 2
+
+exactly, mu_i the h~ hats and kappa_j the indicator of the h^ edge j.
+The normal and tangential stress per fine edge are linear maps of the unknown
+vector, assembled once by NGSolve against piecewise constants on Gamma_C.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import ngsolve as ngs
+import numpy as np
+import scipy.sparse as sp
+
+from . import peers
+from .expr import Expression
+from .forms import DiscreteProblem, _boundary_regex
+
+GAUSS = (np.array([0.5 - np.sqrt(15) / 10, 0.5, 0.5 + np.sqrt(15) / 10]),
+         np.array([5, 8, 5]) / 18)
+
+
+@dataclass
+class FrictionForms:
+    """Everything the friction loop needs on Gamma_C.
+
+    Attributes
+    ----------
+    T_n, T_t : scipy.sparse.csr_matrix
+        sigma_n and sigma_t on every fine Gamma_C edge: ``T_n @ x``.
+    lengths : numpy.ndarray
+        Fine edge lengths.
+    midpoint_hats : scipy.sparse.csr_matrix
+        Mean value of every h~ hat on every fine edge.
+    edge_of : numpy.ndarray
+        Index of the h^ edge containing each fine edge.
+    hat_lengths : numpy.ndarray
+        Lengths of the h^ edges: the (diagonal) mass matrix of L_h^.
+    midpoints : numpy.ndarray
+        Fine edge midpoints (for plots).
+    """
+
+    T_n: sp.csr_matrix
+    T_t: sp.csr_matrix
+    lengths: np.ndarray
+    midpoint_hats: sp.csr_matrix
+    edge_of: np.ndarray
+    hat_lengths: np.ndarray
+    midpoints: np.ndarray
+
+    @property
+    def n_nu(self) -> int:
+        return len(self.hat_lengths)
+
+    def q_matrix(self, F_edges: np.ndarray) -> sp.csr_matrix:
+        """Q_F (N_A x N_C) of (3.95) for F given per fine edge."""
+        R = sp.csr_matrix((F_edges * self.lengths, (self.edge_of, np.arange(len(self.lengths)))),
+                          shape=(self.n_nu, len(self.lengths)))
+        return (R @ self.midpoint_hats).tocsr()
+
+    def coulomb_bound(self, x: np.ndarray, mu_f: float) -> np.ndarray:
+        """F of (3.123) per fine edge: mu_f times the mean |sigma_n| over its h^ edge."""
+        abs_n = np.abs(self.T_n @ x)
+        per_hat = np.bincount(self.edge_of, abs_n, self.n_nu) / np.bincount(self.edge_of,
+                                                                              None, self.n_nu)
+        return mu_f * per_hat[self.edge_of]
+
+    def per_hat_edge(self, F_edges: np.ndarray) -> np.ndarray:
+        """Mean of a fine-edge quantity over each h^ edge."""
+        return np.bincount(self.edge_of, F_edges, self.n_nu) / np.bincount(self.edge_of, None,
+                                                                             self.n_nu)
+
+    def l2_norm_nu(self, nu: np.ndarray, active: np.ndarray | None = None) -> float:
+        """||nu||_{L^2(A_C)}; A_C = the h^ edges where ``active`` is true (all by default)."""
+        w = self.hat_lengths if active is None else self.hat_lengths * active
+        return float(np.sqrt(np.sum(w * nu**2)))
+
+
+def _edge_functionals(problem: DiscreteProblem):
+    """Matrices of int_e sigma_n ds and int_e sigma_t ds for every fine Gamma_C edge."""
+    mesh, fes, names = problem.fes.mesh, problem.fes, problem.names
+    labels = problem.scene.labels("contact")
+    p0 = ngs.Compress(ngs.SurfaceL2(mesh, order=0,
+                                    definedon=mesh.Boundaries(_boundary_regex(labels))))
+    trial = dict(zip(names, fes.TrialFunction()))
+    v0 = p0.TestFunction()
+    traction = peers.stress_traction(trial["r1"], trial["r2"])
+    n = ngs.specialcf.normal(2)
+    t = ngs.CF((n[1], -n[0]))
+    ds = ngs.ds(definedon=mesh.Boundaries(_boundary_regex(labels)))
+    mats = []
+    for direction in (n, t):
+        form = ngs.BilinearForm(trialspace=fes, testspace=p0)
+        form += (direction * traction) * v0 * ds
+        form.Assemble()
+        rows, cols, vals = form.mat.COO()
+        fine = sp.csr_matrix((np.asarray(vals), (np.asarray(rows), np.asarray(cols))),
+                             shape=(p0.ndof, fes.ndof))
+        mats.append((fine @ problem.P).tocsr())
+    dof_of_edge = {}
+    for el in mesh.Elements(ngs.BND):
+        if el.mat in labels:
+            key = frozenset(v.nr for v in el.vertices)
+            dof_of_edge[key] = p0.GetDofNrs(el)[0]
+    return mats, dof_of_edge
+
+
+def build_friction_forms(problem: DiscreteProblem) -> FrictionForms:
+    """Fine-edge traces, hat means and the h^ edge map for the contact boundary."""
+    spaces = problem.spaces
+    contact, hat = spaces.contact, spaces.friction
+    (int_n, int_t), dof_of_edge = _edge_functionals(problem)
+    space = spaces.components["lam_n"]
+    P = spaces.prolongations["lam_n"]
+    order, lengths, mids, edge_of, hat_rows = [], [], [], [], []
+    hat_offset = 0
+    for c, chain in enumerate(contact.chains):
+        verts = np.append(chain.vertices, chain.vertices[0]) if chain.closed else chain.vertices
+        pts = np.vstack([chain.points, chain.points[:1]]) if chain.closed else chain.points
+        for k in range(len(verts) - 1):
+            order.append(dof_of_edge[frozenset((int(verts[k]), int(verts[k + 1])))])
+            lengths.append(np.linalg.norm(pts[k + 1] - pts[k]))
+            mids.append(0.5 * (pts[k] + pts[k + 1]))
+            edge_of.append(hat_offset + np.searchsorted(hat.nodes[c], k, side="right") - 1)
+            a = space.GetDofNrs(ngs.NodeId(ngs.VERTEX, int(verts[k])))[0]
+            b = space.GetDofNrs(ngs.NodeId(ngs.VERTEX, int(verts[k + 1])))[0]
+            hat_rows.append((a, b))
+        hat_offset += len(hat.nodes[c]) - 1
+    lengths = np.array(lengths)
+    order = np.array(order)
+    rows = np.array(hat_rows)
+    midpoint_hats = (0.5 * (P[rows[:, 0]] + P[rows[:, 1]])).tocsr()
+    scale = sp.diags(1.0 / lengths)
+    return FrictionForms(T_n=(scale @ int_n[order]).tocsr(), T_t=(scale @ int_t[order]).tocsr(),
+                         lengths=lengths, midpoint_hats=midpoint_hats,
+                         edge_of=np.array(edge_of), hat_lengths=hat.edge_lengths(),
+                         midpoints=np.array(mids))
+
+
+def tresca_bound(forms: FrictionForms, problem: DiscreteProblem) -> np.ndarray:
+    """The given Tresca bound F, averaged (3-point Gauss) on every fine edge."""
+    bound = Expression(problem.scene.friction.bound)
+    contact = problem.spaces.contact
+    values = np.zeros(len(forms.lengths))
+    start = 0
+    for chain in contact.chains:
+        pts = np.vstack([chain.points, chain.points[:1]]) if chain.closed else chain.points
+        a, b = pts[:-1], pts[1:]
+        for s, w in zip(*GAUSS):
+            q = a + s * (b - a)
+            values[start:start + len(a)] += w * bound.numpy(q[:, 0], q[:, 1])
+        start += len(a)
+    return values
