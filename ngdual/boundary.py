@@ -112,7 +112,7 @@ class CoarseMesh:
     def n_edges(self) -> int:
         return sum(len(n) - 1 for n in self.nodes)
 
-    def _interior(self, c: int) -> np.ndarray:
+    def dof_positions(self, c: int) -> np.ndarray:
         """Coarse node positions carrying a dof: all but the ends of an open chain."""
         n = self.nodes[c]
         return n[:-1] if self.chains[c].closed else n[1:-1]
@@ -130,13 +130,13 @@ class CoarseMesh:
     @property
     def n_p1_dofs(self) -> int:
         """dim of the coarse P1 space vanishing at the ends of every open chain."""
-        return sum(len(self._interior(c)) for c in range(len(self.chains)))
+        return sum(len(self.dof_positions(c)) for c in range(len(self.chains)))
 
     def node_points(self) -> np.ndarray:
         """Coordinates of the coarse P1 dofs, in dof order."""
         out = []
         for c, chain in enumerate(self.chains):
-            pos = self._interior(c) % len(chain.vertices)
+            pos = self.dof_positions(c) % len(chain.vertices)
             out.append(chain.points[pos])
         return np.vstack(out) if out else np.zeros((0, 2))
 
@@ -166,7 +166,7 @@ class CoarseMesh:
         offset = 0
         for c, chain in enumerate(self.chains):
             s, nodes = chain.arclength, self.nodes[c]
-            carriers = self._ends(c) if ends else self._interior(c)
+            carriers = self._ends(c) if ends else self.dof_positions(c)
             dof_of_pos = {int(p): offset + k for k, p in enumerate(carriers)}
             offset += len(carriers)
             for e in range(len(nodes) - 1):
@@ -190,7 +190,7 @@ class CoarseMesh:
         mass, stiff = np.zeros((n, n)), np.zeros((n, n))
         offset = 0
         for c, chain in enumerate(self.chains):
-            interior = [int(p) for p in self._interior(c)]
+            interior = [int(p) for p in self.dof_positions(c)]
             local = {p: offset + k for k, p in enumerate(interior)}
             if chain.closed:
                 local[chain.n_edges] = local[0]

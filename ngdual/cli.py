@@ -84,7 +84,9 @@ def cmd_solve(args) -> int:
 
 def cmd_scenes(args) -> int:
     for name in shipped_scenes():
-        print(f"{name:34s} {load_scene(name).to_dict().get('name')}")
+        scene = load_scene(name)
+        print(f"{name:34s} {scene.geometry.kind:12s} friction={scene.friction.law:8s} "
+              f"gap={scene.contact.gap}")
     return 0
 
 

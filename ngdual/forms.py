@@ -29,13 +29,13 @@ from .scene import Scene
 TRACE_BONUS_ORDER = 6
 
 
-def _boundary_regex(labels: list[str]) -> str:
+def boundary_regex(labels: list[str]) -> str:
     return "|".join(labels)
 
 
 def _trace_space(mesh: ngs.Mesh, labels: list[str]) -> ngs.FESpace:
     """Fine P1 trace space on the boundary part ``labels`` (compressed)."""
-    return ngs.Compress(ngs.H1(mesh, order=1, definedon=mesh.Boundaries(_boundary_regex(labels))))
+    return ngs.Compress(ngs.H1(mesh, order=1, definedon=mesh.Boundaries(boundary_regex(labels))))
 
 
 def _vertex_dof(space: ngs.FESpace):
@@ -185,19 +185,19 @@ def _forms(scene: Scene, fes: ngs.FESpace, names: list[str]):
     rhs = ngs.LinearForm(fes)
     f = ngs.CF(tuple(Expression(e).coefficient() for e in scene.loads.body_force))
     rhs += -f * v * ngs.dx                                                    # -f(v)
-    ds_d = ngs.ds(definedon=mesh.Boundaries(_boundary_regex(scene.labels("dirichlet"))),
+    ds_d = ngs.ds(definedon=mesh.Boundaries(boundary_regex(scene.labels("dirichlet"))),
                   bonus_intorder=TRACE_BONUS_ORDER)
     u_d = ngs.CF(tuple(Expression(e).coefficient() for e in scene.loads.displacement))
     rhs += u_d * trac_tau * ds_d                                              # u = u_D on Gamma_D
     if "phi1" in names:
-        ds_n = ngs.ds(definedon=mesh.Boundaries(_boundary_regex(scene.labels("neumann"))),
+        ds_n = ngs.ds(definedon=mesh.Boundaries(boundary_regex(scene.labels("neumann"))),
                       bonus_intorder=TRACE_BONUS_ORDER)
         phi, psi = ngs.CF((trial["phi1"], trial["phi2"])), ngs.CF((test["phi1"], test["phi2"]))
         a += (phi * trac_tau + psi * trac_sig) * ds_n                         # d_N(phi, tau)
         t0 = ngs.CF(tuple(Expression(e).coefficient() for e in scene.loads.traction))
         rhs += t0 * psi * ds_n                                                # t0(psi)
     if "lam_n" in names:
-        ds_c = ngs.ds(definedon=mesh.Boundaries(_boundary_regex(scene.labels("contact"))),
+        ds_c = ngs.ds(definedon=mesh.Boundaries(boundary_regex(scene.labels("contact"))),
                       bonus_intorder=TRACE_BONUS_ORDER)
         a += (trial["lam_t"] * (t * trac_tau) + test["lam_t"] * (t * trac_sig)) * ds_c  # d_Ct
         a += (trial["lam_n"] * (n * trac_tau) + test["lam_n"] * (n * trac_sig)) * ds_c  # d_Cn

@@ -22,7 +22,7 @@ import scipy.sparse as sp
 
 from . import peers
 from .expr import Expression
-from .forms import DiscreteProblem, _boundary_regex
+from .forms import DiscreteProblem, boundary_regex
 
 GAUSS = (np.array([0.5 - np.sqrt(15) / 10, 0.5, 0.5 + np.sqrt(15) / 10]),
          np.array([5, 8, 5]) / 18)
@@ -89,13 +89,13 @@ def _edge_functionals(problem: DiscreteProblem):
     mesh, fes, names = problem.fes.mesh, problem.fes, problem.names
     labels = problem.scene.labels("contact")
     p0 = ngs.Compress(ngs.SurfaceL2(mesh, order=0,
-                                    definedon=mesh.Boundaries(_boundary_regex(labels))))
+                                    definedon=mesh.Boundaries(boundary_regex(labels))))
     trial = dict(zip(names, fes.TrialFunction()))
     v0 = p0.TestFunction()
     traction = peers.stress_traction(trial["r1"], trial["r2"])
     n = ngs.specialcf.normal(2)
     t = ngs.CF((n[1], -n[0]))
-    ds = ngs.ds(definedon=mesh.Boundaries(_boundary_regex(labels)))
+    ds = ngs.ds(definedon=mesh.Boundaries(boundary_regex(labels)))
     mats = []
     for direction in (n, t):
         form = ngs.BilinearForm(trialspace=fes, testspace=p0)

@@ -127,7 +127,7 @@ def contact_traces(solution: Solution) -> ContactTraces:
     edge_xy, edge_len, s_n, s_t, active, node_xy, ln, lt = ([] for _ in range(8))
     offset = 0
     for c, chain in enumerate(contact.chains):
-        interior = contact._interior(c)
+        interior = contact.dof_positions(c)
         flags = in_contact[offset:offset + len(interior)]
         contact_pos = {int(q) for q, flag in zip(interior, flags) if flag}
         offset += len(interior)

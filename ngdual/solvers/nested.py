@@ -62,6 +62,10 @@ def friction_residuals(forms: FrictionForms, x: np.ndarray, problem: DiscretePro
 
     ``nu_sign`` is the residual of q(kappa - nu, lambda_t) <= 0 for all kappa in
     Lambda_h^: sum_j (|(Q lambda_t)_j| - nu_j (Q lambda_t)_j) / sum_j |(Q lambda_t)_j|.
+    ``sigma_t_excess`` is max(|sigma_t| - F)_+ / max F over the fine edges: a
+    pointwise check that the discrete problem only enforces in the weak sense
+    (tested against the h~ hats), so values O(1) next to the corners of Gamma_C
+    are expected.
     """
     Q = forms.q_matrix(F)
     lam_t = x[problem.index("lam_t")]
@@ -119,11 +123,12 @@ def nested_uzawa(problem: DiscreteProblem, law: str, mu_f: float = 0.0, rho1: fl
     x = np.zeros(problem.K.shape[0])
     if law == "tresca":
         F = tresca_bound(forms, problem)
+        inner_total = 0
     else:  # F^0 from the frictionless solution (Remark 3.45: F^0(sigma^0))
-        y, lam, _, _, _ = loop.run(b0, lam, rho1, eps1, max_iter)
+        y, lam, inner_total, _, _ = loop.run(b0, lam, rho1, eps1, max_iter)
         x[problem.saddle], x[problem.lam_n] = y, lam
         F = forms.coulomb_bound(x, mu_f)
-    history, inner_total, converged = [], 0, False
+    history, converged = [], False
     for outer in range(1, max_iter + 1):
         Q = forms.q_matrix(F)
         b = b0.copy()
