@@ -41,3 +41,11 @@ def test_dofs_command_prints_table_3_1(capsys):
     assert main(["dofs", "thesis-3.46-frictionless", "--levels", "1", "2"]) == 0
     out = capsys.readouterr().out
     assert "680" in out and "180" in out
+
+
+def test_non_rectangular_scene_solves_with_contact(tmp_path):
+    assert main(["solve", "punch-on-foundation", "--out", str(tmp_path), "--no-plots"]) == 0
+    record = json.loads((tmp_path / "result.json").read_text())
+    assert record["converged"] and record["contact"]["nodes_in_contact"] >= 1
+    assert record["residuals"]["sigma_n_positive"] < 1e-7
+    assert record["residuals"]["lambda_n_negative"] == 0.0
