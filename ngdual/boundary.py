@@ -32,10 +32,20 @@ class Chain:
     closed: bool
 
     @property
+    def path_vertices(self) -> np.ndarray:
+        """Vertices along the chain, the first repeated at the end of a closed chain."""
+        return np.append(self.vertices, self.vertices[0]) if self.closed else self.vertices
+
+    @property
+    def path_points(self) -> np.ndarray:
+        """Coordinates of :attr:`path_vertices`."""
+        return np.vstack([self.points, self.points[:1]]) if self.closed else self.points
+
+    @property
     def arclength(self) -> np.ndarray:
-        """Arc length at every vertex (for a closed chain the first vertex is repeated)."""
-        pts = np.vstack([self.points, self.points[:1]]) if self.closed else self.points
-        return np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
+        """Arc length at every vertex of :attr:`path_points`."""
+        steps = np.linalg.norm(np.diff(self.path_points, axis=0), axis=1)
+        return np.concatenate([[0.0], np.cumsum(steps)])
 
     @property
     def n_edges(self) -> int:

@@ -68,10 +68,7 @@ class FrictionForms:
 
     def coulomb_bound(self, x: np.ndarray, mu_f: float) -> np.ndarray:
         """F of (3.123) per fine edge: mu_f times the mean |sigma_n| over its h^ edge."""
-        abs_n = np.abs(self.T_n @ x)
-        per_hat = np.bincount(self.edge_of, abs_n, self.n_nu) / np.bincount(self.edge_of,
-                                                                              None, self.n_nu)
-        return mu_f * per_hat[self.edge_of]
+        return mu_f * self.per_hat_edge(np.abs(self.T_n @ x))[self.edge_of]
 
     def per_hat_edge(self, F_edges: np.ndarray) -> np.ndarray:
         """Mean of a fine-edge quantity over each h^ edge."""
@@ -123,8 +120,7 @@ def build_friction_forms(problem: DiscreteProblem) -> FrictionForms:
     order, lengths, mids, edge_of, hat_rows = [], [], [], [], []
     hat_offset = 0
     for c, chain in enumerate(contact.chains):
-        verts = np.append(chain.vertices, chain.vertices[0]) if chain.closed else chain.vertices
-        pts = np.vstack([chain.points, chain.points[:1]]) if chain.closed else chain.points
+        verts, pts = chain.path_vertices, chain.path_points
         for k in range(len(verts) - 1):
             order.append(dof_of_edge[frozenset((int(verts[k]), int(verts[k + 1])))])
             lengths.append(np.linalg.norm(pts[k + 1] - pts[k]))
@@ -152,8 +148,7 @@ def tresca_bound(forms: FrictionForms, problem: DiscreteProblem) -> np.ndarray:
     values = np.zeros(len(forms.lengths))
     start = 0
     for chain in contact.chains:
-        pts = np.vstack([chain.points, chain.points[:1]]) if chain.closed else chain.points
-        a, b = pts[:-1], pts[1:]
+        a, b = chain.path_points[:-1], chain.path_points[1:]
         for s, w in zip(*GAUSS):
             q = a + s * (b - a)
             values[start:start + len(a)] += w * bound.numpy(q[:, 0], q[:, 1])

@@ -132,8 +132,7 @@ def contact_traces(solution: Solution) -> ContactTraces:
         contact_pos = {int(q) for q, flag in zip(interior, flags) if flag}
         offset += len(interior)
         nodes = contact.nodes[c]
-        verts = np.append(chain.vertices, chain.vertices[0]) if chain.closed else chain.vertices
-        pts = np.vstack([chain.points, chain.points[:1]]) if chain.closed else chain.points
+        verts, pts = chain.path_vertices, chain.path_points
         for k in range(len(verts) - 1):
             a, b = pts[k], pts[k + 1]
             mid = 0.5 * (a + b)

@@ -102,7 +102,7 @@ def nested_uzawa(problem: DiscreteProblem, law: str, mu_f: float = 0.0, rho1: fl
     Raises
     ------
     ConvergenceError
-        When the outer iteration diverges (NaN or growing increments).
+        When the outer increments become NaN (the inner loop also raises on growth).
     """
     if loop_order != "friction-outer":
         raise NotImplementedError("loop_order 'contact-outer' (Remark 3.43) is not implemented "
@@ -116,6 +116,13 @@ def nested_uzawa(problem: DiscreteProblem, law: str, mu_f: float = 0.0, rho1: fl
     i_t = problem.index("lam_t")  # the saddle unknowns are a prefix of x: also positions in y
     i_b = i_t - len(problem.sigma)  # lambda_t rows in the right-hand side b of the mult rows
     b0 = problem.F[problem.mult]
+
+    def rhs(F: np.ndarray, nu: np.ndarray) -> np.ndarray:
+        """b^i of step 3: the lambda_t rows carry q(mu_t, nu)."""
+        b = b0.copy()
+        b[i_b] += forms.q_matrix(F).T @ nu
+        return b
+
     start = time.perf_counter()
 
     lam = np.zeros(len(problem.lam_n))
@@ -130,10 +137,8 @@ def nested_uzawa(problem: DiscreteProblem, law: str, mu_f: float = 0.0, rho1: fl
         F = forms.coulomb_bound(x, mu_f)
     history, converged = [], False
     for outer in range(1, max_iter + 1):
-        Q = forms.q_matrix(F)
-        b = b0.copy()
-        b[i_b] += Q.T @ nu                                                   # step 3
-        y, lam, inner, _, inner_ok = loop.run(b, lam, rho1, eps1, max_iter)  # steps 4-7
+        y, lam, inner, _, inner_ok = loop.run(rhs(F, nu), lam, rho1, eps1,   # steps 3-7
+                                              max_iter)
         inner_total += inner
         x[problem.saddle], x[problem.lam_n] = y, lam
         change_F = 0.0
@@ -141,7 +146,7 @@ def nested_uzawa(problem: DiscreteProblem, law: str, mu_f: float = 0.0, rho1: fl
             F_new = forms.coulomb_bound(x, mu_f)
             change_F = _relative(F_new, F)
             F = F_new
-            Q = forms.q_matrix(F)
+        Q = forms.q_matrix(F)
         f_max = F.max()
         step = rho2 * modulus / (2 * f_max**2 * h_hat) if f_max > 0 else 0.0
         nu_new = box_projection(mass * nu + step * (Q @ y[i_t]), mass)      # step 8 / 10'
@@ -156,21 +161,18 @@ def nested_uzawa(problem: DiscreteProblem, law: str, mu_f: float = 0.0, rho1: fl
             converged = True
             break
     # one last inner solve so that (sigma, lambda) match the final nu and F exactly
-    b = b0.copy()
-    b[i_b] += forms.q_matrix(F).T @ nu
-    y, lam, inner, _, inner_ok = loop.run(b, lam, rho1, eps1, max_iter)
+    y, lam, inner, _, inner_ok = loop.run(rhs(F, nu), lam, rho1, eps1, max_iter)
     inner_total += inner
     converged = converged and inner_ok
     x[problem.saddle], x[problem.lam_n] = y, lam
     return Solution(problem, x, converged, f"nested-uzawa-{law}-{metric}",
-                        iterations={"outer": outer, "inner": inner_total},
-                        residuals={"nu_increment": history[-1],
-                                   **loop.residuals(y, lam),
-                                   **friction_residuals(forms, x, problem, nu, F)},
-                        history=history,
-                        timings={"assemble": problem.assemble_seconds,
-                                 "factorize": loop.fact.seconds,
-                                 "solve": time.perf_counter() - start,
-                                 "total_solver": time.perf_counter() - start_all},
+                    iterations={"outer": outer, "inner": inner_total},
+                    residuals={"nu_increment": history[-1], **loop.residuals(y, lam),
+                               **friction_residuals(forms, x, problem, nu, F)},
+                    history=history,
+                    timings={"assemble": problem.assemble_seconds,
+                             "factorize": loop.fact.seconds,
+                             "solve": time.perf_counter() - start,
+                             "total_solver": time.perf_counter() - start_all},
                     nu=nu, friction_bound=F,
                     nu_l2=forms.l2_norm_nu(nu, forms.per_hat_edge(F) > 0))
