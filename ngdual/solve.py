@@ -10,7 +10,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 
-from .forms import assemble
+from .forms import DiscreteProblem, assemble
 from .mesh import build_mesh
 from .scene import Scene
 from .solvers.nested import nested_uzawa
@@ -24,6 +24,15 @@ def solve_scene(scene: Scene, level: int | None = None,
     start = time.perf_counter()
     problem = assemble(scene, build_mesh(scene.geometry, level))
     problem.level = scene.geometry.level if level is None else level
+    solution = solve_problem(problem, progress)
+    solution.timings["total"] = time.perf_counter() - start
+    return solution
+
+
+def solve_problem(problem: DiscreteProblem,
+                  progress: Callable[[int, float], None] | None = None) -> Solution:
+    """Run the algorithm the scene of an assembled ``problem`` calls for (any mesh)."""
+    scene = problem.scene
     if not scene.has_contact:
         solution = solve_linear(problem)
     elif not scene.has_friction:
@@ -36,5 +45,4 @@ def solve_scene(scene: Scene, level: int | None = None,
                                 rho1=s.rho1, rho2=s.rho2, eps1=s.eps1, eps2=s.eps2,
                                 max_iter=s.max_iter, metric=s.metric, loop_order=s.loop_order,
                                 progress=progress)
-    solution.timings["total"] = time.perf_counter() - start
     return solution
