@@ -8,6 +8,10 @@ grouped ``factor`` at a time, so every fine edge lies entirely on one coarse
 edge (the nesting assumed in Section 3.2) and h~ ~ factor * h locally, on
 uniform and on locally refined meshes alike.
 
+After a local refinement of T_h the coarse meshes follow the fine one
+(:meth:`CoarseMesh.follow`, :class:`BoundaryMeshes`) instead of being grouped
+afresh, which keeps them nested from one adaptive step to the next.
+
 A coarse P1 function is represented by its values at the fine boundary
 vertices: :meth:`CoarseMesh.p1_prolongation` is the matrix mapping coarse
 nodal values to the nodal values of the fine trace space, through which all
@@ -17,6 +21,7 @@ forms assembled by NGSolve on the fine trace are restricted to the coarse space.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from itertools import combinations
 
 import ngsolve as ngs
 import numpy as np
@@ -96,6 +101,27 @@ def _group(n_edges: int, factor: int) -> np.ndarray:
     return np.array(nodes)
 
 
+def _split(points: np.ndarray, arclength: np.ndarray, factor: int) -> list[int]:
+    """Nodes after ``points[0]`` when splitting the m = len(points) - 1 units between them.
+
+    m < 2 * factor: no split (only the end). Otherwise m // factor parts of
+    ``factor`` units, the remainder spread one unit each over the parts, placed
+    so that the longest part is shortest (first such placement on ties).
+    """
+    m = len(points) - 1
+    if m < 2 * factor:
+        return [int(points[-1])]
+    q, r = divmod(m, factor)
+    best, best_length = None, np.inf
+    for extra in combinations(range(q), r):
+        sizes = [factor + (k in extra) for k in range(q)]
+        cut = np.concatenate([[0], np.cumsum(sizes)])
+        length = np.max(np.diff(arclength[points[cut]]))
+        if length < best_length * (1 - 1e-12):
+            best, best_length = cut, length
+    return [int(p) for p in points[best[1:]]]
+
+
 @dataclass(frozen=True)
 class CoarseMesh:
     """A coarse 1D mesh on a boundary part, nested in the fine boundary edges.
@@ -117,6 +143,61 @@ class CoarseMesh:
         """Group this mesh's edges ``factor`` at a time (h^ = factor * h~, nested)."""
         return CoarseMesh(self.chains,
                           tuple(n[_group(len(n) - 1, factor)] for n in self.nodes))
+
+    def follow(self, mesh: ngs.Mesh, labels: list[str], factor: int) -> CoarseMesh:
+        """This coarse mesh carried over to the (locally) refined fine ``mesh``.
+
+        Netgen keeps the numbers of the old vertices when it refines, so every
+        old coarse node is still a fine vertex. Each old coarse edge E now
+        holds m fine edges: if m >= 2 * factor, E is split at fine vertices
+        into m // factor edges of ``factor`` or ``factor + 1`` fine edges
+        (where the extra ones go is chosen to make the longest part shortest);
+        otherwise E is kept. Guarantees, by induction over the steps:
+
+        * every coarse edge is a union of fine edges (nesting of Section 3.2);
+        * the coarse meshes are nested: the old coarse nodes are kept;
+        * a coarse edge made by :meth:`from_fine` or by a split holds between
+          ``factor`` and ``2 * factor - 1`` fine edges, and keeps doing so
+          (a kept edge has m < 2 * factor), so h~/h stays within
+          [1, 2 * factor - 1] times the ratio of neighbouring fine edge lengths:
+          h~ ~ factor * h locally, however strongly the mesh is graded.
+
+        Under uniform refinement this reproduces :meth:`from_fine` of the finer level.
+        """
+        chains = tuple(boundary_chains(mesh, labels))
+        return self._follow(chains, [np.arange(c.n_edges + 1) for c in chains], factor)
+
+    def follow_within(self, fine: CoarseMesh, factor: int) -> CoarseMesh:
+        """This h^ mesh carried over to the refined h~ mesh ``fine`` (see :meth:`follow`).
+
+        The units are now the edges of ``fine``: h^ edges stay unions of
+        ``factor`` to ``2 * factor - 1`` h~ edges and nested across steps.
+        """
+        return self._follow(fine.chains, list(fine.nodes), factor)
+
+    def _follow(self, chains: tuple[Chain, ...], units: list[np.ndarray],
+                factor: int) -> CoarseMesh:
+        """Split the old coarse edges at the positions ``units`` of each new chain."""
+        if len(chains) != len(self.chains):
+            raise ValueError("the refined boundary has a different number of chains")
+        nodes = []
+        for new, unit in zip(chains, units):
+            position = {int(v): p for p, v in enumerate(new.vertices)}
+            old = next(c for c, ch in enumerate(self.chains) if int(ch.vertices[0]) in position)
+            old_vertices = self.chains[old].path_vertices[self.nodes[old]]
+            if new.closed:
+                corners = sorted(position[int(v)] for v in old_vertices[:-1]) + [new.n_edges]
+            else:
+                corners = sorted(position[int(v)] for v in old_vertices)
+            if corners[0] != 0 or corners[-1] != new.n_edges:
+                raise ValueError("the old coarse nodes do not span the refined chain")
+            s = new.arclength
+            out = [0]
+            for a, b in zip(corners[:-1], corners[1:]):
+                inner = unit[(unit > a) & (unit < b)]
+                out.extend(_split(np.concatenate([[a], inner, [b]]), s, factor))
+            nodes.append(np.array(out))
+        return CoarseMesh(chains, tuple(nodes))
 
     @property
     def n_edges(self) -> int:
@@ -153,6 +234,21 @@ class CoarseMesh:
     def edge_lengths(self) -> np.ndarray:
         """Lengths of all coarse edges, chain by chain."""
         return np.concatenate([np.diff(ch.arclength[n]) for ch, n in zip(self.chains, self.nodes)])
+
+    def fine_edges(self) -> tuple[np.ndarray, np.ndarray]:
+        """The fine edges chain by chain: their vertex pairs (n, 2) and the coarse edge of each.
+
+        Coarse edges are numbered chain by chain as in :meth:`edge_lengths`.
+        """
+        pairs, owner, offset = [], [], 0
+        for chain, nodes in zip(self.chains, self.nodes):
+            verts = chain.path_vertices
+            pairs.append(np.column_stack([verts[:-1], verts[1:]]))
+            owner.append(offset + np.searchsorted(nodes, np.arange(chain.n_edges), "right") - 1)
+            offset += len(nodes) - 1
+        if not pairs:
+            return np.zeros((0, 2), dtype=int), np.zeros(0, dtype=int)
+        return np.vstack(pairs).astype(int), np.concatenate(owner)
 
     def p1_prolongation(self, fine_dof_of_vertex, n_fine: int, ends: bool = False
                         ) -> sp.csr_matrix:
@@ -217,3 +313,42 @@ class CoarseMesh:
                             mass[gi, gj] += me[i, j]
                             stiff[gi, gj] += ke[i, j]
         return mass, stiff
+
+
+@dataclass(frozen=True)
+class BoundaryMeshes:
+    """The coarse meshes of a scene: h~ on Gamma_N and Gamma_C, h^ on Gamma_C (or None).
+
+    :meth:`for_scene` groups the fine edges of a fresh mesh; :meth:`follow`
+    carries the meshes over to a (locally) refined mesh, nested and with
+    h~ ~ factor * h locally (see :meth:`CoarseMesh.follow`).
+    """
+
+    neumann: CoarseMesh | None
+    contact: CoarseMesh | None
+    friction: CoarseMesh | None
+
+    @classmethod
+    def for_scene(cls, scene, mesh: ngs.Mesh) -> BoundaryMeshes:
+        """h~ = ``htilde_factor`` * h and h^ = ``hhat_factor`` * h~ on a fresh mesh."""
+        factor = scene.contact.htilde_factor
+        neumann = contact = friction = None
+        if scene.labels("neumann"):
+            neumann = CoarseMesh.from_fine(mesh, scene.labels("neumann"), factor)
+        if scene.has_contact:
+            contact = CoarseMesh.from_fine(mesh, scene.labels("contact"), factor)
+            if scene.has_friction:
+                friction = contact.coarsened(scene.contact.hhat_factor)
+        return cls(neumann, contact, friction)
+
+    def follow(self, scene, mesh: ngs.Mesh) -> BoundaryMeshes:
+        """These coarse meshes carried over to ``mesh``, a refinement of their fine mesh."""
+        factor = scene.contact.htilde_factor
+        neumann = contact = friction = None
+        if self.neumann is not None:
+            neumann = self.neumann.follow(mesh, scene.labels("neumann"), factor)
+        if self.contact is not None:
+            contact = self.contact.follow(mesh, scene.labels("contact"), factor)
+            if self.friction is not None:
+                friction = self.friction.follow_within(contact, scene.contact.hhat_factor)
+        return BoundaryMeshes(neumann, contact, friction)

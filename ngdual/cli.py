@@ -3,7 +3,11 @@
 ``ngdual solve SCENE [--level N] [--set key=value ...] [--out DIR] [--vtk] [--no-plots]``
 solves one scene, prints the result table and writes ``DIR/result.json``
 (atomically) plus figures. ``ngdual scenes`` lists the shipped scenes;
-``ngdual dofs SCENE --levels 1 2 3`` prints DOF counts without solving.
+``ngdual dofs SCENE --levels 1 2 3`` prints DOF counts without solving;
+``ngdual adapt SCENE --marking max|fraction|dorfler --theta T --steps N --out DIR``
+runs the adaptive loop and writes ``DIR/history.json`` plus a mesh (.vol, .png) per step.
+``ngdual tutorials [--notebooks DIR] [--solutions]`` lists the lecture tutorials or
+writes them as Jupyter notebooks.
 Exit status: 0 solved and converged, 1 not converged, 2 bad input.
 """
 
@@ -102,6 +106,82 @@ def cmd_dofs(args) -> int:
     return 0
 
 
+def cmd_adapt(args) -> int:
+    """SOLVE -> ESTIMATE -> MARK -> REFINE; writes DIR/history.json and a mesh per step."""
+    import ngsolve as ngs
+    import numpy as np
+
+    from . import plot
+    from .afem import adapt, reference_norms
+    from .io import write_json
+    from .post import versions
+    from .solvers.result import ConvergenceError
+
+    scene = load_scene(args.scene, args.set)
+    if not 0 <= args.theta <= 1:
+        raise SceneError("--theta", f"must lie in [0, 1], got {args.theta}")
+    if args.steps < 1:
+        raise SceneError("--steps", f"must be >= 1, got {args.steps}")
+    out = Path(args.out)
+    run = {"scene": scene.name, "marking": args.marking, "theta": args.theta,
+           "steps": args.steps, "level": args.level, "asymmetry": args.asymmetry,
+           "parameters": scene.to_dict(), "versions": versions(), "history": []}
+    if args.reference_levels:
+        print(f"reference norms: Aitken extrapolation from levels {args.reference_levels}")
+        run["reference_levels"] = args.reference_levels
+        run["reference_norms"] = reference_norms(scene, args.reference_levels)
+
+    def on_step(record, solution, estimate, marked):
+        mesh = solution.problem.fes.mesh
+        stem = out / f"mesh_step{record['step']:02d}"
+        stem.parent.mkdir(parents=True, exist_ok=True)
+        mesh.ngmesh.Save(str(stem) + ".vol")
+        points = np.array([v.point for v in mesh.vertices])
+        triangles = np.array([[v.nr for v in el.vertices] for el in mesh.Elements(ngs.VOL)])
+        plot.plot_mesh(points, triangles, str(stem) + ".png",
+                       f"{scene.name}, {args.marking} marking, step {record['step']}: "
+                       f"{mesh.ne} triangles", marked)
+        run["history"].append(record)
+        write_json(run, out / "history.json")
+        effectivity = record.get("effectivity")
+        print(f"step {record['step']:3d}  dofs {record['dofs']['total']:8d}  "
+              f"eta {record['eta']:.4e}" + (f"  e_tot {record['e_tot']:.4e}  eta/e_tot "
+                                           f"{effectivity:.3f}" if effectivity else "")
+              + f"  marked {record['marked']}")
+
+    try:
+        adapt(scene, args.marking, args.theta, args.steps, args.level, args.asymmetry,
+              run.get("reference_norms"), on_step)
+    except ConvergenceError as err:
+        print(f"ngdual: {err}", file=sys.stderr)
+        return EXIT_NOT_CONVERGED
+    write_json(run, out / "history.json")
+    print(f"wrote {out / 'history.json'} and {len(run['history'])} meshes (.vol, .png)")
+    return 0 if all(r["converged"] for r in run["history"]) else EXIT_NOT_CONVERGED
+
+
+def cmd_tutorials(args) -> int:
+    """List the tutorials; with --notebooks DIR write them (and their solutions) as notebooks."""
+    from .tutorials import list_tutorials, write_notebooks
+
+    try:
+        items = list_tutorials(args.source)
+        if args.notebooks:
+            written = write_notebooks(args.notebooks, args.source, solutions=args.solutions)
+    except (FileNotFoundError, ImportError) as err:
+        print(f"ngdual: error: {err}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    if not args.notebooks:
+        for item in items:
+            print(f"{item.number:2d}  {item.title}  ({item.path})")
+        return 0
+    for path in written:
+        print(f"wrote {path}")
+    print("execute one with: NGDUAL_QUICK=1 jupyter nbconvert --to notebook --execute "
+          f"{written[0] if written else 'NOTEBOOK'}")
+    return 0
+
+
 def parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="ngdual", description=__doc__.splitlines()[0])
     sub = p.add_subparsers(dest="command", required=True)
@@ -121,6 +201,28 @@ def parser() -> argparse.ArgumentParser:
     d.add_argument("--levels", type=int, nargs="+", default=[1, 2, 3, 4])
     d.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
     d.set_defaults(func=cmd_dofs)
+    ad = sub.add_parser("adapt", help="adaptive refinement (Chapter 4), writes DIR/history.json")
+    ad.add_argument("scene")
+    ad.add_argument("--marking", choices=["max", "fraction", "dorfler"], default="dorfler")
+    ad.add_argument("--theta", type=float, default=0.5, help="marking parameter in [0, 1]")
+    ad.add_argument("--steps", type=int, default=5, help="number of solves (default 5)")
+    ad.add_argument("--level", type=int, default=None, help="initial mesh level")
+    ad.add_argument("--asymmetry", choices=["hdiv", "l2"], default="hdiv",
+                    help="norm of as(sigma_h) in the estimator (default: H(div), eq. 4.15)")
+    ad.add_argument("--reference-levels", type=int, nargs="+", default=None, metavar="LEVEL",
+                    help="uniform levels whose norms give, by Aitken extrapolation, the "
+                         "reference for the total error (3.124) and the effectivity index")
+    ad.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+    ad.add_argument("--out", default="out-adapt", help="output folder (default: out-adapt)")
+    ad.set_defaults(func=cmd_adapt)
+    tu = sub.add_parser("tutorials", help="list the tutorials or write them as notebooks")
+    tu.add_argument("--notebooks", metavar="DIR", default=None,
+                    help="write the tutorials as .ipynb notebooks into DIR (needs jupytext)")
+    tu.add_argument("--solutions", action="store_true",
+                    help="with --notebooks: also write the exercise solutions to DIR/solutions")
+    tu.add_argument("--source", metavar="DIR", default=None,
+                    help="tutorials folder (default: tutorials/ of the source checkout)")
+    tu.set_defaults(func=cmd_tutorials)
     return p
 
 

@@ -22,7 +22,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from . import peers
-from .boundary import CoarseMesh
+from .boundary import BoundaryMeshes, CoarseMesh
 from .expr import Expression
 from .scene import Scene
 
@@ -60,13 +60,14 @@ class Spaces:
     end_hats: dict[str, sp.csr_matrix] = field(default_factory=dict)
 
     @classmethod
-    def build(cls, scene: Scene, mesh: ngs.Mesh) -> Spaces:
+    def build(cls, scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes | None = None) -> Spaces:
+        """Spaces on ``mesh``; ``coarse`` carries coarse meshes over from an adaptive step."""
         comps = peers.peers_spaces(mesh)
-        factor = scene.contact.htilde_factor
+        coarse = coarse or BoundaryMeshes.for_scene(scene, mesh)
         neumann = contact = friction = None
         prolong, end_hats = {}, {}
         if scene.labels("neumann"):
-            neumann = CoarseMesh.from_fine(mesh, scene.labels("neumann"), factor)
+            neumann = coarse.neumann
             space = _trace_space(mesh, scene.labels("neumann"))
             comps["phi1"] = comps["phi2"] = space
             prolong["phi1"] = prolong["phi2"] = neumann.p1_prolongation(_vertex_dof(space),
@@ -74,13 +75,13 @@ class Spaces:
             end_hats["phi1"] = end_hats["phi2"] = neumann.p1_prolongation(
                 _vertex_dof(space), space.ndof, ends=True)
         if scene.has_contact:
-            contact = CoarseMesh.from_fine(mesh, scene.labels("contact"), factor)
+            contact = coarse.contact
             space = _trace_space(mesh, scene.labels("contact"))
             comps["lam_t"] = comps["lam_n"] = space
             prolong["lam_t"] = prolong["lam_n"] = contact.p1_prolongation(_vertex_dof(space),
                                                                           space.ndof)
             if scene.has_friction:
-                friction = contact.coarsened(scene.contact.hhat_factor)
+                friction = coarse.friction
         return cls(mesh, comps, neumann, contact, friction, prolong, end_hats)
 
     def coarse_ndof(self, name: str) -> int:
@@ -212,10 +213,11 @@ def _to_scipy(mat) -> sp.csr_matrix:
                          shape=(mat.height, mat.width))
 
 
-def assemble(scene: Scene, mesh: ngs.Mesh) -> DiscreteProblem:
-    """Assemble the block system of (3.62) for ``scene`` on ``mesh``."""
+def assemble(scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes | None = None
+             ) -> DiscreteProblem:
+    """Assemble the block system of (3.62) for ``scene`` on ``mesh`` (``coarse``: see Spaces)."""
     start = time.perf_counter()
-    spaces = Spaces.build(scene, mesh)
+    spaces = Spaces.build(scene, mesh, coarse)
     names = list(spaces.components)
     fes = ngs.FESpace([spaces.components[n] for n in names])
     a, rhs = _forms(scene, fes, names)

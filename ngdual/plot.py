@@ -63,3 +63,20 @@ def plot_element_field(points: np.ndarray, triangles: np.ndarray, values: np.nda
     ax.set_ylabel(r"$x_2$ [length]")
     ax.set_title(title)
     return _save(fig, path)
+
+
+def plot_mesh(points: np.ndarray, triangles: np.ndarray, path: Path, title: str = "",
+              marked: np.ndarray | None = None) -> Path:
+    """The triangulation, with the elements marked for refinement shaded (Figs. 4.1-4.13)."""
+    fig, ax = plt.subplots(figsize=(8, 8 * np.ptp(points[:, 1]) / max(np.ptp(points[:, 0]), 1e-300)
+                                    + 0.8))
+    tri = mtri.Triangulation(points[:, 0], points[:, 1], triangles)
+    if marked is not None and np.any(marked):
+        ax.tripcolor(tri, facecolors=np.asarray(marked, dtype=float), cmap="Oranges",
+                     vmin=0, vmax=2.5, edgecolors="none")
+    ax.triplot(tri, color="k", lw=0.3)
+    ax.set_aspect("equal")
+    ax.set_xlabel(r"$x_1$ [length]")
+    ax.set_ylabel(r"$x_2$ [length]")
+    ax.set_title(title or f"{len(triangles)} triangles")
+    return _save(fig, path)

@@ -14,7 +14,8 @@ The schema (all tables optional except ``geometry`` and ``boundary``)::
     [loads]      body_force = [fx, fy], traction = [tx, ty], displacement = [ux, uy]
     [contact]    gap, htilde_factor (h~/h), hhat_factor (h^/h~: 1 or 2)
     [friction]   law = "none" | "tresca" | "coulomb", mu, bound (Tresca F)
-    [solver]     metric, rho, eps, max_iter, rho1, rho2, eps1, eps2, loop_order
+    [solver]     metric, rho, eps, max_iter, rho1, rho2, eps1, eps2, loop_order,
+                 friction_metric
 
 Loads, gap and bound are formulas in ``x`` and ``y`` (see :mod:`ngdual.expr`).
 """
@@ -39,6 +40,7 @@ except ModuleNotFoundError:  # Python < 3.11
 FRICTION_LAWS = ("none", "tresca", "coulomb")
 METRICS = ("h12", "euclidean")
 LOOP_ORDERS = ("friction-outer", "contact-outer")
+FRICTION_METRICS = ("jacobi", "mass")
 GEOMETRY_KINDS = ("thesis-3.46", "polygon")
 
 
@@ -130,7 +132,11 @@ class Solver:
 
     ``rho`` (and ``rho1``, ``rho2``) are dimensionless: the metric of the
     projection carries the plane-strain modulus, so the same values work for
-    E = 2e5 and E = 2e11.
+    E = 2e5 and E = 2e11. ``rho2`` is relative to the stability bound of the nu
+    iteration and must lie in (0, 2). ``friction_metric`` is the diagonal metric
+    of the nu projection P^Lambda: ``"mass"`` (Remark 3.44) or ``"jacobi"`` (the
+    mass matrix weighted by the diagonal of the nu operator, so that h^ edges
+    with a small friction bound F converge as fast as the others).
     """
 
     metric: str = "h12"
@@ -138,10 +144,11 @@ class Solver:
     eps: float = 1e-8
     max_iter: int = 2000
     rho1: float = 1.0
-    rho2: float = 2.0
+    rho2: float = 1.0
     eps1: float = 1e-8
     eps2: float = 1e-6
     loop_order: str = "friction-outer"
+    friction_metric: str = "jacobi"
 
 
 @dataclass
@@ -403,6 +410,13 @@ def validate(scene: Scene) -> None:
     if sol.loop_order not in LOOP_ORDERS:
         raise SceneError("solver.loop_order", f"unknown loop order {sol.loop_order!r}; use one "
                                               "of " + ", ".join(LOOP_ORDERS))
+    if sol.friction_metric not in FRICTION_METRICS:
+        raise SceneError("solver.friction_metric", f"unknown metric {sol.friction_metric!r}; "
+                                                   "use one of " + ", ".join(FRICTION_METRICS))
+    if not 0 < sol.rho2 < 2:
+        raise SceneError("solver.rho2", f"rho2 = {sol.rho2} is outside (0, 2), where the nu "
+                                        "iteration converges (it is relative to the stability "
+                                        "bound)")
     for key in ("rho", "eps", "rho1", "rho2", "eps1", "eps2"):
         _positive(getattr(sol, key), f"solver.{key}")
     _positive(sol.max_iter, "solver.max_iter", integer=True)

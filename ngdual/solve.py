@@ -44,5 +44,6 @@ def solve_problem(problem: DiscreteProblem,
         solution = nested_uzawa(problem, scene.friction.law, mu_f=scene.friction.mu,
                                 rho1=s.rho1, rho2=s.rho2, eps1=s.eps1, eps2=s.eps2,
                                 max_iter=s.max_iter, metric=s.metric, loop_order=s.loop_order,
+                                friction_metric=s.friction_metric,
                                 progress=progress)
     return solution

@@ -41,6 +41,15 @@ class Factorization:
             self._lu = spla.splu(matrix.tocsc())
         self.seconds = time.perf_counter() - start
 
+    def solve_many(self, rhs: np.ndarray) -> np.ndarray:
+        """Solve for every column of ``rhs`` (n x k) with the stored factors."""
+        rhs = np.asarray(rhs, dtype=float)
+        if rhs.shape[1] == 0:
+            return np.zeros(rhs.shape)
+        if self.backend == "superlu":
+            return self._lu.solve(rhs)
+        return np.column_stack([self.solve(col) for col in rhs.T])
+
     def solve(self, rhs: np.ndarray) -> np.ndarray:
         """Solve with the stored factors."""
         if self.backend == "superlu":

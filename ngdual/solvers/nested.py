@@ -17,11 +17,14 @@ Stopping (honest): the iteration stops only when the increments of nu (and,
 for Coulomb, of F) are below eps2 *and* the inner loop converged; every
 residual of the discrete variational inequality (3.62) is reported.
 
-rho_2 is dimensionless: the step applied is rho_2 E* / (2 max(F)^2 h^), h^ the
-mean h^ edge length, the inverse of the scale of M^{-1} Q_F S^{-1} Q_F^T for
-the stiffest tangential mode (one h^ edge), so the same rho_2 works for any E
-and load scale; the number of outer steps still grows like 1/h^ (the mass
-matrix metric of Remark 3.44 is not H^{-1/2}-equivalent).
+rho_2 is dimensionless: the step applied is rho_2 / lambda_max(H), H the
+operator of the nu iteration (:class:`FrictionStep`), computed from the
+tangential block of the Gamma_C response, so 0 < rho_2 < 2 converges for any E,
+load scale and level. The number of outer steps still grows like 1/h^: the
+mass-matrix metric of Remark 3.44 is not H^{-1/2}-equivalent, so the condition
+number of H grows like |Gamma_C| / h^. By default the loops run on the
+condensed Gamma_C response (:mod:`ngdual.solvers.condensed`), so that an outer
+step costs small dense products instead of sparse solves.
 """
 
 from __future__ import annotations
@@ -34,6 +37,7 @@ import numpy as np
 
 from ..forms import DiscreteProblem
 from ..friction import FrictionForms, build_friction_forms, tresca_bound
+from .condensed import CondensedResponse
 from .result import ConvergenceError, Solution
 from .uzawa import ContactLoop
 
@@ -80,10 +84,63 @@ def friction_residuals(forms: FrictionForms, x: np.ndarray, problem: DiscretePro
     }
 
 
+STAGNATION_WINDOW = 400  # outer steps without halving the best residual
+
+
+class FrictionStep:
+    """Step 8 / 10': nu <- P^Lambda(nu + s M^{-1} Q_F lambda_t) with a scale-free step s.
+
+    The map nu -> M^{-1} Q_F lambda_t(Q_F^T nu) is linear with the symmetric
+    negative semidefinite operator -H, H = M^{-1/2} Q_F S_t Q_F^T M^{-1/2}, where
+    S_t = -d lambda_t / d tau is the tangential block of the Gamma_C response
+    (the inverse of the (2,2) Schur complement, hence SPD). The step
+    s = rho_2 / lambda_max(H) makes rho_2 dimensionless: the gradient-projection
+    iteration contracts for 0 < rho_2 < 2 (Theorem 3.42's bound, computed
+    instead of estimated), independently of E, the load scale and the level.
+    For Coulomb friction H changes with F, so s is recomputed with F.
+    """
+
+    def __init__(self, forms: FrictionForms, S_t: np.ndarray, rho2: float, metric: str = "mass"):
+        self.forms, self.S_t, self.rho2, self.metric = forms, S_t, rho2, metric
+        self.mass = forms.hat_lengths
+        self.F = None
+
+    def set_bound(self, F: np.ndarray) -> None:
+        self.F, self.Q = F, self.forms.q_matrix(F)
+        if self.metric == "jacobi":
+            diag = np.einsum("ij,jk,ik->i", self.Q.toarray(), self.S_t, self.Q.toarray())
+            self.mass = np.where(diag > 1e-14 * diag.max(initial=0.0), diag,
+                                 max(diag.max(initial=0.0), 1e-300))
+        QM = (self.Q.T / np.sqrt(self.mass)).T
+        lam_max = float(np.linalg.eigvalsh(QM @ self.S_t @ QM.T)[-1]) if F.max() > 0 else 0.0
+        self.step = self.rho2 / lam_max if lam_max > 0 else 0.0
+
+    def __call__(self, nu: np.ndarray, lam_t: np.ndarray) -> np.ndarray:
+        return box_projection(self.mass * nu + self.step * (self.Q @ lam_t), self.mass)
+
+    def load(self, nu: np.ndarray) -> np.ndarray:
+        """tau = Q_F^T nu, the lambda_t-row load of step 3 / 5."""
+        return self.Q.T @ nu
+
+
+def _stagnation_message(problem: DiscreteProblem, outer: int, law: str) -> str:
+    remedies = ["a smaller solver.rho2"]
+    if problem.scene.contact.hhat_factor == 1:
+        remedies.insert(0, "contact.hhat_factor = 2 (with h^ = h~ the inf-sup condition "
+                           "(3.74) for nu fails where the contact zone reaches the end of "
+                           "Gamma_C, and nu is not unique)")
+    if law == "coulomb":
+        remedies.append("a smaller friction.mu (the Coulomb fixed point F = mu |sigma_n| "
+                        "need not contract for large mu)")
+    return (f"nested Uzawa stagnated: the residual did not halve in {STAGNATION_WINDOW} outer "
+            f"steps (up to step {outer}); try " + ", or ".join(remedies))
+
+
 def nested_uzawa(problem: DiscreteProblem, law: str, mu_f: float = 0.0, rho1: float = 1.0,
                  rho2: float = 1.0, eps1: float = 1e-8, eps2: float = 1e-6,
                  max_iter: int = 2000, metric: str = "h12", loop_order: str = "friction-outer",
-                 backend: str = "umfpack",
+                 friction_metric: str = "jacobi", backend: str = "umfpack",
+                 condensed: bool = True,
                  progress: Callable[[int, float], None] | None = None) -> Solution:
     """Solve (3.62) with Tresca (Algorithm 3.41) or Coulomb (Remark 3.45) friction.
 
@@ -92,82 +149,111 @@ def nested_uzawa(problem: DiscreteProblem, law: str, mu_f: float = 0.0, rho1: fl
     law : {"tresca", "coulomb"}
     mu_f : float
         Coulomb friction coefficient (ignored for Tresca, whose F is the scene's bound).
-    rho1, rho2 : float
-        Dimensionless step lengths of the lambda_n and nu updates.
+    rho1 : float
+        Dimensionless step of the lambda_n update (the metric W carries E*).
+    rho2 : float in (0, 2)
+        Step of the nu update relative to its stability bound (:class:`FrictionStep`).
     eps1, eps2 : float
-        Tolerances of the inner loop and of the nu / F increments.
+        Tolerances of the inner loop and of the outer increments (nu, F, lambda_n).
     max_iter : int
         Bound on the outer iterations (and on the inner ones per outer step).
+    loop_order : {"friction-outer", "contact-outer"}
+        Algorithm 3.41 (nu outside, lambda_n inside) or Remark 3.43 (exchanged).
+    friction_metric : {"jacobi", "mass"}
+        Diagonal metric of P^Lambda (:class:`FrictionStep`).
+    condensed : bool
+        Iterate on the Gamma_C response from one factorisation
+        (:mod:`ngdual.solvers.condensed`) instead of one sparse solve per step;
+        same iterates.
+
+    Stopping is honest: the iteration ends only when the inner loop converged
+    and the relative increments of nu, F (Coulomb) and, for ``contact-outer``,
+    lambda_n are <= eps2; every residual of (3.62) is reported.
 
     Raises
     ------
     ConvergenceError
-        When the outer increments become NaN (the inner loop also raises on growth).
+        When the residual becomes NaN, grows by 1e6, or does not halve within
+        ``STAGNATION_WINDOW`` outer steps (the message names the remedies).
     """
-    if loop_order != "friction-outer":
-        raise NotImplementedError("loop_order 'contact-outer' (Remark 3.43) is not implemented "
-                                  "yet; use 'friction-outer'")
+    if loop_order not in ("friction-outer", "contact-outer"):
+        raise ValueError(f"unknown loop_order {loop_order!r}")
     start_all = time.perf_counter()
-    loop = ContactLoop(problem, metric, backend)
     forms = build_friction_forms(problem)
-    modulus = problem.scene.material.plane_strain_modulus
-    h_hat = float(forms.hat_lengths.mean())
-    mass = forms.hat_lengths
-    i_t = problem.index("lam_t")  # the saddle unknowns are a prefix of x: also positions in y
-    i_b = i_t - len(problem.sigma)  # lambda_t rows in the right-hand side b of the mult rows
-    b0 = problem.F[problem.mult]
-
-    def rhs(F: np.ndarray, nu: np.ndarray) -> np.ndarray:
-        """b^i of step 3: the lambda_t rows carry q(mu_t, nu)."""
-        b = b0.copy()
-        b[i_b] += forms.q_matrix(F).T @ nu
-        return b
-
+    loop = ContactLoop(problem, metric, backend, condensed,
+                       extra_outputs=forms.T_n[:, problem.saddle])
+    n_c = loop.n_c
+    if loop.response is not None:
+        S_t = -loop.response.G[n_c:2 * n_c, n_c:]
+    else:
+        S_t = -CondensedResponse(loop.fact, loop.r0, loop.E_t, loop.E_t.T, gram=False).G
+    friction = FrictionStep(forms, 0.5 * (S_t + S_t.T), rho2, friction_metric)
     start = time.perf_counter()
 
-    lam = np.zeros(len(problem.lam_n))
+    lam = np.zeros(n_c)
     nu = np.zeros(forms.n_nu)
-    x = np.zeros(problem.K.shape[0])
+    inner_total = 0
     if law == "tresca":
-        F = tresca_bound(forms, problem)
-        inner_total = 0
+        friction.set_bound(tresca_bound(forms, problem))
     else:  # F^0 from the frictionless solution (Remark 3.45: F^0(sigma^0))
-        y, lam, inner_total, _, _ = loop.run(b0, lam, rho1, eps1, max_iter)
-        x[problem.saddle], x[problem.lam_n] = y, lam
-        F = forms.coulomb_bound(x, mu_f)
-    history, converged = [], False
+        state, inner_total, _, _ = loop.run(lam, rho1, eps1, max_iter)
+        lam = state.lam
+        friction.set_bound(mu_f * forms.per_hat_edge(np.abs(state.extra))[forms.edge_of])
+
+    def coulomb_update(state) -> float:                                       # step 8'
+        if law != "coulomb":
+            return 0.0
+        F_new = mu_f * forms.per_hat_edge(np.abs(state.extra))[forms.edge_of]
+        change = _relative(F_new, friction.F)
+        friction.set_bound(F_new)
+        return change
+
+    history, converged, best, best_at = [], False, np.inf, 0
     for outer in range(1, max_iter + 1):
-        y, lam, inner, _, inner_ok = loop.run(rhs(F, nu), lam, rho1, eps1,   # steps 3-7
-                                              max_iter)
+        if loop_order == "friction-outer":
+            state, inner, _, inner_ok = loop.run(lam, rho1, eps1, max_iter,   # steps 3-7
+                                                 tau=friction.load(nu))
+            lam = state.lam
+            change_F = coulomb_update(state)
+            nu_new = friction(nu, state.lam_t)                                # step 8 / 10'
+            change = max(_relative(nu_new, nu), change_F)
+        else:  # Remark 3.43: nu (and F) converge inside for fixed lambda_n
+            inner, inner_ok = 0, False
+            while inner < max_iter and not inner_ok:
+                inner += 1
+                state = loop.respond(lam, friction.load(nu))
+                change_F = coulomb_update(state)
+                nu_new = friction(nu, state.lam_t)
+                inner_ok = max(_relative(nu_new, nu), change_F) <= eps1
+                nu = nu_new
+            lam_new = loop.projection(loop.projection.matvec(lam) + rho1 * state.traction)
+            change = max(_relative(lam_new, lam), change_F)
+            lam = lam_new
         inner_total += inner
-        x[problem.saddle], x[problem.lam_n] = y, lam
-        change_F = 0.0
-        if law == "coulomb":                                                 # step 8'
-            F_new = forms.coulomb_bound(x, mu_f)
-            change_F = _relative(F_new, F)
-            F = F_new
-        Q = forms.q_matrix(F)
-        f_max = F.max()
-        step = rho2 * modulus / (2 * f_max**2 * h_hat) if f_max > 0 else 0.0
-        nu_new = box_projection(mass * nu + step * (Q @ y[i_t]), mass)      # step 8 / 10'
-        change_nu = _relative(nu_new, nu)
         nu = nu_new
-        history.append(max(change_nu, change_F))
+        history.append(change)
         if progress:
-            progress(outer, history[-1])
-        if not np.isfinite(history[-1]):
-            raise ConvergenceError(f"nested Uzawa diverged at outer step {outer}", history)
-        if inner_ok and change_nu <= eps2 and change_F <= eps2:              # step 9 / 9'
+            progress(outer, change)
+        if not np.isfinite(change) or change > 1e6 * max(history[0], 1e-300):
+            raise ConvergenceError(f"nested Uzawa diverged at outer step {outer} "
+                                   f"(rho1 = {rho1}, rho2 = {rho2})", history)
+        if inner_ok and change <= eps2:                                      # step 9 / 9'
             converged = True
             break
+        if change < 0.5 * best:
+            best, best_at = change, outer
+        elif outer - best_at > STAGNATION_WINDOW:
+            raise ConvergenceError(_stagnation_message(problem, outer, law), history)
     # one last inner solve so that (sigma, lambda) match the final nu and F exactly
-    y, lam, inner, _, inner_ok = loop.run(rhs(F, nu), lam, rho1, eps1, max_iter)
+    state, inner, _, inner_ok = loop.run(lam, rho1, eps1, max_iter, tau=friction.load(nu))
     inner_total += inner
     converged = converged and inner_ok
-    x[problem.saddle], x[problem.lam_n] = y, lam
-    return Solution(problem, x, converged, f"nested-uzawa-{law}-{metric}",
+    x = np.zeros(problem.K.shape[0])
+    x[problem.saddle], x[problem.lam_n] = loop.solution(state), state.lam
+    F = friction.F
+    return Solution(problem, x, converged, f"nested-uzawa-{law}-{metric}-{loop_order}",
                     iterations={"outer": outer, "inner": inner_total},
-                    residuals={"nu_increment": history[-1], **loop.residuals(y, lam),
+                    residuals={"outer_increment": history[-1], **loop.residuals(state),
                                **friction_residuals(forms, x, problem, nu, F)},
                     history=history,
                     timings={"assemble": problem.assemble_seconds,

@@ -1,0 +1,169 @@
+"""The adaptive loop SOLVE -> ESTIMATE -> MARK -> REFINE of Section 4.2.
+
+:func:`adapt` solves the scene on its initial mesh, computes the indicators
+eta_{tot,T} of (4.50) (:mod:`ngdual.estimator`), marks with one of the
+strategies of :mod:`ngdual.marking`, refines the marked triangles with
+netgen's bisection (plus its conforming closure) and carries the coarse
+boundary meshes h~, h^ over to the new mesh, nested and with h~ ~ 2h locally
+(:meth:`ngdual.boundary.BoundaryMeshes.follow`). Each step adds one plain
+record to the returned history: DOFs, the summed estimator terms, the norms of
+SPEC section 6, iterations and the wall time of every phase; given reference
+norms (e.g. Aitken-extrapolated from uniform levels, :func:`reference_norms`),
+also the total error (3.124) and the effectivity index eta / e_tot
+(Table 4.4). Uniform refinement is ``marking="max", theta=0``.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+
+import ngsolve as ngs
+import numpy as np
+
+from .boundary import BoundaryMeshes
+from .estimator import Estimate, estimate
+from .forms import assemble
+from .marking import mark
+from .mesh import build_mesh
+from .post import aitken_extrapolate, norms, total_error
+from .scene import Scene
+from .solve import solve_problem, solve_scene
+from .solvers.result import Solution
+
+StepCallback = Callable[[dict, Solution, Estimate, np.ndarray | None], None]
+
+
+def refine(mesh: ngs.Mesh, marked: np.ndarray) -> ngs.Mesh:
+    """A copy of ``mesh`` with the marked triangles refined (netgen bisection + closure).
+
+    The copy keeps the vertex numbers (new vertices are appended), which the
+    coarse boundary meshes rely on; refining a copy leaves the spaces built on
+    ``mesh`` valid (NGSolve cannot update compressed spaces in place).
+    """
+    marked = np.asarray(marked, dtype=bool)
+    if len(marked) != mesh.ne:
+        raise ValueError(f"{len(marked)} marks for a mesh of {mesh.ne} elements")
+    fine = ngs.Mesh(mesh.ngmesh.Copy())
+    for el in fine.Elements(ngs.VOL):
+        fine.SetRefinementFlag(el, bool(marked[el.nr]))
+    fine.Refine()
+    return fine
+
+
+def adapt(scene: Scene, marking: str = "dorfler", theta: float = 0.5, steps: int = 5,
+          level: int | None = None, asymmetry: str = "hdiv", reference: dict | None = None,
+          on_step: StepCallback | None = None) -> list[dict]:
+    """Run ``steps`` adaptive steps on ``scene`` from its mesh on ``level``.
+
+    Parameters
+    ----------
+    scene : Scene
+    marking : {"max", "fraction", "dorfler"}
+        Marking strategy (:func:`ngdual.marking.mark`) with parameter ``theta``.
+    steps : int
+        Number of SOLVE-ESTIMATE steps (``steps - 1`` refinements).
+    level : int, optional
+        Level of the initial mesh (default: the scene's).
+    asymmetry : {"hdiv", "l2"}
+        Norm of as(sigma_h) in the estimator (see :func:`ngdual.estimator.estimate`).
+    reference : dict, optional
+        Norms of the exact solution (keys of :func:`ngdual.post.norms`); adds
+        the errors of (3.124) and the effectivity index to every record.
+    on_step : callable, optional
+        ``on_step(record, solution, estimate, marked)`` after MARK (``marked`` is
+        None on the last step), before the mesh is refined: for output files.
+
+    Returns
+    -------
+    list of dict
+        One record per step (see :func:`step_record`).
+    """
+    if steps < 1:
+        raise ValueError(f"steps must be >= 1, got {steps}")
+    mesh = build_mesh(scene.geometry, level)
+    coarse = BoundaryMeshes.for_scene(scene, mesh)
+    history = []
+    for step in range(steps):
+        # SOLVE
+        problem = assemble(scene, mesh, coarse)
+        solution = solve_problem(problem)
+        # ESTIMATE
+        indicators = estimate(solution, asymmetry)
+        record = step_record(step, solution, indicators, reference)
+        history.append(record)
+        # MARK
+        marked = None
+        if step < steps - 1:
+            start = time.perf_counter()
+            marked = mark(indicators.eta, theta, marking)
+            record["marked"] = int(marked.sum())
+            record["timings_s"]["mark"] = time.perf_counter() - start
+        if on_step is not None:
+            on_step(record, solution, indicators, marked)
+        if marked is None:
+            break
+        # REFINE
+        start = time.perf_counter()
+        mesh = refine(mesh, marked)
+        coarse = coarse.follow(scene, mesh)
+        record["timings_s"]["refine"] = time.perf_counter() - start
+    return history
+
+
+def step_record(step: int, solution: Solution, indicators: Estimate,
+                reference: dict | None = None) -> dict:
+    """The history entry of one adaptive step (plain JSON-serialisable data).
+
+    ``eta_terms[k]`` is (sum_T term_k,T)^{1/2}, so ``eta``^2 is the sum of their
+    squares; ``eta_sum`` is sum_T eta_{tot,T} (the eta_tot of Table 4.4).
+    """
+    pb = solution.problem
+    mesh = pb.fes.mesh
+    dofs = pb.spaces.dofs()
+    timings = solution.timings
+    record = {
+        "step": step,
+        "elements": mesh.ne,
+        "h_min": float(indicators.h.min()),
+        "h_max": float(indicators.h.max()),
+        "dofs": {**dofs, "total": int(sum(dofs.values()))},
+        "converged": bool(solution.converged),
+        "iterations": {k: int(v) for k, v in solution.iterations.items()},
+        "eta": indicators.total,
+        "eta_sum": indicators.total_sum,
+        "eta_max": float(indicators.eta.max()),
+        "eta_terms": {k: float(np.sqrt(v)) for k, v in indicators.summed().items()},
+        "asymmetry_norm": indicators.asymmetry,
+        "norms": norms(solution),
+        "marked": 0,
+        "timings_s": {"assemble": float(timings.get("assemble", pb.assemble_seconds)),
+                      "solve": float(timings.get("factorize", 0.0) + timings.get("solve", 0.0)),
+                      "estimate": indicators.seconds, "mark": 0.0, "refine": 0.0},
+    }
+    if reference is not None:
+        errors, e_tot = total_error(record["norms"], reference)
+        record.update(errors=errors, e_tot=e_tot,
+                      effectivity=indicators.total / e_tot if e_tot > 0 else None,
+                      effectivity_sum=indicators.total_sum / e_tot if e_tot > 0 else None)
+    return record
+
+
+def reference_norms(scene: Scene, levels: list[int]) -> dict:
+    """Norms of the exact solution, Aitken-extrapolated from uniform levels (Section 3.4).
+
+    Uses the last three of ``levels`` (at least three, consecutive uniform
+    refinements); see :func:`ngdual.post.aitken_extrapolate` for its safeguard.
+    """
+    if len(levels) < 3:
+        raise ValueError("Aitken extrapolation needs at least three levels")
+    sequence = [norms(solve_scene(scene, level)) for level in levels[-3:]]
+    return {q: (aitken_extrapolate([s[q] for s in sequence])
+                if all(s[q] is not None for s in sequence) else None)
+            for q in sequence[0]}
+
+
+def convergence_rate(ndofs, errors) -> float:
+    """Least-squares slope alpha/2 of e ~ N^{-alpha/2}: -d log e / d log N (cf. Section 3.4)."""
+    slope = np.polyfit(np.log(np.asarray(ndofs, float)), np.log(np.asarray(errors, float)), 1)[0]
+    return float(-slope)

@@ -1,0 +1,327 @@
+"""The a posteriori error indicators of Chapter 4, eq. (4.50), every term separately.
+
+For a discrete solution of (3.62), with w_h := C^{-1} sigma_h + eta_h (eta_h
+read as the skew tensor [[0, eta_h], [-eta_h, 0]], so w_h approximates grad u)
+and t = (n_2, -n_1) the tangent of (3.24) and of the proof of Theorem 4.2:
+
+eta_{sigma,T}^2 (4.15)
+    ``residual``        ||f + div sigma_h||_T^2
+    ``asymmetry``       ||as(sigma_h)||_{H(div,T)}^2 (``asymmetry="hdiv"``, the thesis) or
+                        ||as(sigma_h)||_T^2 (``"l2"``, Carstensen-Dolzmann [22], Gatica [46])
+    ``curl``            h_T^2 ||curl w_h||_T^2
+    ``jump_interior``   sum_{e in E^T, interior}  h_e ||[w_h t]||_e^2
+    ``jump_dirichlet``  sum_{e in E^T on Gamma_D} h_e ||w_h t - du_D/dt||_e^2
+    ``jump_neumann``    sum_{e in E^T on Gamma_N} h_e ||w_h t + dphi/dt||_e^2
+    ``jump_contact``    sum_{e in E^T on Gamma_C} h_e ||w_h t + dlam_t/dt t + d(lam_n-g)/dt n||^2
+eta_{u,T}^2 (4.31)
+    ``u_volume``        h_T^2 ||w_h||_T^2
+    ``u_dirichlet``     sum h_e ||u_Gamma - u_D||_e^2
+    ``u_neumann``       sum h_e ||phi + u_Gamma||_e^2
+    ``u_contact``       sum h_e ||lam_t t + (lam_n - g) n + u_Gamma||_e^2
+the friction and Neumann terms of (4.50)
+    ``friction``        sum_{e in E^T on A_C} h~_e ||sigma_t - F nu||_e^2,  A_C = supp F
+    ``neumann``         log(1 + C~_N) sum_{e in E^T on Gamma_N} h~_e ||sigma_h n - t0||_e^2
+
+u_Gamma is the value of the piecewise constant u_h of the element at the edge
+(4.29). The thesis has u_D = 0; the ``du_D/dt`` and ``- u_D`` parts are the
+same terms for non-homogeneous Dirichlet data (w_h t approximates du/dt, and
+u = u_D on Gamma_D). h_T = diam T and h_e = |e| stand for the equivalent
+patch diameters of (3.60); h~_e is the length of the coarse (h~) edge holding e.
+
+Every term is an NGSolve integral: element integrals, element-boundary
+integrals for the interior jumps, and ``ds`` integrals tested with the
+piecewise constants on the boundary edges, each edge added to its element.
+Every array holds squared contributions per element, so that
+eta_{tot,T}^2 = the sum of all terms (4.50).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import ngsolve as ngs
+import numpy as np
+
+from . import peers
+from .expr import Expression
+from .forms import boundary_regex
+from .post import fields
+from .solvers.result import Solution
+
+SIGMA_TERMS = ("residual", "asymmetry", "curl", "jump_interior", "jump_dirichlet",
+               "jump_neumann", "jump_contact")
+U_TERMS = ("u_volume", "u_dirichlet", "u_neumann", "u_contact")
+OTHER_TERMS = ("friction", "neumann")
+TERMS = SIGMA_TERMS + U_TERMS + OTHER_TERMS
+ASYMMETRY_NORMS = ("hdiv", "l2")
+# w_h, as(sigma_h) are polynomials of degree <= 2 per element (RT_0 plus Curl of cubic bubbles)
+W_ORDER = 2
+BONUS_ORDER = 4
+
+
+@dataclass
+class Estimate:
+    """Per-element indicators of (4.50).
+
+    Attributes
+    ----------
+    terms : dict[str, numpy.ndarray]
+        Squared contribution of every term of :data:`TERMS` on every element.
+    h : numpy.ndarray
+        Element diameters h_T.
+    seconds : float
+        Wall time of the estimation.
+    asymmetry : str
+        The norm of as(sigma_h) used ("hdiv" or "l2").
+    """
+
+    terms: dict[str, np.ndarray]
+    h: np.ndarray
+    seconds: float = 0.0
+    asymmetry: str = "hdiv"
+
+    @property
+    def eta_sigma(self) -> np.ndarray:
+        """eta_{sigma,T} of (4.15)."""
+        return np.sqrt(sum(self.terms[k] for k in SIGMA_TERMS))
+
+    @property
+    def eta_u(self) -> np.ndarray:
+        """eta_{u,T} of (4.31)."""
+        return np.sqrt(sum(self.terms[k] for k in U_TERMS))
+
+    @property
+    def eta(self) -> np.ndarray:
+        """eta_{tot,T} of (4.50): the indicator that marking uses."""
+        return np.sqrt(sum(self.terms[k] for k in TERMS))
+
+    @property
+    def total(self) -> float:
+        """(sum_T eta_{tot,T}^2)^{1/2}, the global estimator compared with the error."""
+        return float(np.sqrt(np.sum(self.eta**2)))
+
+    @property
+    def total_sum(self) -> float:
+        """sum_T eta_{tot,T}, the eta_tot of Table 4.4 (Theorem 4.8 bounds the error by it)."""
+        return float(np.sum(self.eta))
+
+    def summed(self) -> dict[str, float]:
+        """sum_T of every squared term (their sum is ``total**2``)."""
+        return {k: float(np.sum(v)) for k, v in self.terms.items()}
+
+
+def element_diameters(mesh: ngs.Mesh) -> np.ndarray:
+    """h_T = the longest edge of every triangle."""
+    pts = np.array([v.point for v in mesh.vertices])
+    tri = np.array([[v.nr for v in el.vertices] for el in mesh.Elements(ngs.VOL)])
+    p = pts[tri]
+    return np.linalg.norm(p - np.roll(p, 1, axis=1), axis=2).max(axis=1)
+
+
+def _tangent():
+    n = ngs.specialcf.normal(2)
+    return n, ngs.CF((n[1], -n[0]))
+
+
+def _interpolate(mesh: ngs.Mesh, cfs) -> list[ngs.GridFunction]:
+    """Element-wise L2 projections onto P2 (exact for the PEERS fields), to differentiate them."""
+    space = ngs.L2(mesh, order=W_ORDER)
+    out = []
+    for cf in cfs:
+        gf = ngs.GridFunction(space)
+        gf.Set(cf)
+        out.append(gf)
+    return out
+
+
+def _element_integrals(cf, mesh: ngs.Mesh) -> np.ndarray:
+    return ngs.Integrate(cf * ngs.dx(bonus_intorder=BONUS_ORDER), mesh,
+                         element_wise=True).NumPy().copy()
+
+
+class _BoundaryEdges:
+    """Integrals over the boundary edges, each added to the one element that owns it."""
+
+    def __init__(self, mesh: ngs.Mesh):
+        self.mesh = mesh
+        self.space = ngs.SurfaceL2(mesh, order=0)
+        self.test = self.space.TestFunction()
+        self.element = np.zeros(self.space.ndof, dtype=int)
+        self.length = np.zeros(self.space.ndof)
+        self.dof_of_edge: dict[frozenset, int] = {}
+        pts = np.array([v.point for v in mesh.vertices])
+        for el in mesh.Elements(ngs.BND):
+            dof = self.space.GetDofNrs(el)[0]
+            a, b = (v.nr for v in el.vertices)
+            self.element[dof] = mesh[el.edges[0]].elements[0].nr
+            self.length[dof] = np.linalg.norm(pts[a] - pts[b])
+            self.dof_of_edge[frozenset((a, b))] = dof
+
+    def integrals(self, cf, labels: list[str]) -> np.ndarray:
+        """int_e cf ds for every boundary edge e (zero off ``labels``), by edge dof."""
+        if not labels:
+            return np.zeros(self.space.ndof)
+        form = ngs.LinearForm(self.space)
+        form += cf * self.test * ngs.ds(definedon=self.mesh.Boundaries(boundary_regex(labels)),
+                                        bonus_intorder=BONUS_ORDER)
+        form.Assemble()
+        return form.vec.FV().NumPy().copy()
+
+    def to_elements(self, values: np.ndarray) -> np.ndarray:
+        return np.bincount(self.element, values, self.mesh.ne)
+
+    def per_edge(self, coarse, values: np.ndarray) -> np.ndarray:
+        """Scatter values given per fine edge of a coarse mesh's chains onto edge dofs."""
+        out = np.zeros(self.space.ndof)
+        pairs, _ = coarse.fine_edges()
+        dofs = [self.dof_of_edge[frozenset(map(int, p))] for p in pairs]
+        out[dofs] = values
+        return out
+
+    def coarse_lengths(self, coarse) -> np.ndarray:
+        """h~_e: the length of the coarse edge holding every fine edge of ``coarse``."""
+        _, owner = coarse.fine_edges()
+        return self.per_edge(coarse, coarse.edge_lengths()[owner])
+
+
+def _interior_edge_lengths(mesh: ngs.Mesh) -> ngs.GridFunction:
+    """h_e on interior edges, 0 on boundary edges (a facet function)."""
+    space = ngs.FacetFESpace(mesh, order=0)
+    v = space.TestFunction()
+    both, bnd = ngs.LinearForm(space), ngs.LinearForm(space)
+    both += v * ngs.dx(element_boundary=True)   # 2|e| inside, |e| on the boundary
+    bnd += v * ngs.ds                            # |e| on the boundary
+    both.Assemble()
+    bnd.Assemble()
+    gf = ngs.GridFunction(space)
+    gf.vec.FV().NumPy()[:] = 0.5 * (both.vec.FV().NumPy() - bnd.vec.FV().NumPy())
+    return gf
+
+
+def estimate(solution: Solution, asymmetry: str = "hdiv") -> Estimate:
+    """Every term of eta_{tot,T} (4.50) on every element of the solution's mesh.
+
+    Parameters
+    ----------
+    solution : Solution
+        A discrete solution of (3.62) (with ``nu`` and ``friction_bound`` if
+        the scene has friction).
+    asymmetry : {"hdiv", "l2"}
+        The norm of as(sigma_h): H(div, T) as in (4.15), or L^2(T). Without
+        weights, ||div as(sigma_h)||_T does not tend to zero for PEERS (the
+        observation of Table 4.2); the L^2 variant does.
+
+    Returns
+    -------
+    Estimate
+    """
+    if asymmetry not in ASYMMETRY_NORMS:
+        raise ValueError(f"asymmetry must be one of {ASYMMETRY_NORMS}, got {asymmetry!r}")
+    start = time.perf_counter()
+    pb = solution.problem
+    scene, spaces = pb.scene, pb.spaces
+    mesh = pb.fes.mesh
+    lam, mu = scene.material.lame
+    f = fields(solution)
+    h = element_diameters(mesh)
+    n, t = _tangent()
+
+    # w_h = C^{-1} sigma_h + eta_h and a_h = (sigma_12 - sigma_21) / 2, as P2 functions per element
+    w_cf = peers.compliance(f.sigma, lam, mu) + ngs.CF((0, f.eta, -f.eta, 0), dims=(2, 2))
+    *w_parts, a = _interpolate(mesh, [w_cf[0, 0], w_cf[0, 1], w_cf[1, 0], w_cf[1, 1],
+                                      0.5 * peers.asym(f.sigma)])
+    w = ngs.CF(tuple(w_parts), dims=(2, 2))
+    curl_w = ngs.CF((ngs.grad(w_parts[1])[0] - ngs.grad(w_parts[0])[1],
+                     ngs.grad(w_parts[3])[0] - ngs.grad(w_parts[2])[1]))
+    body = ngs.CF(tuple(Expression(e).coefficient() for e in scene.loads.body_force))
+    residual = body + f.div_sigma
+
+    terms = dict.fromkeys(TERMS)
+    terms["residual"] = _element_integrals(residual * residual, mesh)
+    as_l2 = 2 * a * a                           # |[[0, a], [-a, 0]]|^2
+    as_div = ngs.grad(a) * ngs.grad(a)          # |div [[0, a], [-a, 0]]|^2 = |grad a|^2
+    terms["asymmetry"] = _element_integrals(as_l2 + as_div if asymmetry == "hdiv" else as_l2,
+                                            mesh)
+    terms["curl"] = h**2 * _element_integrals(curl_w * curl_w, mesh)
+    terms["u_volume"] = h**2 * _element_integrals(ngs.InnerProduct(w, w), mesh)
+
+    h_int = _interior_edge_lengths(mesh)
+    w_other = ngs.CF(tuple(p.Other() for p in w_parts), dims=(2, 2))
+    jump = (w - w_other) * t
+    terms["jump_interior"] = ngs.Integrate(
+        h_int * (jump * jump) * ngs.dx(element_boundary=True, bonus_intorder=BONUS_ORDER),
+        mesh, element_wise=True).NumPy().copy()
+
+    edges = _BoundaryEdges(mesh)
+    he = edges.length
+    w_t = ngs.BoundaryFromVolumeCF(w) * t
+    u_gamma = ngs.BoundaryFromVolumeCF(f.u)
+    sigma_n = ngs.BoundaryFromVolumeCF(f.sigma) * n
+
+    def squared(vec):
+        return vec * vec
+
+    labels_d = scene.labels("dirichlet")
+    u_d = ngs.CF(tuple(Expression(e).coefficient() for e in scene.loads.displacement))
+    du_d = ngs.CF(tuple(c.Diff(ngs.x) * t[0] + c.Diff(ngs.y) * t[1]
+                        for c in (u_d[0], u_d[1])))
+    on_edges = {
+        "jump_dirichlet": he * edges.integrals(squared(w_t - du_d), labels_d),
+        "u_dirichlet": he * edges.integrals(squared(u_gamma - u_d), labels_d),
+    }
+    labels_n = scene.labels("neumann")
+    if f.phi is not None:
+        gf = dict(zip(pb.names, f.gf.components))
+        dphi = ngs.CF((ngs.grad(gf["phi1"]) * t, ngs.grad(gf["phi2"]) * t))
+        t0 = ngs.CF(tuple(Expression(e).coefficient() for e in scene.loads.traction))
+        on_edges["jump_neumann"] = he * edges.integrals(squared(w_t + dphi), labels_n)
+        on_edges["u_neumann"] = he * edges.integrals(squared(f.phi + u_gamma), labels_n)
+        on_edges["neumann"] = (np.log(1 + neighbour_ratio(spaces.neumann))
+                               * edges.coarse_lengths(spaces.neumann)
+                               * edges.integrals(squared(sigma_n - t0), labels_n))
+    labels_c = scene.labels("contact")
+    if f.lam_n is not None:
+        gf = dict(zip(pb.names, f.gf.components))
+        g = Expression(scene.contact.gap).coefficient()
+        dg = g.Diff(ngs.x) * t[0] + g.Diff(ngs.y) * t[1]
+        d_mult = (ngs.grad(gf["lam_t"]) * t) * t + (ngs.grad(gf["lam_n"]) * t - dg) * n
+        mult = f.lam_t * t + (f.lam_n - g) * n
+        on_edges["jump_contact"] = he * edges.integrals(squared(w_t + d_mult), labels_c)
+        on_edges["u_contact"] = he * edges.integrals(squared(mult + u_gamma), labels_c)
+        if spaces.friction is not None and solution.friction_bound is not None:
+            on_edges["friction"] = _friction_term(solution, edges, sigma_n * t, labels_c)
+    for name in ("jump_dirichlet", "jump_neumann", "jump_contact", "u_dirichlet", "u_neumann",
+                 "u_contact", "friction", "neumann"):
+        values = on_edges.get(name)
+        terms[name] = edges.to_elements(values) if values is not None else np.zeros(mesh.ne)
+    return Estimate(terms, h, time.perf_counter() - start, asymmetry)
+
+
+def neighbour_ratio(coarse) -> float:
+    """C~_N of Theorem 4.8: the largest ratio of the lengths of neighbouring fine edges."""
+    ratio = 1.0
+    for chain in coarse.chains:
+        ell = np.diff(chain.arclength)
+        if chain.closed:
+            ell = np.append(ell, ell[0])
+        if len(ell) > 1:
+            ratio = max(ratio, float(np.max(np.maximum(ell[1:] / ell[:-1], ell[:-1] / ell[1:]))))
+    return ratio
+
+
+def _friction_term(solution: Solution, edges: _BoundaryEdges, sigma_t, labels) -> np.ndarray:
+    """h~_e ||sigma_t - F nu||_e^2 on the fine Gamma_C edges of A_C = supp F.
+
+    F (``friction_bound``) is given per fine edge and nu per h^ edge, both in
+    the chain order of the contact mesh (see :mod:`ngdual.friction`).
+    """
+    spaces = solution.problem.spaces
+    _, owner = spaces.friction.fine_edges()
+    bound = np.asarray(solution.friction_bound, dtype=float)
+    f_nu = bound * np.asarray(solution.nu, dtype=float)[owner]
+    gf = ngs.GridFunction(edges.space)
+    gf.vec.FV().NumPy()[:] = edges.per_edge(spaces.contact, f_nu)
+    active = edges.per_edge(spaces.contact, (bound > 0).astype(float))
+    return (active * edges.coarse_lengths(spaces.contact)
+            * edges.integrals((sigma_t - gf) * (sigma_t - gf), labels))
