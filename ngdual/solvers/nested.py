@@ -62,24 +62,34 @@ def _relative(new: np.ndarray, old: np.ndarray) -> float:
 
 def friction_residuals(forms: FrictionForms, x: np.ndarray, problem: DiscreteProblem,
                        nu: np.ndarray, F: np.ndarray) -> dict:
-    """Residuals of (3.62)_5,7 and |sigma_t| <= F on Gamma_C (relative, 0 = exact).
+    """Residuals of (3.62)_5,7 and of |sigma_t| <= F on Gamma_C (relative, 0 = exact).
 
-    ``nu_sign`` is the residual of q(kappa - nu, lambda_t) <= 0 for all kappa in
-    Lambda_h^: sum_j (|(Q lambda_t)_j| - nu_j (Q lambda_t)_j) / sum_j |(Q lambda_t)_j|.
-    ``sigma_t_excess`` is max(|sigma_t| - F)_+ / max F over the fine edges: a
-    pointwise check that the discrete problem only enforces in the weak sense
-    (tested against the h~ hats), so values O(1) next to the corners of Gamma_C
-    are expected.
+    ``nu_sign``: q(kappa - nu, lambda_t) <= 0 for all kappa in Lambda_h^, i.e.
+    sum_j (|(Q lambda_t)_j| - nu_j (Q lambda_t)_j), relative to the friction work
+    j(lambda_t) = int F |lambda_t| ds (so that stick, Q lambda_t = 0, counts as exact).
+    ``tangential``: the equation C_t^T sigma = Q_F^T nu of (3.62)_5.
+    ``sigma_t_bound``: |int sigma_t mu_i| <= int F mu_i for every h~ hat mu_i (the
+    discrete form of |sigma_t| <= F, Proposition 3.25).
+    ``sigma_t_excess``: the same pointwise on the fine edges, max(|sigma_t| - F)_+ / max F,
+    which the discrete problem does not enforce: O(1) values next to the ends of
+    Gamma_C are expected.
     """
     Q = forms.q_matrix(F)
     lam_t = x[problem.index("lam_t")]
     qlt = Q @ lam_t
-    total = np.abs(qlt).sum() or 1.0
+    work = np.sum(Q @ np.abs(lam_t)) or 1.0
+    sigma = x[problem.sigma]
+    tangential = problem.block(problem.sigma, problem.index("lam_t")).T @ sigma
+    load = Q.T @ nu
+    bound = Q.T @ np.ones(forms.n_nu)
+    scale = np.max(bound, initial=0.0) or 1.0
     sigma_t = forms.T_t @ x
     f_scale = F.max() if F.max() > 0 else 1.0
     return {
-        "nu_sign": float(np.sum(np.abs(qlt) - nu * qlt) / total),
+        "nu_sign": float(np.sum(np.abs(qlt) - nu * qlt) / work),
         "nu_bound": float(max(0.0, np.abs(nu).max(initial=0.0) - 1.0)),
+        "tangential": float(np.max(np.abs(tangential - load), initial=0.0) / scale),
+        "sigma_t_bound": float(max(0.0, np.max(np.abs(tangential) - bound, initial=0.0)) / scale),
         "sigma_t_excess": float(max(0.0, np.max(np.abs(sigma_t) - F, initial=0.0)) / f_scale),
     }
 

@@ -14,7 +14,7 @@ with W the matrix of the metric. Two metrics are offered:
     half-plane (normal stress (E*/2)|k| per unit normal displacement of wave
     number k). Spectrally equivalent to the hypersingular operator the thesis
     uses, so the iteration count does not grow with the level. The QP is posed
-    in cvxpy (Clarabel) and polished on its active set.
+    by SciPy's NNLS (or as a cvxpy QP, Clarabel, polished on its active set).
 ``euclidean``
     W = (E*/2) I: a diagonal metric with the closed-form projection
     max(0, c / w). Cheap per step, but the number of steps grows with 1/h.
@@ -28,6 +28,7 @@ from __future__ import annotations
 import cvxpy as cp
 import numpy as np
 import scipy.linalg as sla
+import scipy.optimize as spo
 
 from ..boundary import CoarseMesh
 
@@ -53,20 +54,29 @@ class NonnegativeProjection:
     W : numpy.ndarray
         Symmetric positive definite metric; a 1-D array means a diagonal one,
         solved in closed form.
+    solver : {"nnls", "cvxpy"}
+        For a dense W: with W = R^T R the QP is the non-negative least-squares
+        problem min ||R chi - R^{-T} c|| (SciPy's active-set NNLS, exact), or
+        the QP posed in cvxpy and solved by Clarabel, then polished on its
+        active set. Both give the same chi (tested).
     """
 
-    def __init__(self, W: np.ndarray):
+    def __init__(self, W: np.ndarray, solver: str = "nnls"):
         self.W = np.asarray(W, dtype=float)
         self.diagonal = self.W.ndim == 1
+        self.solver = solver
         if self.diagonal:
             return
         self._scale = float(np.max(np.abs(np.diag(self.W))))
-        n = self.W.shape[0]
-        self._chi = cp.Variable(n)
-        self._c = cp.Parameter(n)
-        root = sla.cholesky(self.W / self._scale, lower=False)
-        objective = 0.5 * cp.sum_squares(root @ self._chi) - self._c @ self._chi
-        self._problem = cp.Problem(cp.Minimize(objective), [self._chi >= 0])
+        self._root = sla.cholesky(self.W / self._scale, lower=False)
+        if solver == "cvxpy":
+            n = self.W.shape[0]
+            self._chi = cp.Variable(n)
+            self._c = cp.Parameter(n)
+            objective = 0.5 * cp.sum_squares(self._root @ self._chi) - self._c @ self._chi
+            self._problem = cp.Problem(cp.Minimize(objective), [self._chi >= 0])
+        elif solver != "nnls":
+            raise ValueError(f"unknown projection solver {solver!r}")
 
     def matvec(self, x: np.ndarray) -> np.ndarray:
         return self.W * x if self.diagonal else self.W @ x
@@ -74,6 +84,9 @@ class NonnegativeProjection:
     def __call__(self, c: np.ndarray) -> np.ndarray:
         if self.diagonal:
             return np.maximum(c / self.W, 0.0)
+        if self.solver == "nnls":
+            rhs = sla.solve_triangular(self._root, c / self._scale, trans="T")
+            return spo.nnls(self._root, rhs, maxiter=50 * len(c))[0]
         self._c.value = c / self._scale
         self._problem.solve(solver=cp.CLARABEL, tol_gap_abs=1e-12, tol_gap_rel=1e-12,
                             tol_feas=1e-12)

@@ -42,19 +42,26 @@ def solve_linear(problem: DiscreteProblem, backend: str = "umfpack") -> Solution
 
 
 def contact_residuals(lam: np.ndarray, traction: np.ndarray,
-                      projection: NonnegativeProjection) -> dict:
+                      projection: NonnegativeProjection, lam_scale: float | None = None,
+                      load_scale: float = 0.0) -> dict:
     """Residuals of the discrete VI (3.103): lambda_n >= 0, C_n^T sigma <= 0, complementarity.
 
     ``traction`` is C_n^T sigma (the normal stress tested with the coarse hats).
-    All values are relative, so 0 means exact and 1e-8 is at solver tolerance.
+    ``lam_scale`` is the displacement scale on Gamma_C that lambda_n is measured
+    against (default max |lambda_n|; pass max(|lambda_n|, |lambda_t|) when
+    lambda_n may vanish, e.g. full contact at g = 0, where lambda_n itself is
+    round-off). ``load_scale`` (max of the load vector b) keeps the traction
+    scale meaningful when C_n^T sigma vanishes (no contact anywhere). All values
+    are relative, so 0 means exact and 1e-8 is at solver tolerance;
+    complementarity is max_j |lambda_j t_j| / (lam_scale max |t|).
     """
-    lam_scale = np.max(np.abs(lam)) or 1.0
-    tr_scale = np.max(np.abs(traction)) or 1.0
+    lam_scale = lam_scale or np.max(np.abs(lam), initial=0.0) or 1.0
+    tr_scale = max(np.max(np.abs(traction), initial=0.0), load_scale) or 1.0
     return {
         "lambda_n_negative": float(max(0.0, -lam.min(initial=0.0)) / lam_scale),
         "sigma_n_positive": float(max(0.0, traction.max(initial=0.0)) / tr_scale),
-        "complementarity": float(abs(lam @ traction)
-                                 / ((np.linalg.norm(lam) * np.linalg.norm(traction)) or 1.0)),
+        "complementarity": float(np.max(np.abs(lam * traction), initial=0.0)
+                                 / (lam_scale * tr_scale)),
         "natural": projection.residual(lam, traction),
     }
 
@@ -173,7 +180,10 @@ class ContactLoop:
         return state, it, history, converged
 
     def residuals(self, state: LoopState) -> dict:
-        return contact_residuals(state.lam, state.traction, self.projection)
+        scale = max(np.max(np.abs(state.lam), initial=0.0),
+                    np.max(np.abs(state.lam_t), initial=0.0))
+        return contact_residuals(state.lam, state.traction, self.projection, scale,
+                                 np.max(np.abs(self.b0), initial=0.0))
 
 
 def uzawa(problem: DiscreteProblem, rho: float = 1.0, eps: float = 1e-8, max_iter: int = 2000,
