@@ -1,4 +1,4 @@
-"""A reference solver independent of Algorithm 3.38: the frictionless problem as one convex QP.
+"""Reference solvers independent of Algorithms 3.38/3.41: the discrete problem as convex QPs.
 
 The algebraic problem (3.103), i.e. the discrete variational inequality (3.68)
 without friction, is the KKT system of
@@ -9,6 +9,15 @@ with the multipliers (u, eta, phi, lambda_t) of the equalities and lambda_n >= 0
 of the inequalities. Here the QP is solved directly by Clarabel's interior-point
 method through cvxpy and then polished once on the active set it found, so
 nothing is shared with the Uzawa iteration or its saddle-point factorisation.
+
+With friction and a given bound F, (3.62) is the KKT system of the QP in (sigma, nu)
+
+    min 1/2 sigma^T A sigma - g^T sigma
+    s.t. B^T sigma - (0, 0, 0, Q_F^T nu) = b,  C_n^T sigma <= 0,  |nu_j| <= 1,
+
+(stationarity in nu is nu_j = sign (Q_F lambda_t)_j, i.e. (3.62)_7); Coulomb
+friction iterates this QP on F = mu_f |sigma_n| of (3.123) to a fixed point
+(:func:`solve_qp_friction`).
 """
 
 from __future__ import annotations
@@ -21,7 +30,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..forms import DiscreteProblem
-from .result import Solution
+from ..friction import build_friction_forms, tresca_bound
+from .result import ConvergenceError, Solution
 
 CLARABEL_TOLERANCES = {"tol_gap_abs": 1e-12, "tol_gap_rel": 1e-12, "tol_feas": 1e-12,
                        "tol_ktratio": 1e-10, "max_iter": 500}
@@ -29,6 +39,11 @@ FEASIBILITY_TOL = 1e-10
 
 
 def solve_qp(problem: DiscreteProblem) -> Solution:
+    """Solve the frictionless problem (3.103); see :func:`_solve_qp`."""
+    return _solve_qp(problem)
+
+
+def _solve_qp(problem: DiscreteProblem, Q: sp.spmatrix | None = None) -> Solution:
     """Solve (3.103), the algebraic form of (3.68), as one convex QP in sigma (Clarabel via cvxpy).
 
     The QP is posed in scaled variables so that its numbers are O(1): the
@@ -36,6 +51,10 @@ def solve_qp(problem: DiscreteProblem) -> Solution:
     measured in the stress unit ``s = max(max|b|, E* max|g|)``. Then
     ``sigma = s z``, and the multipliers of the scaled QP give
     ``(u, eta, phi, lambda_t, lambda_n) = (s / E*) * (duals)``.
+
+    With ``Q`` (= Q_F, N_A x N_C) the friction variable nu (|nu| <= 1) enters
+    the lambda_t rows of the equality; ``Solution.nu`` is then set and the
+    active-set polish is skipped (it would need the stick/slip sets too).
 
     Returns
     -------
@@ -56,9 +75,17 @@ def solve_qp(problem: DiscreteProblem) -> Solution:
 
     start = time.perf_counter()
     z = cp.Variable(len(i_sigma))
-    equality, contact = B.T @ z == b_s, C_n.T @ z <= 0
+    lhs, constraints, nu = B.T @ z, [], None
+    if Q is not None:
+        nu = cp.Variable(Q.shape[0])
+        rows = problem.index("lam_t") - len(i_sigma)  # lambda_t rows within mult
+        inject = sp.csr_matrix((np.ones(len(rows)), (rows, np.arange(len(rows)))),
+                               shape=(len(i_mult), Q.shape[1]))
+        lhs = lhs - (inject @ Q.T / stress) @ nu
+        constraints.append(cp.abs(nu) <= 1)
+    equality, contact = lhs == b_s, C_n.T @ z <= 0
     qp = cp.Problem(cp.Minimize(0.5 * cp.quad_form(z, A_s, assume_PSD=True) - g_s @ z),
-                    [equality, contact])
+                    [equality, contact, *constraints])
     qp.solve(solver=cp.CLARABEL, **CLARABEL_TOLERANCES)
     if z.value is None:
         raise RuntimeError(f"Clarabel returned no solution (status {qp.status!r})")
@@ -67,7 +94,7 @@ def solve_qp(problem: DiscreteProblem) -> Solution:
     qp_s = time.perf_counter() - start
 
     start = time.perf_counter()
-    polished = _polish(A_s, B, C_n, g_s, b_s, *scaled)
+    polished = _polish(A_s, B, C_n, g_s, b_s, *scaled) if Q is None else None
     polish_s = time.perf_counter() - start
     z_v, y_v, lam_v = polished if polished is not None else scaled
 
@@ -75,13 +102,54 @@ def solve_qp(problem: DiscreteProblem) -> Solution:
     x[i_sigma] = stress * z_v
     x[i_mult] = stress / modulus * y_v
     x[i_lam] = stress / modulus * lam_v
-    residuals = {**_residuals(A, B, C_n, g, b, x[i_sigma], x[i_mult], x[i_lam]),
+    nu_v = None if nu is None else np.clip(nu.value, -1.0, 1.0)
+    b_nu = b if nu is None else b + inject @ (Q.T @ nu_v)  # the lambda_t rows carry Q_F^T nu
+    residuals = {**_residuals(A, B, C_n, g, b_nu, x[i_sigma], x[i_mult], x[i_lam]),
                  "polished": float(polished is not None)}
     converged = polished is not None or qp.status == cp.OPTIMAL
     return Solution(problem, x, converged, "reference-qp", iterations={"outer": 0, "inner": 0},
                     residuals=residuals,
                     timings={"assemble": problem.assemble_seconds, "qp": qp_s,
-                             "polish": polish_s, "solve": qp_s + polish_s})
+                             "polish": polish_s, "solve": qp_s + polish_s},
+                    nu=nu_v)
+
+
+def solve_qp_friction(problem: DiscreteProblem, law: str, mu_f: float = 0.0,
+                      tol: float = 1e-10, max_iter: int = 200) -> Solution:
+    """Tresca or Coulomb friction by the QP in (sigma, nu), iterated on F for Coulomb.
+
+    Tresca: one QP with the given bound. Coulomb: F^0 = mu_f |sigma_n| of the
+    frictionless QP, then F^{k+1} = mu_f |sigma_n(sigma^k)| (3.123) until the
+    relative change of F is <= ``tol`` (successive substitution: no Uzawa step,
+    no metric, no factorisation shared with :mod:`ngdual.solvers.nested`).
+
+    Raises
+    ------
+    ConvergenceError
+        If the fixed point on F does not converge in ``max_iter`` QPs.
+    """
+    forms = build_friction_forms(problem)
+    start = time.perf_counter()
+    if law == "tresca":
+        F, history = tresca_bound(forms, problem), [0.0]
+        sol = _solve_qp(problem, forms.q_matrix(F))
+    else:
+        sol = _solve_qp(problem)
+        history = []
+        while len(history) < max_iter:
+            F = mu_f * forms.per_hat_edge(np.abs(forms.T_n @ sol.x))[forms.edge_of]
+            sol = _solve_qp(problem, forms.q_matrix(F))
+            F_new = mu_f * forms.per_hat_edge(np.abs(forms.T_n @ sol.x))[forms.edge_of]
+            history.append(float(np.linalg.norm(F_new - F) / (np.linalg.norm(F_new) or 1.0)))
+            if history[-1] <= tol:
+                break
+        else:
+            raise ConvergenceError(f"the fixed point on F did not converge in {max_iter} QPs",
+                                   history)
+    sol.friction_bound, sol.method, sol.history = F, f"reference-qp-{law}", history
+    sol.iterations = {"outer": len(history), "inner": 0}
+    sol.timings["solve"] = time.perf_counter() - start
+    return sol
 
 
 def _polish(A, B, C_n, g, b, z, y, lam):
