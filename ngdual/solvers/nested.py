@@ -34,6 +34,7 @@ from collections.abc import Callable
 
 import cvxpy as cp
 import numpy as np
+import scipy.sparse as sp
 
 from ..forms import DiscreteProblem
 from ..friction import FrictionForms, build_friction_forms, tresca_bound
@@ -60,13 +61,23 @@ def _relative(new: np.ndarray, old: np.ndarray) -> float:
     return float(np.linalg.norm(new - old) / (np.linalg.norm(new) or 1.0))
 
 
+def sign_residual(Q: sp.spmatrix, nu: np.ndarray, lam_t: np.ndarray) -> float:
+    """Residual of (3.62)_7, sum_j (|q_j| - nu_j q_j) / j(lambda_t) with q = Q_F lambda_t.
+
+    Zero iff nu_j = sign q_j wherever q_j != 0; relative to the friction work
+    j(lambda_t) = int F |lambda_t| ds, so that stick (q = 0) counts as exact.
+    """
+    q = Q @ lam_t
+    work = float(np.sum(Q @ np.abs(lam_t)))
+    return float(np.sum(np.abs(q) - nu * q) / work) if work > 0 else 0.0
+
+
 def friction_residuals(forms: FrictionForms, x: np.ndarray, problem: DiscreteProblem,
                        nu: np.ndarray, F: np.ndarray) -> dict:
     """Residuals of (3.62)_5,7 and of |sigma_t| <= F on Gamma_C (relative, 0 = exact).
 
-    ``nu_sign``: q(kappa - nu, lambda_t) <= 0 for all kappa in Lambda_h^, i.e.
-    sum_j (|(Q lambda_t)_j| - nu_j (Q lambda_t)_j), relative to the friction work
-    j(lambda_t) = int F |lambda_t| ds (so that stick, Q lambda_t = 0, counts as exact).
+    ``nu_sign``: q(kappa - nu, lambda_t) <= 0 for all kappa in Lambda_h^
+    (:func:`sign_residual`).
     ``tangential``: the equation C_t^T sigma = Q_F^T nu of (3.62)_5.
     ``sigma_t_bound``: |int sigma_t mu_i| <= int F mu_i for every h~ hat mu_i (the
     discrete form of |sigma_t| <= F, Proposition 3.25).
@@ -75,9 +86,6 @@ def friction_residuals(forms: FrictionForms, x: np.ndarray, problem: DiscretePro
     Gamma_C are expected.
     """
     Q = forms.q_matrix(F)
-    lam_t = x[problem.index("lam_t")]
-    qlt = Q @ lam_t
-    work = np.sum(Q @ np.abs(lam_t)) or 1.0
     sigma = x[problem.sigma]
     tangential = problem.block(problem.sigma, problem.index("lam_t")).T @ sigma
     load = Q.T @ nu
@@ -86,7 +94,7 @@ def friction_residuals(forms: FrictionForms, x: np.ndarray, problem: DiscretePro
     sigma_t = forms.T_t @ x
     f_scale = F.max() if F.max() > 0 else 1.0
     return {
-        "nu_sign": float(np.sum(np.abs(qlt) - nu * qlt) / work),
+        "nu_sign": sign_residual(Q, nu, x[problem.index("lam_t")]),
         "nu_bound": float(max(0.0, np.abs(nu).max(initial=0.0) - 1.0)),
         "tangential": float(np.max(np.abs(tangential - load), initial=0.0) / scale),
         "sigma_t_bound": float(max(0.0, np.max(np.abs(tangential) - bound, initial=0.0)) / scale),
@@ -133,7 +141,7 @@ class FrictionStep:
         return self.Q.T @ nu
 
 
-def _stagnation_message(problem: DiscreteProblem, outer: int, law: str) -> str:
+def _stagnation_message(problem: DiscreteProblem, outer: int, law: str, what: str) -> str:
     remedies = ["a smaller solver.rho2"]
     if problem.scene.contact.hhat_factor == 1:
         remedies.insert(0, "contact.hhat_factor = 2 (with h^ = h~ the inf-sup condition "
@@ -142,8 +150,8 @@ def _stagnation_message(problem: DiscreteProblem, outer: int, law: str) -> str:
     if law == "coulomb":
         remedies.append("a smaller friction.mu (the Coulomb fixed point F = mu |sigma_n| "
                         "need not contract for large mu)")
-    return (f"nested Uzawa stagnated: the residual did not halve in {STAGNATION_WINDOW} outer "
-            f"steps (up to step {outer}); try " + ", or ".join(remedies))
+    return (f"nested Uzawa {what} (outer step {outer}, solver.max_iter); try "
+            + ", or ".join(remedies))
 
 
 def nested_uzawa(problem: DiscreteProblem, law: str, mu_f: float = 0.0, rho1: float = 1.0,
@@ -177,14 +185,18 @@ def nested_uzawa(problem: DiscreteProblem, law: str, mu_f: float = 0.0, rho1: fl
         same iterates.
 
     Stopping is honest: the iteration ends only when the inner loop converged
-    and the relative increments of nu, F (Coulomb) and, for ``contact-outer``,
-    lambda_n are <= eps2; every residual of (3.62) is reported.
+    (complementarity of lambda_n to eps1), the relative increments of nu, F
+    (Coulomb) and, for ``contact-outer``, lambda_n are <= eps2, and so is the
+    residual of nu lambda_t = |lambda_t| (:func:`sign_residual`); the thesis'
+    increment-only test (step 9 / 9') can stop while nu is still far from its
+    limit. Every residual of (3.62) is reported.
 
     Raises
     ------
     ConvergenceError
-        When the residual becomes NaN, grows by 1e6, or does not halve within
-        ``STAGNATION_WINDOW`` outer steps (the message names the remedies).
+        When the residual becomes NaN, grows by 1e6, does not halve within
+        ``STAGNATION_WINDOW`` outer steps, or is not below eps2 after
+        ``max_iter`` outer steps (the message names the remedies).
     """
     if loop_order not in ("friction-outer", "contact-outer"):
         raise ValueError(f"unknown loop_order {loop_order!r}")
@@ -225,19 +237,21 @@ def nested_uzawa(problem: DiscreteProblem, law: str, mu_f: float = 0.0, rho1: fl
                                                  tau=friction.load(nu))
             lam = state.lam
             change_F = coulomb_update(state)
+            sign = sign_residual(friction.Q, nu, state.lam_t)
             nu_new = friction(nu, state.lam_t)                                # step 8 / 10'
-            change = max(_relative(nu_new, nu), change_F)
+            change = max(_relative(nu_new, nu), change_F, sign)
         else:  # Remark 3.43: nu (and F) converge inside for fixed lambda_n
             inner, inner_ok = 0, False
             while inner < max_iter and not inner_ok:
                 inner += 1
                 state = loop.respond(lam, friction.load(nu))
                 change_F = coulomb_update(state)
+                sign = sign_residual(friction.Q, nu, state.lam_t)
                 nu_new = friction(nu, state.lam_t)
                 inner_ok = max(_relative(nu_new, nu), change_F) <= eps1
                 nu = nu_new
             lam_new = loop.projection(loop.projection.matvec(lam) + rho1 * state.traction)
-            change = max(_relative(lam_new, lam), change_F)
+            change = max(_relative(lam_new, lam), change_F, sign)
             lam = lam_new
         inner_total += inner
         nu = nu_new
@@ -253,7 +267,12 @@ def nested_uzawa(problem: DiscreteProblem, law: str, mu_f: float = 0.0, rho1: fl
         if change < 0.5 * best:
             best, best_at = change, outer
         elif outer - best_at > STAGNATION_WINDOW:
-            raise ConvergenceError(_stagnation_message(problem, outer, law), history)
+            raise ConvergenceError(_stagnation_message(problem, outer, law, "stagnated: the "
+                                   f"residual did not halve in {STAGNATION_WINDOW} outer steps"),
+                                   history)
+    else:
+        raise ConvergenceError(_stagnation_message(problem, outer, law, "did not converge"),
+                               history)
     # one last inner solve so that (sigma, lambda) match the final nu and F exactly
     state, inner, _, inner_ok = loop.run(lam, rho1, eps1, max_iter, tau=friction.load(nu))
     inner_total += inner
