@@ -1,14 +1,19 @@
-"""Nested Uzawa (Algorithm 3.41, Remark 3.45): Tresca and Coulomb on coarse levels."""
+"""Nested Uzawa (Algorithm 3.41, Remark 3.45): Tresca and Coulomb on coarse levels, and
+the variants (loop order, metrics, step, condensed iteration) reach the same solution."""
 
 import functools
 
 import numpy as np
 import pytest
 
+from ngdual.forms import assemble
 from ngdual.friction import build_friction_forms
+from ngdual.mesh import build_mesh
 from ngdual.scene import load_scene
 from ngdual.solve import solve_scene
-from ngdual.solvers.nested import box_projection, box_projection_qp
+from ngdual.solvers.nested import box_projection, box_projection_qp, nested_uzawa
+from ngdual.solvers.projections import NonnegativeProjection, metric_matrix
+from ngdual.solvers.uzawa import uzawa
 
 
 def test_box_projection_qp_equals_closed_form():
@@ -65,3 +70,53 @@ def test_coulomb_bound_is_mu_times_the_normal_stress():
     forms = build_friction_forms(sol.problem)
     F = forms.coulomb_bound(sol.x, scene.friction.mu)
     np.testing.assert_allclose(F, sol.friction_bound, rtol=1e-5, atol=1e-8 * F.max())
+
+
+@functools.cache
+def _coulomb_problem(level=2):
+    return assemble(load_scene("thesis-3.46-coulomb"), build_mesh(load_scene(
+        "thesis-3.46-coulomb").geometry, level))
+
+
+def _nested(**options):
+    params = {"mu_f": 0.5, "eps1": 1e-11, "eps2": 1e-10, **options}
+    return nested_uzawa(_coulomb_problem(), "coulomb", **params)
+
+
+@pytest.mark.parametrize("variant", [{"loop_order": "contact-outer"},
+                                     {"friction_metric": "mass"}, {"rho2": 0.5},
+                                     {"metric": "euclidean"}])
+def test_loop_orders_metrics_and_steps_reach_the_same_solution(variant):
+    base, other = _nested(), _nested(**variant)
+    assert base.converged and other.converged
+    assert np.linalg.norm(other.x - base.x) <= 1e-7 * np.linalg.norm(base.x)
+
+
+def test_condensed_iteration_repeats_the_sparse_solves_exactly():
+    """Same iterates, so the same iteration counts and the same solution."""
+    condensed, full = _nested(), _nested(condensed=False)
+    assert condensed.iterations == full.iterations
+    assert np.linalg.norm(condensed.x - full.x) <= 1e-10 * np.linalg.norm(full.x)
+
+
+def test_frictionless_uzawa_condensed_equals_sparse():
+    problem = assemble(load_scene("thesis-3.46-frictionless"),
+                       build_mesh(load_scene("thesis-3.46-frictionless").geometry, 3))
+    a, b = uzawa(problem, eps=1e-10), uzawa(problem, eps=1e-10, condensed=True)
+    assert a.iterations == b.iterations and a.history == pytest.approx(b.history, rel=1e-6)
+    assert np.linalg.norm(a.x - b.x) <= 1e-10 * np.linalg.norm(a.x)
+
+
+def test_projection_by_nnls_equals_the_cvxpy_qp():
+    problem = _coulomb_problem()
+    W = metric_matrix(problem.spaces.contact, 1.0, "h12")
+    rng = np.random.default_rng(1)
+    nnls, qp = NonnegativeProjection(W), NonnegativeProjection(W, solver="cvxpy")
+    active = 0
+    for _ in range(10):
+        c = rng.normal(size=W.shape[0])
+        chi = nnls(c)
+        assert chi.min() >= 0
+        active += int((chi == 0).sum())
+        np.testing.assert_allclose(chi, qp(c), atol=1e-8 * np.abs(chi).max())
+    assert active > 0

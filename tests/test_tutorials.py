@@ -1,0 +1,229 @@
+"""Every tutorial runs top to bottom, headless and in quick mode, and its numbers are right.
+
+Each tutorial (``tutorials/NN_*.py``, jupytext percent format) is executed as a
+script in a fresh process with ``NGDUAL_QUICK=1`` and ``MPLBACKEND=Agg`` in a
+temporary folder, within two minutes. It writes the numbers it computed to
+``results.json``; the check registered for its number in ``CHECKS`` asserts the
+mathematics behind them (Table 3.1, a bounded inf-sup constant, locking of P1 but
+not of PEERS, Uzawa = QP, validation errors naming their field...). A new tutorial
+fails ``test_every_tutorial_has_a_check`` until it gets a check here.
+
+The notebooks written by ``ngdual tutorials --notebooks DIR`` are executed with
+``jupyter nbconvert --execute`` and must produce no error and the same numbers.
+The exercise solutions (``tutorials/solutions/``) run in quick mode as well.
+"""
+
+import json
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from ngdual.cli import main
+from ngdual.tutorials import (
+    Tutorial,
+    in_notebook,
+    list_tutorials,
+    quick_mode,
+    tutorials_dir,
+    write_notebooks,
+)
+
+TIME_LIMIT_S = 120
+TUTORIALS = list_tutorials()
+SOLUTIONS = list_tutorials(solutions=True)
+TABLE_3_1 = {1: (180, 64, 27), 2: (680, 256, 85), 3: (2640, 1024, 297), 4: (10400, 4096, 1105),
+             5: (41280, 16384, 4257)}
+
+
+def quick_env(out: Path) -> dict:
+    """The environment of a headless quick run: no display, Agg backend, output in ``out``."""
+    env = dict(os.environ, NGDUAL_QUICK="1", MPLBACKEND="Agg", NGDUAL_TUTORIAL_OUT=str(out))
+    env.pop("DISPLAY", None)
+    return env
+
+
+def run_script(item: Tutorial, tmp_path: Path) -> dict:
+    """Run one tutorial or solution as a script; return its results.json."""
+    out = tmp_path / "out"
+    result = subprocess.run([sys.executable, str(item.path)], cwd=tmp_path, env=quick_env(out),
+                            capture_output=True, text=True, timeout=TIME_LIMIT_S)
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    assert "Traceback" not in result.stderr, result.stderr[-3000:]
+    return json.loads((out / item.name / "results.json").read_text())
+
+
+# --- what each tutorial must have computed ---------------------------------------------------
+
+def check_peers_mixed_elasticity(r: dict) -> None:
+    """Table 3.1, a bounded inf-sup constant (zero without bubbles), locking of P1 only."""
+    for row in r["dofs"]:
+        assert (row["X"], row["M"], row["S"]) == TABLE_3_1[row["level"]]
+    betas = [row["peers"][0] for row in r["inf_sup"]]
+    assert 0.35 < min(betas) and max(betas) / min(betas) < 1.05, betas
+    for row in r["inf_sup"]:
+        assert max(row["rt0_only"][:2]) < 1e-6          # two spurious modes without bubbles
+    third = [row["rt0_only"][2] for row in r["inf_sup"]]
+    assert all(1.7 < a / b < 2.3 for a, b in zip(third, third[1:])), third   # decays like h
+    ratios = r["ratios"]
+    assert ratios["peers_sigma"] < 1.5 and ratios["peers_u"] < 1.5, ratios
+    assert ratios["p1_sigma"] > 2 and ratios["p1_u"] > 2, ratios
+    for nu in {row["nu"] for row in r["convergence"]}:
+        errors = [row["peers_sigma"] for row in r["convergence"] if row["nu"] == nu]
+        assert all(b < a for a, b in zip(errors, errors[1:])), errors
+
+
+def check_signorini_uzawa(r: dict) -> None:
+    """P+ as a QP, iteration counts vs rho and metric, Uzawa = independent QP."""
+    p = r["projection"]
+    assert p["cvxpy_vs_ngdual"] < 1e-6 and p["kkt_complementarity"] < 1e-10, p
+    assert p["kkt_gradient_min"] > -1e-10 and p["clipping_differs_by"] > 1e-3, p
+    assert all(all(runs.values()) for runs in r["converged"].values())
+    assert not r["overshoot"]["converged"]
+    for counts in r["iterations"].values():               # small rho: contraction ~ 1 - c rho
+        assert 1.7 < counts["0.25"] / counts["0.5"] < 2.3, counts
+    h12, euclidean = (r["iterations_per_level"][m] for m in ("h12", "euclidean"))
+    assert h12[-1] <= h12[0] + 2, h12                     # mesh independent (Remark 3.40)
+    assert euclidean[-1] > euclidean[-2] and euclidean[-1] > h12[-1], (euclidean, h12)
+    a = r["agreement"]
+    assert a["sigma"] < 1e-8 and a["lam_n"] < 1e-8, a
+    assert a["nodes_in_contact"][0] == a["nodes_in_contact"][1] > 0, a
+    assert r["residuals"]["sigma_n_positive"] < 1e-8 and r["residuals"]["lambda_n_negative"] == 0
+
+
+def check_your_own_scene(r: dict) -> None:
+    """Each mistake caught with the right field, CLI exit codes, a convergent contact solve."""
+    assert r["caught"] == r["expected_fields"]
+    assert r["cli_bad_input_status"] == 2 and not r["cli_bad_input_wrote"]
+    assert r["cli_status"] == 0
+    levels = r["levels"]
+    for row in levels:
+        assert row["converged"] and row["nodes_in_contact"] >= 1, row
+        assert row["sigma_n_positive"] < 1e-7, row
+    dims = [row["dofs"]["X"] for row in levels]
+    assert all(3.5 < b / a < 4.5 for a, b in zip(dims, dims[1:])), dims
+
+
+CHECKS = {1: check_peers_mixed_elasticity, 2: check_signorini_uzawa, 6: check_your_own_scene}
+
+
+def check_solutions(number: int, r: dict) -> None:
+    if number == 1:
+        assert 1.8 < r["growth_of_largest"]["l2"] < 2.2          # ~1/h in L2
+        assert abs(r["growth_of_largest"]["hdiv"] - 1) < 0.05    # bounded in H(div)
+        assert r["primal_ratios"]["P1"] > r["primal_ratios"]["P2"] > 2
+    elif number == 2:
+        assert all(uzawa == qp for uzawa, qp in r["gaps"].values()), r["gaps"]
+        assert r["mass_metric_iterations"][-1] > r["mass_metric_iterations"][0]
+        assert all(abs(hand - ngdual) <= 1 for hand, ngdual in r["hand_vs_ngdual"])
+    elif number == 6:
+        assert r["touching"]["0.95"] == 0 and r["touching"]["1.05"] >= 1, r["touching"]
+        assert sorted(r["arch_errors"].values()) == ["boundary", "geometry.points"]
+        assert r["arch_contact"] >= 1
+
+
+# --- the tests ---------------------------------------------------------------------------------
+
+def test_tutorials_are_found_and_numbered():
+    numbers = [t.number for t in TUTORIALS]
+    assert {1, 2, 6} <= set(numbers) and numbers == sorted(set(numbers))
+
+
+def test_every_tutorial_has_a_check_and_solutions():
+    assert {t.number for t in TUTORIALS} == set(CHECKS)
+    assert {s.number for s in SOLUTIONS} == set(CHECKS)
+
+
+@pytest.mark.parametrize("tutorial", TUTORIALS, ids=lambda t: t.name)
+def test_tutorial_opens_with_header_and_ends_with_exercises(tutorial):
+    """STYLE.md: problem, discretisation, learning goals, references; 2-3 exercises at the end."""
+    text = tutorial.path.read_text(encoding="utf-8")
+    header = text.split("# %%\n", 1)[0]
+    for words in ("**Problem.**", "**Discretisation.**", "**What you will learn.**",
+                  "**References.**"):
+        assert words in header, words
+    exercises = text.rsplit("## Exercises", 1)[1]
+    assert 2 <= len(re.findall(r"^# \d\. ", exercises, flags=re.M)) <= 3
+    assert f"solutions/{tutorial.name}_solutions.py" in exercises
+    assert "input(" not in text
+
+
+@pytest.mark.parametrize("tutorial", TUTORIALS, ids=lambda t: t.name)
+def test_tutorial_runs_headless_in_quick_mode(tutorial, tmp_path):
+    results = run_script(tutorial, tmp_path)
+    assert results["quick"] is True
+    CHECKS[tutorial.number](results)
+    pictures = list((tmp_path / "out" / tutorial.name).glob("*.png"))
+    assert pictures and all(p.stat().st_size > 0 for p in pictures)
+
+
+@pytest.mark.parametrize("solution", SOLUTIONS, ids=lambda t: t.name)
+def test_solutions_run_in_quick_mode(solution, tmp_path):
+    check_solutions(solution.number, run_script(solution, tmp_path))
+
+
+def test_notebooks_execute_cleanly_with_nbconvert(tmp_path):
+    """`ngdual tutorials --notebooks DIR`, then `jupyter nbconvert --execute` on every notebook."""
+    import nbformat
+
+    folder = tmp_path / "notebooks"
+    assert main(["tutorials", "--notebooks", str(folder)]) == 0
+    notebooks = sorted(folder.glob("*.ipynb"))
+    assert [p.stem for p in notebooks] == [t.name for t in TUTORIALS]
+    out = tmp_path / "out"
+    command = [sys.executable, "-m", "jupyter", "nbconvert", "--to", "notebook", "--execute",
+               "--ExecutePreprocessor.kernel_name=python3",
+               f"--ExecutePreprocessor.startup_timeout={TIME_LIMIT_S}",
+               f"--ExecutePreprocessor.timeout={TIME_LIMIT_S}",
+               "--output-dir", str(tmp_path / "executed"), *map(str, notebooks)]
+    result = subprocess.run(command, cwd=folder, env=quick_env(out), capture_output=True,
+                            text=True, timeout=TIME_LIMIT_S * len(notebooks))
+    assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-6000:]
+    for tutorial in TUTORIALS:
+        executed = nbformat.read(tmp_path / "executed" / f"{tutorial.name}.ipynb", as_version=4)
+        outputs = [o for cell in executed.cells for o in cell.get("outputs", [])]
+        assert not [o for o in outputs if o["output_type"] == "error"], tutorial.name
+        assert any("image/png" in o.get("data", {}) for o in outputs), tutorial.name
+        CHECKS[tutorial.number](json.loads((out / tutorial.name / "results.json").read_text()))
+
+
+def test_solution_notebooks_are_written_on_request(tmp_path, capsys):
+    assert main(["tutorials", "--notebooks", str(tmp_path), "--solutions"]) == 0
+    assert len(list((tmp_path / "solutions").glob("*.ipynb"))) == len(SOLUTIONS)
+    assert "wrote" in capsys.readouterr().out
+
+
+def test_notebook_cells_follow_the_percent_markers(tmp_path):
+    import nbformat
+
+    path = write_notebooks(tmp_path)[0]
+    notebook = nbformat.read(path, as_version=4)
+    kinds = [cell.cell_type for cell in notebook.cells]
+    assert kinds[0] == "markdown" and "code" in kinds
+    assert notebook.metadata["kernelspec"]["name"] == "python3"
+
+
+def test_cli_lists_the_tutorials(capsys):
+    assert main(["tutorials"]) == 0
+    out = capsys.readouterr().out
+    for tutorial in TUTORIALS:
+        assert tutorial.title in out
+
+
+def test_missing_tutorials_folder_is_a_clear_error(tmp_path, capsys):
+    assert main(["tutorials", "--source", str(tmp_path / "nowhere")]) == 2
+    assert "no tutorials folder" in capsys.readouterr().err
+
+
+def test_quick_mode_and_source_folder_come_from_the_environment(monkeypatch, tmp_path):
+    monkeypatch.delenv("NGDUAL_QUICK", raising=False)
+    assert not quick_mode()
+    for value, expected in (("1", True), ("yes", True), ("0", False), ("", False)):
+        monkeypatch.setenv("NGDUAL_QUICK", value)
+        assert quick_mode() is expected
+    monkeypatch.setenv("NGDUAL_TUTORIALS_DIR", str(tmp_path))
+    assert tutorials_dir() == tmp_path
+    assert not in_notebook()
