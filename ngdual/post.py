@@ -168,17 +168,25 @@ def contact_summary(solution: Solution) -> dict:
     """Nodes in contact (lambda_n = 0 on the h~ mesh), stick/slip among them, and F_abs.
 
     F_abs = int_{A_C} |sigma_n| + |sigma_t| ds over the active part A_C: the
-    h~ edges with a node in contact.
+    h~ edges with a node in contact. Stick / slip as in :func:`friction_diagnostics`
+    (all contact nodes count as slip without friction); with friction also the
+    largest hat-weighted ratio |sigma_t| / |sigma_n| over the contact nodes.
     """
     if solution.problem.spaces.contact is None:
         return {"nodes_in_contact": 0, "stick_nodes": 0, "slip_nodes": 0, "F_abs": 0.0}
     tr = contact_traces(solution)
-    lam_t = tr.coarse_lam_t
-    scale = max(float(np.max(np.abs(lam_t), initial=0.0)), 1e-300)
-    stick = tr.coarse_in_contact & (np.abs(lam_t) <= CONTACT_TOL * scale)
     f_abs = np.sum(tr.edge_length * (np.abs(tr.sigma_n) + np.abs(tr.sigma_t)) * tr.edge_active)
-    return {"nodes_in_contact": int(tr.coarse_in_contact.sum()), "stick_nodes": int(stick.sum()),
-            "slip_nodes": int((tr.coarse_in_contact & ~stick).sum()), "F_abs": float(f_abs)}
+    summary = {"nodes_in_contact": int(tr.coarse_in_contact.sum()), "stick_nodes": 0,
+               "slip_nodes": int(tr.coarse_in_contact.sum()), "F_abs": float(f_abs)}
+    if solution.nu is not None:
+        diag = friction_diagnostics(solution)
+        summary.update(stick_nodes=int(np.sum(diag.node_status == "stick")),
+                       slip_nodes=int(np.sum(diag.node_status == "slip")),
+                       stick_edges=int(np.sum(diag.edge_status == "stick")),
+                       slip_edges=int(np.sum(diag.edge_status == "slip")),
+                       max_traction_ratio=float(np.max(diag.traction_ratio[
+                           diag.node_status != "separation"], initial=0.0)))
+    return summary
 
 
 def versions() -> dict:
@@ -265,3 +273,56 @@ def total_error(norms_h: dict, reference: dict) -> tuple[dict, float]:
     errors = {q: float(np.sqrt(abs(norms_h[q] ** 2 - reference[q] ** 2)))
               for q in norms_h if norms_h[q] is not None and reference.get(q) is not None}
     return errors, float(np.sqrt(sum(e * e for e in errors.values())))
+
+
+@dataclass
+class FrictionDiagnostics:
+    """Contact / separation and stick / slip on Gamma_C, as arrays for tables and plots.
+
+    Per h~ node (interior, ``node_xy``): lambda_n, lambda_t, the hat moments
+    ``t_n`` = int sigma_n mu_i and ``t_t`` = int sigma_t mu_i, their ratio
+    ``traction_ratio`` = |t_t| / |t_n| (the hat-weighted |sigma_t| / |sigma_n|, at most
+    about mu_f on the active set) and ``node_status``: "separation" (lambda_n > 0),
+    "stick" (every h^ edge under the hat has |nu| < 1) or "slip".
+    Per h^ edge (``edge_xy`` midpoints): nu, ``sign_lam_t`` = sign(Q_F lambda_t),
+    ``F`` (mean over the edge) and ``edge_status``: "free" (F = 0), "stick"
+    (|nu| < 1) or "slip" (|nu| = 1, nu = sign lambda_t).
+    """
+
+    node_xy: np.ndarray
+    lam_n: np.ndarray
+    lam_t: np.ndarray
+    t_n: np.ndarray
+    t_t: np.ndarray
+    traction_ratio: np.ndarray
+    node_status: np.ndarray
+    edge_xy: np.ndarray
+    nu: np.ndarray
+    sign_lam_t: np.ndarray
+    F: np.ndarray
+    edge_status: np.ndarray
+
+
+def friction_diagnostics(solution: Solution, slip_tol: float = 1e-6) -> FrictionDiagnostics:
+    """Stick / slip / separation of a frictional ``solution`` (see :class:`FrictionDiagnostics`)."""
+    from .friction import build_friction_forms
+
+    pb = solution.problem
+    forms = build_friction_forms(pb)
+    sigma = solution.x[pb.sigma]
+    t_n = pb.block(pb.sigma, pb.lam_n).T @ sigma
+    t_t = pb.block(pb.sigma, pb.index("lam_t")).T @ sigma
+    lam_n, lam_t = solution.part("lam_n"), solution.part("lam_t")
+    F_hat = forms.per_hat_edge(solution.friction_bound)
+    Q = forms.q_matrix(solution.friction_bound)
+    nu = solution.nu
+    edge_status = np.where(F_hat <= 0, "free", np.where(np.abs(nu) >= 1 - slip_tol, "slip",
+                                                         "stick"))
+    slips = (Q.T.tocsr() != 0).astype(float) @ (edge_status == "slip")
+    node_status = np.where(_in_contact(lam_n), np.where(slips > 0, "slip", "stick"),
+                           "separation")
+    ratio = np.abs(t_t) / np.maximum(np.abs(t_n), np.finfo(float).tiny)
+    hat_mid = np.array([forms.midpoints[forms.edge_of == j].mean(axis=0)
+                        for j in range(forms.n_nu)])
+    return FrictionDiagnostics(pb.spaces.contact.node_points(), lam_n, lam_t, t_n, t_t, ratio,
+                               node_status, hat_mid, nu, np.sign(Q @ lam_t), F_hat, edge_status)

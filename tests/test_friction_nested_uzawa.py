@@ -6,6 +6,7 @@ import functools
 import numpy as np
 import pytest
 
+from ngdual import post
 from ngdual.forms import assemble
 from ngdual.friction import build_friction_forms
 from ngdual.mesh import build_mesh
@@ -120,3 +121,15 @@ def test_projection_by_nnls_equals_the_cvxpy_qp():
         active += int((chi == 0).sum())
         np.testing.assert_allclose(chi, qp(c), atol=1e-8 * np.abs(chi).max())
     assert active > 0
+
+
+def test_stick_slip_diagnostics_are_consistent(solved):
+    _, sol = solved
+    diag = post.friction_diagnostics(sol)
+    assert set(diag.edge_status) <= {"free", "stick", "slip"}
+    assert np.all(np.abs(diag.nu[diag.edge_status == "slip"]) >= 1 - 1e-6)
+    assert np.all(np.abs(diag.nu[diag.edge_status == "stick"]) < 1)
+    separated = diag.node_status == "separation"
+    assert np.all(diag.lam_n[separated] > 0) and np.all(diag.lam_n[~separated] >= 0)
+    summary = post.contact_summary(sol)
+    assert summary["stick_nodes"] + summary["slip_nodes"] == summary["nodes_in_contact"] > 0
