@@ -150,8 +150,7 @@ def _stagnation_message(problem: DiscreteProblem, outer: int, law: str, what: st
     if law == "coulomb":
         remedies.append("a smaller friction.mu (the Coulomb fixed point F = mu |sigma_n| "
                         "need not contract for large mu)")
-    return (f"nested Uzawa {what} (outer step {outer}, solver.max_iter); try "
-            + ", or ".join(remedies))
+    return f"nested Uzawa {what} (outer step {outer}); try " + ", or ".join(remedies)
 
 
 def nested_uzawa(problem: DiscreteProblem, law: str, mu_f: float = 0.0, rho1: float = 1.0,
@@ -271,8 +270,9 @@ def nested_uzawa(problem: DiscreteProblem, law: str, mu_f: float = 0.0, rho1: fl
                                    f"residual did not halve in {STAGNATION_WINDOW} outer steps"),
                                    history)
     else:
-        raise ConvergenceError(_stagnation_message(problem, outer, law, "did not converge"),
-                               history)
+        raise ConvergenceError(_stagnation_message(
+            problem, outer, law, f"did not converge in solver.max_iter = {max_iter} steps"),
+            history)
     # one last inner solve so that (sigma, lambda) match the final nu and F exactly
     state, inner, _, inner_ok = loop.run(lam, rho1, eps1, max_iter, tau=friction.load(nu))
     inner_total += inner
@@ -287,6 +287,7 @@ def nested_uzawa(problem: DiscreteProblem, law: str, mu_f: float = 0.0, rho1: fl
                     history=history,
                     timings={"assemble": problem.assemble_seconds,
                              "factorize": loop.fact.seconds,
+                             "condense": loop.condense_seconds,
                              "solve": time.perf_counter() - start,
                              "total_solver": time.perf_counter() - start_all},
                     nu=nu, friction_bound=F,

@@ -122,8 +122,10 @@ class ContactLoop:
         self.outputs = sp.vstack([C_pad.T, self.E_t.T, extra]).tocsr()
         self.inputs = sp.hstack([-C_pad, self.E_t]).tocsc()
         self.r0 = np.concatenate([self.g, self.b0])
+        start = time.perf_counter()
         self.response = (CondensedResponse(self.fact, self.r0, self.inputs, self.outputs)
                          if condensed else None)
+        self.condense_seconds = time.perf_counter() - start
         self._split = np.cumsum([n_c, n_t])
 
     def respond(self, lam: np.ndarray, tau: np.ndarray) -> LoopState:
@@ -222,4 +224,5 @@ def uzawa(problem: DiscreteProblem, rho: float = 1.0, eps: float = 1e-8, max_ite
                     history=history,
                     timings={"assemble": problem.assemble_seconds,
                              "factorize": loop.fact.seconds,
+                             "condense": loop.condense_seconds,
                              "solve": time.perf_counter() - start})
