@@ -105,8 +105,11 @@ class ContactTraces:
     coarse_in_contact: np.ndarray
 
 
-def _in_contact(lam_n: np.ndarray) -> np.ndarray:
-    scale = max(float(np.max(np.abs(lam_n), initial=0.0)), 1e-300)
+def _in_contact(lam_n: np.ndarray, lam_t: np.ndarray) -> np.ndarray:
+    """lambda_n = 0 relative to the displacement scale on Gamma_C (not max lambda_n alone,
+    which is round-off itself when every node touches)."""
+    scale = max(float(np.max(np.abs(lam_n), initial=0.0)),
+                float(np.max(np.abs(lam_t), initial=0.0)), 1e-300)
     return lam_n <= CONTACT_TOL * scale
 
 
@@ -117,7 +120,7 @@ def contact_traces(solution: Solution) -> ContactTraces:
     f = fields(solution)
     sigma = f.sigma
     lam_n_c, lam_t_c = solution.part("lam_n"), solution.part("lam_t")
-    in_contact = _in_contact(lam_n_c)
+    in_contact = _in_contact(lam_n_c, lam_t_c)
     gap = Expression(pb.scene.contact.gap)
     # fine nodal values of the coarse P1 multipliers
     p = pb.spaces.prolongations["lam_n"]
@@ -323,7 +326,7 @@ def friction_diagnostics(solution: Solution, slip_tol: float = 1e-6) -> Friction
     edge_status = np.where(F_hat <= 0, "free", np.where(np.abs(nu) >= 1 - slip_tol, "slip",
                                                          "stick"))
     slips = (Q.T.tocsr() != 0).astype(float) @ (edge_status == "slip")
-    node_status = np.where(_in_contact(lam_n), np.where(slips > 0, "slip", "stick"),
+    node_status = np.where(_in_contact(lam_n, lam_t), np.where(slips > 0, "slip", "stick"),
                            "separation")
     ratio = np.abs(t_t) / np.maximum(np.abs(t_n), np.finfo(float).tiny)
     hat_mid = np.array([forms.midpoints[forms.edge_of == j].mean(axis=0)

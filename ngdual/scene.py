@@ -337,9 +337,9 @@ def _validate_boundary(scene: Scene) -> None:
             for role in _ROLES}
     touch = ends["neumann"] & ends["contact"]
     if touch:
-        raise SceneError("boundary", "Gamma_N touches Gamma_C at "
-                                     f"{sorted(touch)[0]}; separate them by a Dirichlet side "
-                                     "(the formulation assumes they do not touch)")
+        point = tuple(float(c) for c in sorted(touch)[0])
+        raise SceneError("boundary", f"Gamma_N touches Gamma_C at {point}; separate them by a "
+                                     "Dirichlet side (the formulation assumes they do not touch)")
 
 
 def _contact_points(scene: Scene, per_side: int = 401) -> tuple[np.ndarray, np.ndarray]:

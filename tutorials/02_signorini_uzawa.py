@@ -1,0 +1,265 @@
+# %% [markdown]
+# # Tutorial 2: Signorini contact and the Uzawa algorithm
+#
+# **Problem.** Example 3.46 of the thesis without friction: the block [−4,4]×[−1,1] is
+# clamped at its ends, pressed down by a parabolic traction on top and may touch a
+# rigid foundation at distance g = 0.01 below Γ_C (the bottom). In the dual-dual form
+# the contact conditions become a sign condition on the multiplier λ_n = g − u_n
+# (the remaining gap): find σ and (u, η, φ, λ_t) and λ_n ∈ C⁺_h̃ with (eq. (3.103))
+#
+#     A σ + B (u, η, φ, λ_t) + C_n λ_n = g,      Bᵀ σ = b,
+#     λ_n ≥ 0,   C_nᵀ σ ≤ 0,   λ_nᵀ C_nᵀ σ = 0          (gap ≥ 0, σ_n ≤ 0, complementarity)
+#
+# **Discretisation.** PEERS for (σ, u, η), P1 multipliers φ on Γ_N and λ_t, λ_n on Γ_C on
+# the coarser boundary mesh h̃ = 2h (eq. (3.61)).
+#
+# **What you will learn.**
+# 1. Algorithm 3.38 (Uzawa): one linear saddle-point solve with a fixed matrix per step,
+#    then a projection of λ_n onto the cone λ_n ≥ 0.
+# 2. The projection P⁺ as a small convex quadratic program posed in cvxpy, and why its
+#    metric W matters (Remark 3.40): P⁺ is *not* componentwise clipping.
+# 3. How the step length ρ and the metric (`"h12"` vs `"euclidean"`) change the number
+#    of iterations, on one mesh and under refinement.
+# 4. How to check the result against an independent solver (one convex QP, `solve_qp`).
+#
+# **References.** M. Andres (2011), Section 3.3: eqs. (3.98)-(3.107), Algorithm 3.38,
+# Theorem 3.39, Remark 3.40, Example 3.46, Table 3.5. M. Maischak, *FEM/BEM methods for
+# Signorini-type problems* (Habilitation, Hannover 2004), Section 5.3.
+
+# %%
+import cvxpy as cp
+import matplotlib.pyplot as plt
+import numpy as np
+
+from ngdual import peers, plot, post
+from ngdual.forms import assemble
+from ngdual.mesh import build_mesh
+from ngdual.scene import load_scene
+from ngdual.solvers.projections import NonnegativeProjection, metric_matrix
+from ngdual.solvers.reference import solve_qp
+from ngdual.solvers.uzawa import solve_linear, uzawa
+from ngdual.tutorials import draw, output_dir, quick_mode, save_figure, save_results, show_file
+
+# %% [markdown]
+# ## Parameters
+
+# %%
+QUICK = quick_mode()
+LEVEL = 2 if QUICK else 4                                # mesh level of Example 3.46
+RHOS = [0.25, 0.5, 1.0, 1.5, 2.0]                        # step lengths of Algorithm 3.38
+TOO_LARGE_RHO = 3.0                                      # beyond the convergence range
+MAX_ITER = 500                                           # per run of the sweep
+METRICS = ["h12", "euclidean"]
+REFINEMENT_LEVELS = [1, 2, 3] if QUICK else [1, 2, 3, 4, 5]
+EPS = 1e-8                                               # stopping tolerance (step 5)
+EPS_COMPARE = 1e-10                                      # tighter, for the comparison with the QP
+OUT = output_dir("02_signorini_uzawa")
+print(f"quick mode: {QUICK}; level {LEVEL}; output in {OUT}")
+
+# %% [markdown]
+# ## 1. The algebraic problem
+#
+# `assemble` builds the matrix of (3.103) once. The unknown vector is ordered
+# [σ | u, η, φ, λ_t | λ_n]; `problem.sigma`, `problem.mult` and `problem.lam_n` index the
+# three groups, and `problem.block(rows, cols)` cuts out A, B and C_n.
+
+# %%
+scene = load_scene("thesis-3.46-frictionless")
+problem = assemble(scene, build_mesh(scene.geometry, LEVEL))
+A = problem.block(problem.sigma, problem.sigma)
+B = problem.block(problem.sigma, problem.mult)
+C_n = problem.block(problem.sigma, problem.lam_n)
+print(f"dofs per space (Table 3.1): {problem.spaces.dofs()}")
+print(f"A: {A.shape}, B: {B.shape}, C_n: {C_n.shape}")
+
+# %% [markdown]
+# ## 2. One Uzawa step by hand, and the projection P⁺ as a QP
+#
+# Algorithm 3.38 starts from λ_n⁰ = 0. Step 3 then solves the saddle-point system
+# without contact forces: the body falls through the foundation. `solve_linear` does
+# exactly this solve. The vector C_nᵀσ¹ tests σ_n with the coarse hat functions;
+# positive entries are where the contact condition is violated.
+
+# %%
+first = solve_linear(problem)
+traction = C_n.T @ first.part(*peers.STRESS)
+print(f"C_n^T sigma^1: {np.sum(traction > 0)} of {len(traction)} coarse nodes violate sigma_n <= 0")
+
+# %% [markdown]
+# Step 4 sets λ_n¹ = P⁺(λ_n⁰ + ρ Φ(σ¹)), where Φ represents d_{C,n}(·, σ) in the metric W
+# (3.105) and P⁺ is the W-orthogonal projection onto the cone (3.104). Remark 3.40 and
+# (3.106)-(3.107) turn this into the convex QP
+#
+#     λ_n¹ = argmin_{χ ≥ 0}  ½ χᵀ W χ − χᵀ c,      c = W λ_n⁰ + ρ C_nᵀ σ¹,
+#
+# so Φ never has to be computed. In cvxpy it is four lines. W is the discrete
+# H^{1/2}(Γ_C) metric `metric_matrix(..., "h12")`: dense, not diagonal.
+
+# %%
+rho = 1.0
+W = metric_matrix(problem.spaces.contact, scene.material.plane_strain_modulus, "h12")
+lam0 = np.zeros(len(problem.lam_n))
+c = W @ lam0 + rho * traction
+
+scale = np.max(np.abs(W))                 # O(1) numbers help the interior-point solver
+chi = cp.Variable(len(c))
+qp = cp.Problem(cp.Minimize(0.5 * cp.quad_form(chi, W / scale) - (c / scale) @ chi), [chi >= 0])
+qp.solve(solver=cp.CLARABEL, tol_gap_abs=1e-12, tol_gap_rel=1e-12, tol_feas=1e-12)
+lam1_cvxpy = np.maximum(chi.value, 0.0)
+
+lam1_ngdual = NonnegativeProjection(W)(c)            # the same QP, as used by `uzawa`
+clipped = np.maximum(np.linalg.solve(W, c), 0.0)     # componentwise clipping of W⁻¹c
+gradient = W @ lam1_ngdual - c                       # KKT: >= 0, and 0 where λ > 0
+projection_check = {
+    "cvxpy_vs_ngdual": float(np.linalg.norm(lam1_cvxpy - lam1_ngdual)
+                             / np.linalg.norm(lam1_ngdual)),
+    "kkt_gradient_min": float(gradient.min() / np.max(np.abs(c))),
+    "kkt_complementarity": float(abs(lam1_ngdual @ gradient)
+                                 / (np.linalg.norm(lam1_ngdual) * np.linalg.norm(c))),
+    "clipping_differs_by": float(np.linalg.norm(clipped - lam1_ngdual)
+                                 / np.linalg.norm(lam1_ngdual)),
+}
+for key, value in projection_check.items():
+    print(f"{key:22s} {value: .2e}")
+
+# %% [markdown]
+# cvxpy and ngdual agree (an interior-point solver stops at a tolerance, hence the tight
+# settings; ngdual also re-solves exactly on the active set it finds), and the KKT
+# conditions of the QP (Wλ − c ≥ 0, complementary to λ ≥ 0) hold. Clipping W⁻¹c at
+# zero gives a different vector: in a non-diagonal metric the projection couples the
+# nodes. For the diagonal `"euclidean"` metric W = (E*/2) I the QP has the closed form
+# max(0, c/w), which ngdual uses.
+#
+# ## 3. The step length ρ and the metric
+#
+# Theorem 3.39: the iteration converges for 0 < ρ < 2α (α the ellipticity constant of
+# ã). ngdual scales W with the plane-strain modulus E*, so ρ is dimensionless and
+# values around 1 work for any E. `uzawa` returns a `Solution` whose `history` holds the
+# relative increment of step 5 for every iteration.
+
+# %%
+runs = {}
+for metric in METRICS:
+    for rho in RHOS:
+        solution = uzawa(problem, rho=rho, eps=EPS, metric=metric, max_iter=MAX_ITER)
+        runs[(metric, rho)] = solution
+        print(f"metric {metric:9s} rho = {rho:4.2f}: {solution.iterations['outer']:4d} "
+              f"iterations, converged {solution.converged}")
+
+fig, axes = plt.subplots(1, 2, figsize=(11, 4), sharey=True)
+for ax, metric in zip(axes, METRICS):
+    for rho in RHOS:
+        history = runs[(metric, rho)].history
+        ax.semilogy(range(1, len(history) + 1), history, label=f"ρ = {rho}")
+    ax.set_title(f"metric {metric!r}, level {LEVEL}")
+    ax.set_xlabel("Uzawa iteration i")
+    ax.grid(True, which="both", alpha=0.3)
+axes[0].set_ylabel("relative increment (step 5)")
+axes[1].legend()
+save_figure(fig, OUT / "uzawa_histories.png")
+
+# %% [markdown]
+# For small ρ the contraction factor is about 1 − cρ, so halving ρ doubles the number of
+# iterations. Too large a step and the iteration no longer contracts: it oscillates (or
+# diverges, in which case `uzawa` raises `ConvergenceError`) and stops at `max_iter`
+# unconverged. ngdual reports that through `converged` instead of returning a wrong
+# answer. Where "too large" begins depends on the mesh: on level 4, ρ = 2 already stalls.
+
+# %%
+overshoot = uzawa(problem, rho=TOO_LARGE_RHO, eps=EPS, metric="h12", max_iter=200)
+print(f"rho = {TOO_LARGE_RHO}: converged {overshoot.converged} after "
+      f"{overshoot.iterations['outer']} iterations, last increment {overshoot.history[-1]:.1e}")
+
+# %% [markdown]
+# ## 4. Iterations under refinement (Remark 3.40)
+#
+# The convergence proof works in the H^{1/2}(Γ_C) inner product and carries over to any
+# metric W whose norm is *equivalent* to it; if the equivalence constants do not depend
+# on h, neither does the contraction factor. The `"h12"` metric (a discrete H^{1/2}_{00}
+# interpolation norm) is such a metric. The Euclidean one is not: its equivalence
+# constants degrade like 1/h, and the iteration count grows accordingly.
+
+# %%
+by_level = {metric: [] for metric in METRICS}
+for level in REFINEMENT_LEVELS:
+    refined = assemble(scene, build_mesh(scene.geometry, level))
+    for metric in METRICS:
+        by_level[metric].append(uzawa(refined, rho=1.0, eps=EPS, metric=metric)
+                                .iterations["outer"])
+    print(f"level {level}: iterations h12 {by_level['h12'][-1]:4d}, "
+          f"euclidean {by_level['euclidean'][-1]:4d}")
+
+fig, ax = plt.subplots(figsize=(6, 4))
+for metric in METRICS:
+    ax.plot(REFINEMENT_LEVELS, by_level[metric], "o-", label=f"metric {metric!r}")
+ax.set_xlabel("level (h halves per level)")
+ax.set_ylabel("Uzawa iterations, ρ = 1")
+ax.set_xticks(REFINEMENT_LEVELS)
+ax.grid(True, alpha=0.3)
+ax.legend()
+save_figure(fig, OUT / "iterations_per_level.png")
+
+# %% [markdown]
+# ## 5. An independent check: the whole problem as one QP
+#
+# (3.103) is the KKT system of min ½σᵀAσ − gᵀσ subject to Bᵀσ = b and C_nᵀσ ≤ 0, with
+# λ_n the multiplier of the inequality. `solve_qp` hands this QP to Clarabel through
+# cvxpy and shares nothing with the Uzawa loop but the matrices. Both must agree.
+
+# %%
+tight = uzawa(problem, rho=1.0, eps=EPS_COMPARE, metric="h12")
+reference = solve_qp(problem)
+
+
+def relative_difference(a, b):
+    return float(np.linalg.norm(a - b) / np.linalg.norm(b))
+
+
+agreement = {
+    "sigma": relative_difference(tight.part(*peers.STRESS), reference.part(*peers.STRESS)),
+    "lam_n": relative_difference(tight.part("lam_n"), reference.part("lam_n")),
+    "nodes_in_contact": [post.contact_summary(s)["nodes_in_contact"] for s in (tight, reference)],
+}
+print(f"Uzawa vs QP: sigma {agreement['sigma']:.1e}, lambda_n {agreement['lam_n']:.1e}, "
+      f"nodes in contact {agreement['nodes_in_contact']}")
+print("contact residuals of the Uzawa solution:",
+      {k: f"{v:.1e}" for k, v in tight.residuals.items()})
+
+# %% [markdown]
+# The traces on Γ_C: σ_n ≤ 0 everywhere, and λ_n − g = −u_n reaches −g (gap closed,
+# λ_n = 0) exactly where σ_n < 0.
+
+# %%
+show_file(plot.plot_contact_traces(post.contact_traces(tight), OUT / "contact_traces.png",
+                                   f"Example 3.46 without friction, level {LEVEL}"))
+mesh = problem.fes.mesh
+draw(post.von_mises(post.fields(tight).sigma, scene.material.nu), mesh, "von_mises")
+
+# %%
+results = {
+    "quick": QUICK, "level": LEVEL,
+    "projection": projection_check,
+    "iterations": {metric: {str(rho): runs[(metric, rho)].iterations["outer"] for rho in RHOS}
+                   for metric in METRICS},
+    "converged": {metric: {str(rho): runs[(metric, rho)].converged for rho in RHOS}
+                  for metric in METRICS},
+    "overshoot": {"rho": TOO_LARGE_RHO, "converged": overshoot.converged},
+    "iterations_per_level": {"levels": REFINEMENT_LEVELS, **by_level},
+    "agreement": agreement,
+    "residuals": tight.residuals,
+}
+print(f"wrote {save_results('02_signorini_uzawa', results)}")
+
+# %% [markdown]
+# ## Exercises
+# Solutions: `tutorials/solutions/02_signorini_uzawa_solutions.py`.
+#
+# 1. **Optimal ρ.** For levels 1-4 and both metrics find the ρ ∈ [0.25, 2.5] with the
+#    fewest iterations (compare Table 3.5 of the thesis). How does ρ_opt move with h?
+# 2. **An L² metric.** Pose P⁺ in the mass-matrix metric W = (E*/2) M / h̃ (scaled so
+#    that it has the units of the others) and run the Uzawa loop with it. Is the mass
+#    matrix H^{1/2}-equivalent? What do the iteration counts do under refinement?
+# 3. **Other gaps.** Solve with g = |x₁| and with g = 0.005 + 0.002 x₁²
+#    (`load_scene(..., ["contact.gap='abs(x)'"])`) on level 3 and compare the number of
+#    nodes in contact of the Uzawa and the QP solution. Why does the body not touch the
+#    foundation g = |x₁| at all on level 2?

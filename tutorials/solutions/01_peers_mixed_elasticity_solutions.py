@@ -1,0 +1,179 @@
+# %% [markdown]
+# # Solutions to Tutorial 1: Mixed elasticity with PEERS
+#
+# Each exercise is one section; all run in seconds with `NGDUAL_QUICK=1`.
+
+# %%
+import ngsolve as ngs
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from ngdual import peers
+from ngdual.expr import Expression
+from ngdual.forms import Spaces, assemble
+from ngdual.mesh import build_mesh, polygon_mesh
+from ngdual.scene import Material, load_scene
+from ngdual.tutorials import output_dir, quick_mode, save_results
+
+QUICK = quick_mode()
+LEVELS = [1, 2] if QUICK else [1, 2, 3, 4]
+OUT = output_dir("01_peers_mixed_elasticity_solutions")
+
+# %% [markdown]
+# ## Exercise 1: the inf-sup constant in the L² norm
+#
+# Brezzi's theory needs b to be *continuous* and inf-sup stable in the same pair of
+# norms, both uniformly in h. We compute the smallest and the largest singular value
+# of B in both norms. The smallest barely changes (it is decided by smooth modes, for
+# which ‖div τ‖ ~ ‖τ‖). The largest is bounded in H(div) but grows like 1/h in L²:
+# a rough τ with ‖τ‖ = 1 has ‖div τ‖ ~ 1/h. In the L² norm b is not uniformly
+# continuous, so no h-independent error estimate can come out of it; in ‖·‖_X both
+# constants are h-independent, which is what Lemma 3.28 and Theorem 3.34 use.
+
+# %%
+clamped = load_scene("thesis-3.46-frictionless",
+                     ["boundary.dirichlet=['left', 'right', 'bottom', 'top']",
+                      "boundary.neumann=[]", "boundary.contact=[]"])
+
+
+def to_scipy(matrix) -> sp.csr_matrix:
+    rows, cols, vals = matrix.COO()
+    return sp.csr_matrix((np.asarray(vals), (np.asarray(rows), np.asarray(cols))),
+                         shape=(matrix.height, matrix.width))
+
+
+def gram_matrix(problem, with_div: bool) -> sp.csr_matrix:
+    trial = dict(zip(problem.names, problem.fes.TrialFunction()))
+    test = dict(zip(problem.names, problem.fes.TestFunction()))
+
+    def parts(f):
+        return (peers.stress(f["r1"], f["r2"], f["b1"], f["b2"]),
+                peers.stress_divergence(f["r1"], f["r2"]), ngs.CF((f["u1"], f["u2"])), f["eta"])
+
+    sigma, div_sigma, u, eta = parts(trial)
+    tau, div_tau, v, xi = parts(test)
+    integrand = ngs.InnerProduct(sigma, tau) + u * v + eta * xi
+    if with_div:
+        integrand = integrand + div_sigma * div_tau
+    form = ngs.BilinearForm(problem.fes)
+    form += integrand * ngs.dx
+    form.Assemble()
+    return to_scipy(form.mat)
+
+
+def extreme_singular_values(X, B, Y, shift=-1e-6) -> tuple[float, float]:
+    """Smallest and largest singular value of B from the X-norm to the Y-norm."""
+    n, m = B.shape
+    saddle = spla.splu(sp.bmat([[X, B], [B.T, shift * Y]], format="csc"))
+    x_lu = spla.splu(X.tocsc())
+    schur = spla.LinearOperator((m, m), matvec=lambda y: B.T @ x_lu.solve(B @ y))
+    inverse = spla.LinearOperator((m, m),
+                                  matvec=lambda r: saddle.solve(np.r_[np.zeros(n), -r])[n:])
+    smallest = spla.eigsh(schur, k=1, M=Y, sigma=shift, OPinv=inverse,
+                          return_eigenvectors=False).min()
+    largest = spla.eigsh(schur, k=1, M=Y.tocsc(), which="LA", return_eigenvectors=False).max()
+    return float(np.sqrt(max(smallest, 0.0))), float(np.sqrt(largest))
+
+
+singular = {"hdiv": [], "l2": []}
+for level in LEVELS:
+    problem = assemble(clamped, build_mesh(clamped.geometry, level))
+    s, m = problem.sigma, problem.mult
+    B = problem.block(s, m)
+    for key, with_div in (("hdiv", True), ("l2", False)):
+        G = gram_matrix(problem, with_div)
+        singular[key].append(extreme_singular_values(G[s][:, s], B, G[m][:, m]))
+    print(f"level {level}: (smallest, largest) in H(div) "
+          f"({singular['hdiv'][-1][0]:.3f}, {singular['hdiv'][-1][1]:.3f}),  in L2 "
+          f"({singular['l2'][-1][0]:.3f}, {singular['l2'][-1][1]:.3f})")
+growth = {key: values[-1][1] / values[0][1] for key, values in singular.items()}
+print(f"largest singular value grew by {growth['l2']:.2f} (L2) and {growth['hdiv']:.2f} "
+      f"(H(div)) over {len(LEVELS) - 1} halvings of h")
+
+# %% [markdown]
+# ## Exercise 2: P2 on the same meshes
+#
+# We reuse the manufactured divergence-free solution of the tutorial. P2 is much better
+# than P1, but on general triangulations it is still not robust in λ: the error ratio
+# between ν = 0.4999 and ν = 0.3 exceeds one noticeably (locking-free conforming
+# Lagrange elements need degree ≥ 4 with special meshes, Scott-Vogelius).
+
+# %%
+P = {"p": "(T**2*(1 - T)**2)", "dp": "(2*T - 6*T**2 + 4*T**3)",
+     "d2p": "(2 - 12*T + 12*T**2)", "d3p": "(24*T - 12)"}
+
+
+def term(first: str, second: str) -> str:
+    return P[first].replace("T", "x") + "*" + P[second].replace("T", "y")
+
+
+def cf(formula: str):
+    return Expression(formula).coefficient()
+
+
+mu = 1.0
+shear = f"{mu}*({term('p', 'd2p')} - {term('d2p', 'p')})"
+sigma_exact = ngs.CF((cf(f"{2 * mu}*{term('dp', 'dp')}"), cf(shear), cf(shear),
+                      cf(f"-{2 * mu}*{term('dp', 'dp')}")), dims=(2, 2))
+force = ngs.CF((cf(f"-{mu}*({term('d2p', 'dp')} + {term('p', 'd3p')})"),
+                cf(f"{mu}*({term('d3p', 'p')} + {term('dp', 'd2p')})")))
+SIDES = ["bottom", "right", "top", "left"]
+
+
+def primal_stress_error(mesh, nu: float, order: int) -> float:
+    lam, shear_modulus = Material(2 * mu * (1 + nu), nu).lame
+    space = ngs.VectorH1(mesh, order=order, dirichlet="|".join(SIDES))
+    u, v = space.TnT()
+    eps_u, eps_v = ngs.Sym(ngs.Grad(u)), ngs.Sym(ngs.Grad(v))
+    a = ngs.BilinearForm(2 * shear_modulus * ngs.InnerProduct(eps_u, eps_v) * ngs.dx
+                         + lam * ngs.div(u) * ngs.div(v) * ngs.dx).Assemble()
+    rhs = ngs.LinearForm(force * v * ngs.dx(bonus_intorder=4)).Assemble()
+    uh = ngs.GridFunction(space)
+    uh.vec.data = a.mat.Inverse(space.FreeDofs(), inverse="umfpack") * rhs.vec
+    sigma_h = 2 * shear_modulus * ngs.Sym(ngs.Grad(uh)) + lam * ngs.div(uh) * ngs.Id(2)
+    error = sigma_h - sigma_exact
+    return float(np.sqrt(ngs.Integrate(ngs.InnerProduct(error, error), mesh, order=10)
+                         / ngs.Integrate(ngs.InnerProduct(sigma_exact, sigma_exact), mesh,
+                                         order=10)))
+
+
+mesh = polygon_mesh([[0, 0], [1, 0], [1, 1], [0, 1]], SIDES, maxh=0.25, level=LEVELS[-1])
+ratios = {}
+for order in (1, 2):
+    errors = [primal_stress_error(mesh, nu, order) for nu in (0.3, 0.4999)]
+    ratios[f"P{order}"] = errors[1] / errors[0]
+    print(f"P{order}: stress error {errors[0]:.3e} (nu = 0.3), {errors[1]:.3e} (nu = 0.4999), "
+          f"ratio {ratios[f'P{order}']:.2f}")
+
+# %% [markdown]
+# ## Exercise 3: counting with Euler's formula
+#
+# Level k of Example 3.46 has n = 2^(k−1), an 8n × 2n grid of squares, so
+# V = (8n + 1)(2n + 1), T = 2 · 16n² and, by Euler, E = V + T − 1. Hence
+# dim X_h = 2(E + T), dim M_h = 2T = 64n², dim S_h = V.
+
+# %%
+TABLE_3_1 = {1: (180, 64, 27), 2: (680, 256, 85), 3: (2640, 1024, 297),
+             4: (10400, 4096, 1105), 5: (41280, 16384, 4257), 6: (164480, 65536, 16705),
+             7: (656640, 262144, 66177), 8: (2624000, 1048576, 263425)}
+
+
+def formula(level: int) -> tuple[int, int, int]:
+    n = 2 ** (level - 1)
+    vertices, triangles = (8 * n + 1) * (2 * n + 1), 32 * n * n
+    edges = vertices + triangles - 1
+    return 2 * (edges + triangles), 2 * triangles, vertices
+
+
+assert all(formula(k) == TABLE_3_1[k] for k in TABLE_3_1)
+thesis = load_scene("thesis-3.46-frictionless")
+for level in LEVELS:
+    dofs = Spaces.build(thesis, build_mesh(thesis.geometry, level)).dofs()
+    assert (dofs["X"], dofs["M"], dofs["S"]) == formula(level)
+print("Euler's formula reproduces all eight rows of Table 3.1")
+
+# %%
+save_results("01_peers_mixed_elasticity_solutions",
+             {"singular_values": singular, "growth_of_largest": growth,
+              "primal_ratios": ratios})
