@@ -14,8 +14,9 @@ piecewise constant), so the projection is the closed form clip(., -1, 1); the
 same projection as a cvxpy QP is :func:`box_projection_qp`.
 
 Stopping (honest): the iteration stops only when the increments of nu (and,
-for Coulomb, of F) are below eps2 *and* the inner loop converged; every
-residual of the discrete variational inequality (3.62) is reported.
+for Coulomb, of F) and the residual of nu lambda_t = |lambda_t| are below eps2
+*and* the inner loop converged; every residual of the discrete variational
+inequality (3.62) is reported.
 
 rho_2 is dimensionless: the step applied is rho_2 / lambda_max(H), H the
 operator of the nu iteration (:class:`FrictionStep`), computed from the
