@@ -68,7 +68,11 @@ class FrictionForms:
 
     def coulomb_bound(self, x: np.ndarray, mu_f: float) -> np.ndarray:
         """F of (3.123) per fine edge: mu_f times the mean |sigma_n| over its h^ edge."""
-        return mu_f * self.per_hat_edge(np.abs(self.T_n @ x))[self.edge_of]
+        return self.coulomb_bound_of(self.T_n @ x, mu_f)
+
+    def coulomb_bound_of(self, sigma_n: np.ndarray, mu_f: float) -> np.ndarray:
+        """F of (3.123) from sigma_n given per fine edge."""
+        return mu_f * self.per_hat_edge(np.abs(sigma_n))[self.edge_of]
 
     def per_hat_edge(self, F_edges: np.ndarray) -> np.ndarray:
         """Mean of a fine-edge quantity over each h^ edge."""

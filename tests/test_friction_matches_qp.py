@@ -70,7 +70,7 @@ def test_discrete_coulomb_conditions(name, level):
     # Coulomb: int |sigma_t| mu_i <= mu_f int |sigma_n|_h^ mu_i for every hat mu_i
     sigma = sol.x[pb.sigma]
     tangential = pb.block(pb.sigma, pb.index("lam_t")).T @ sigma
-    mean_normal = forms.per_hat_edge(np.abs(forms.T_n @ sol.x))[forms.edge_of]
+    mean_normal = forms.coulomb_bound(sol.x, 1.0)  # the h^ mean of |sigma_n|
     q_normal = forms.q_matrix(mean_normal).T @ np.ones(forms.n_nu)
     assert q_normal.max() > 0
     assert np.all(np.abs(tangential) <= mu_f * q_normal * (1 + 1e-6) + 1e-12 * q_normal.max())

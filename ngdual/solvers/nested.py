@@ -220,12 +220,12 @@ def nested_uzawa(problem: DiscreteProblem, law: str, mu_f: float = 0.0, rho1: fl
     else:  # F^0 from the frictionless solution (Remark 3.45: F^0(sigma^0))
         state, inner_total, _, _ = loop.run(lam, rho1, eps1, max_iter)
         lam = state.lam
-        friction.set_bound(mu_f * forms.per_hat_edge(np.abs(state.extra))[forms.edge_of])
+        friction.set_bound(forms.coulomb_bound_of(state.extra, mu_f))
 
     def coulomb_update(state) -> float:                                       # step 8'
         if law != "coulomb":
             return 0.0
-        F_new = mu_f * forms.per_hat_edge(np.abs(state.extra))[forms.edge_of]
+        F_new = forms.coulomb_bound_of(state.extra, mu_f)
         change = _relative(F_new, friction.F)
         friction.set_bound(F_new)
         return change

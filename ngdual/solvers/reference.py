@@ -137,9 +137,9 @@ def solve_qp_friction(problem: DiscreteProblem, law: str, mu_f: float = 0.0,
         sol = _solve_qp(problem)
         history = []
         while len(history) < max_iter:
-            F = mu_f * forms.per_hat_edge(np.abs(forms.T_n @ sol.x))[forms.edge_of]
+            F = forms.coulomb_bound(sol.x, mu_f)
             sol = _solve_qp(problem, forms.q_matrix(F))
-            F_new = mu_f * forms.per_hat_edge(np.abs(forms.T_n @ sol.x))[forms.edge_of]
+            F_new = forms.coulomb_bound(sol.x, mu_f)
             history.append(float(np.linalg.norm(F_new - F) / (np.linalg.norm(F_new) or 1.0)))
             if history[-1] <= tol:
                 break
