@@ -52,7 +52,7 @@ def refine(mesh: ngs.Mesh, marked: np.ndarray) -> ngs.Mesh:
 
 
 def adapt(scene: Scene, marking: str = "dorfler", theta: float = 0.5, steps: int = 5,
-          level: int | None = None, asymmetry: str = "hdiv", reference: dict | None = None,
+          level: int | None = None, asymmetry: str = "l2", reference: dict | None = None,
           on_step: StepCallback | None = None) -> list[dict]:
     """Run ``steps`` adaptive steps on ``scene`` from its mesh on ``level``.
 

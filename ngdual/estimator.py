@@ -6,8 +6,9 @@ and t = (n_2, -n_1) the tangent of (3.24) and of the proof of Theorem 4.2:
 
 eta_{sigma,T}^2 (4.15)
     ``residual``        ||f + div sigma_h||_T^2
-    ``asymmetry``       ||as(sigma_h)||_{H(div,T)}^2 (``asymmetry="hdiv"``, the thesis) or
-                        ||as(sigma_h)||_T^2 (``"l2"``, Carstensen-Dolzmann [22], Gatica [46])
+    ``asymmetry``       ||as(sigma_h)||_T^2 (``asymmetry="l2"``, the default, as in
+                        Carstensen-Dolzmann [22], Gatica [46]) or ||as(sigma_h)||_{H(div,T)}^2
+                        (``"hdiv"``, as printed in (4.15); it does not decrease for PEERS)
     ``curl``            h_T^2 ||curl w_h||_T^2
     ``jump_interior``   sum_{e in E^T, interior}  h_e ||[w_h t]||_e^2
     ``jump_dirichlet``  sum_{e in E^T on Gamma_D} h_e ||w_h t - du_D/dt||_e^2
@@ -79,7 +80,7 @@ class Estimate:
     terms: dict[str, np.ndarray]
     h: np.ndarray
     seconds: float = 0.0
-    asymmetry: str = "hdiv"
+    asymmetry: str = "l2"
 
     @property
     def eta_sigma(self) -> np.ndarray:
@@ -199,7 +200,7 @@ def _interior_edge_lengths(mesh: ngs.Mesh) -> ngs.GridFunction:
     return gf
 
 
-def estimate(solution: Solution, asymmetry: str = "hdiv") -> Estimate:
+def estimate(solution: Solution, asymmetry: str = "l2") -> Estimate:
     """Every term of eta_{tot,T} (4.50) on every element of the solution's mesh.
 
     Parameters
@@ -208,9 +209,12 @@ def estimate(solution: Solution, asymmetry: str = "hdiv") -> Estimate:
         A discrete solution of (3.62) (with ``nu`` and ``friction_bound`` if
         the scene has friction).
     asymmetry : {"hdiv", "l2"}
-        The norm of as(sigma_h): H(div, T) as in (4.15), or L^2(T). Without
-        weights, ||div as(sigma_h)||_T does not tend to zero for PEERS (the
-        observation of Table 4.2); the L^2 variant does.
+        The norm of as(sigma_h): L^2(T) (default), or H(div, T) as printed in
+        (4.15). For PEERS ||div as(sigma_h)||_T does not tend to zero (its RT_0
+        part has a row divergence of about |f|/4), so with ``"hdiv"`` the
+        estimator stops decreasing and the effectivity index grows with the
+        level (2.7 -> 17.9 on levels 1-4 of the manufactured problem); with
+        ``"l2"`` (Carstensen-Dolzmann, Gatica et al.) it stays in [0.90, 0.94].
 
     Returns
     -------
