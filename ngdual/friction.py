@@ -3,7 +3,9 @@
 nu is piecewise constant on the h^ edges (L_h^ of (3.61)); F is taken
 piecewise constant on the fine edges of T_h along Gamma_C: for Tresca the mean
 of the given bound on each fine edge, for Coulomb (Remark 3.45, (3.123))
-F|_e^ = mu_f / n^ sum_{e in e^} |sigma_n|_e on every h^ edge. With that,
+F|_e^ = mu_f / n^ sum_{e in e^} |sigma_n|_e on every h^ edge, |sigma_n| by default
+of the projection of sigma_n onto the h~ hats (see :meth:`FrictionForms.coulomb_bound_of`).
+With that,
 
     (Q_F)_{ji} = q(mu_i, kappa_j) = sum_{e in e^_j} F_e |e| (mu_i(a_e) + mu_i(b_e)) / 2
 
@@ -46,6 +48,9 @@ class FrictionForms:
         Lengths of the h^ edges: the (diagonal) mass matrix of L_h^.
     midpoints : numpy.ndarray
         Fine edge midpoints (for plots).
+    normal_stress : str
+        The |sigma_n| of the Coulomb bound (3.123): ``"hat-projection"`` or
+        ``"fine-edges"`` (see :class:`ngdual.scene.Friction`).
     """
 
     T_n: sp.csr_matrix
@@ -55,6 +60,7 @@ class FrictionForms:
     edge_of: np.ndarray
     hat_lengths: np.ndarray
     midpoints: np.ndarray
+    normal_stress: str = "hat-projection"
 
     @property
     def n_nu(self) -> int:
@@ -71,7 +77,18 @@ class FrictionForms:
         return self.coulomb_bound_of(self.T_n @ x, mu_f)
 
     def coulomb_bound_of(self, sigma_n: np.ndarray, mu_f: float) -> np.ndarray:
-        """F of (3.123) from sigma_n given per fine edge."""
+        """F of (3.123) from sigma_n given per fine edge.
+
+        With ``normal_stress = "hat-projection"`` sigma_n is first replaced by
+        its lumped L^2 projection onto the h~ hats, sum_i (t_i / m_i) mu_i with
+        the moments t_i = int sigma_n mu_i ds = d_Cn(mu_i, sigma) and m_i =
+        int mu_i ds (sigma_n is constant on every fine edge, so both are exact
+        sums); it is zero wherever the moments are, i.e. where the body separates.
+        """
+        if self.normal_stress == "hat-projection":
+            weights = self.midpoint_hats.T @ self.lengths
+            moments = self.midpoint_hats.T @ (self.lengths * sigma_n)
+            sigma_n = self.midpoint_hats @ (moments / weights)
         return mu_f * self.per_hat_edge(np.abs(sigma_n))[self.edge_of]
 
     def per_hat_edge(self, F_edges: np.ndarray) -> np.ndarray:
@@ -142,7 +159,8 @@ def build_friction_forms(problem: DiscreteProblem) -> FrictionForms:
     return FrictionForms(T_n=(scale @ int_n[order]).tocsr(), T_t=(scale @ int_t[order]).tocsr(),
                          lengths=lengths, midpoint_hats=midpoint_hats,
                          edge_of=np.array(edge_of), hat_lengths=hat.edge_lengths(),
-                         midpoints=np.array(mids))
+                         midpoints=np.array(mids),
+                         normal_stress=problem.scene.friction.normal_stress)
 
 
 def tresca_bound(forms: FrictionForms, problem: DiscreteProblem) -> np.ndarray:

@@ -13,7 +13,8 @@ The schema (all tables optional except ``geometry`` and ``boundary``)::
     [material]   E, nu                                   (plane strain)
     [loads]      body_force = [fx, fy], traction = [tx, ty], displacement = [ux, uy]
     [contact]    gap, htilde_factor (h~/h), hhat_factor (h^/h~: 1 or 2)
-    [friction]   law = "none" | "tresca" | "coulomb", mu, bound (Tresca F)
+    [friction]   law = "none" | "tresca" | "coulomb", mu, bound (Tresca F),
+                 normal_stress = "hat-projection" | "fine-edges" (the |sigma_n| of F)
     [solver]     metric, rho, eps, max_iter, rho1, rho2, eps1, eps2, loop_order,
                  friction_metric
 
@@ -38,6 +39,7 @@ except ModuleNotFoundError:  # Python < 3.11
     import tomli as tomllib
 
 FRICTION_LAWS = ("none", "tresca", "coulomb")
+NORMAL_STRESSES = ("hat-projection", "fine-edges")
 METRICS = ("h12", "euclidean")
 LOOP_ORDERS = ("friction-outer", "contact-outer")
 FRICTION_METRICS = ("jacobi", "mass")
@@ -119,11 +121,23 @@ class Contact:
 
 @dataclass
 class Friction:
-    """Friction law on Gamma_C: none, Tresca with bound F, Coulomb with coefficient mu."""
+    """Friction law on Gamma_C: none, Tresca with bound F, Coulomb with coefficient mu.
+
+    ``normal_stress`` says which |sigma_n| enters the Coulomb bound F of (3.123):
+    ``"hat-projection"`` (default) the lumped L^2 projection of sigma_n onto the
+    h~ hats, built from the moments d_Cn(mu_i, sigma) that the contact
+    conditions constrain, so F vanishes exactly where the body separates
+    (A_C = supp F is the discrete contact zone); ``"fine-edges"`` the values of
+    sigma_n on the fine edges, (3.123) literally. With h~ = 2h those oscillate
+    at the fine scale even where the moments vanish, which puts friction where
+    there is no contact (e.g. g = |x1|: F ~ 1e5 on separated edges, the body is
+    glued tangentially, and with h^ = h~ the nested Uzawa loop stagnates).
+    """
 
     law: str = "none"
     mu: float = 0.0
     bound: str = "0"
+    normal_stress: str = "hat-projection"
 
 
 @dataclass
@@ -386,6 +400,9 @@ def validate(scene: Scene) -> None:
                                          + ", ".join(FRICTION_LAWS))
     if isinstance(fr.mu, bool) or not isinstance(fr.mu, (int, float)) or not fr.mu >= 0:
         raise SceneError("friction.mu", f"friction coefficient must be >= 0, got {fr.mu!r}")
+    if fr.normal_stress not in NORMAL_STRESSES:
+        raise SceneError("friction.normal_stress", f"unknown choice {fr.normal_stress!r}; use "
+                                                   "one of " + ", ".join(NORMAL_STRESSES))
     bound = _expression(fr.bound, "friction.bound")
     if scene.has_contact:
         x, y = _contact_points(scene)

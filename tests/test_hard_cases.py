@@ -63,10 +63,14 @@ def test_nearly_incompressible_contact_converges_like_compressible():
     for key in ("sigma_X", "u", "lam_n"):
         r3, r4 = (table[0.4999][i][key] / table[0.3][i][key] for i in (2, 3))
         assert abs(r4 - r3) <= 0.05 * r4, (key, r3, r4)
-    # and the last refinement changes sigma and u no more than for nu = 0.3
+    # locking would make the coarse displacement too small and the levels creep up to it;
+    # here the last refinement changes sigma and u by a few percent at most, for both nu
+    # (for 0.4999 the stress singularities at the ends of the contact zone and at the
+    # corners are stronger, so the change is larger than for 0.3, but it is not locking)
     for key in ("sigma_X", "u"):
         change = {nu: abs(t[3][key] - t[2][key]) / t[3][key] for nu, t in table.items()}
-        assert change[0.4999] <= 2 * change[0.3] + 5e-3, (key, change)
+        assert max(change.values()) <= 0.03, (key, change)
+    assert table[0.4999][0]["u"] >= 0.95 * table[0.4999][3]["u"], table[0.4999]
     its = {nu: sols[-1].iterations["outer"] for nu, sols in study.items()}
     assert its[0.4999] <= 2 * its[0.3] + 10, its
 
