@@ -26,6 +26,7 @@ from . import peers
 from .expr import Expression
 from .forms import DiscreteProblem, boundary_regex
 
+NEGLIGIBLE = 1e-6  # hat moments of sigma_n below this fraction of the largest are zero
 GAUSS = (np.array([0.5 - np.sqrt(15) / 10, 0.5, 0.5 + np.sqrt(15) / 10]),
          np.array([5, 8, 5]) / 18)
 
@@ -88,6 +89,9 @@ class FrictionForms:
         if self.normal_stress == "hat-projection":
             weights = self.midpoint_hats.T @ self.lengths
             moments = self.midpoint_hats.T @ (self.lengths * sigma_n)
+            # an iterative contact solve leaves moments of the size of its tolerance
+            # where the body separates: they are zero, and so is F there
+            moments[np.abs(moments) <= NEGLIGIBLE * np.abs(moments).max(initial=0.0)] = 0.0
             sigma_n = self.midpoint_hats @ (moments / weights)
         return mu_f * self.per_hat_edge(np.abs(sigma_n))[self.edge_of]
 

@@ -288,9 +288,13 @@ class FrictionDiagnostics:
 
     Per h~ node (interior, ``node_xy``): lambda_n, lambda_t, the hat moments
     ``t_n`` = int sigma_n mu_i and ``t_t`` = int sigma_t mu_i, their ratio
-    ``traction_ratio`` = |t_t| / |t_n| (the hat-weighted |sigma_t| / |sigma_n|, at most
-    about mu_f on the active set) and ``node_status``: "separation" (lambda_n > 0),
-    "stick" (every h^ edge under the hat has |nu| < 1) or "slip".
+    ``traction_ratio`` = |t_t| / |t_n| (the hat-weighted |sigma_t| / |sigma_n|) and
+    ``node_status``: "separation" (lambda_n > 0), "stick" (every h^ edge under the
+    hat has |nu| < 1) or "slip" (also where no friction acts under the hat). The
+    discrete problem bounds |t_t| by int F mu_i (``sigma_t_bound``), not by mu_f |t_n|:
+    F is the h^-mean of mu_f |sigma_n|, so at the last node of the contact zone, where
+    |sigma_n| drops to zero within one h~ edge, the ratio can exceed mu_f (about 3 mu_f
+    for Example 3.46); inside the zone it stays below mu_f.
     Per h^ edge (``edge_xy`` midpoints): nu, ``sign_lam_t`` = sign(Q_F lambda_t),
     ``F`` (mean over the edge) and ``edge_status``: "free" (F = 0), "stick"
     (|nu| < 1) or "slip" (|nu| = 1, nu = sign lambda_t).
@@ -325,9 +329,11 @@ def friction_diagnostics(solution: Solution, slip_tol: float = 1e-6) -> Friction
     nu = solution.nu
     edge_status = np.where(F_hat <= 0, "free", np.where(np.abs(nu) >= 1 - slip_tol, "slip",
                                                          "stick"))
-    slips = (Q.T.tocsr() != 0).astype(float) @ (edge_status == "slip")
-    node_status = np.where(_in_contact(lam_n, lam_t), np.where(slips > 0, "slip", "stick"),
-                           "separation")
+    under_hat = (Q.T.tocsr() != 0).astype(float)
+    slips = under_hat @ (edge_status == "slip")
+    held = under_hat @ np.ones(forms.n_nu)  # no F under the hat: the node slides freely
+    node_status = np.where(_in_contact(lam_n, lam_t),
+                           np.where((slips > 0) | (held == 0), "slip", "stick"), "separation")
     ratio = np.abs(t_t) / np.maximum(np.abs(t_n), np.finfo(float).tiny)
     hat_mid = np.array([forms.midpoints[forms.edge_of == j].mean(axis=0)
                         for j in range(forms.n_nu)])
