@@ -14,12 +14,14 @@ The exercise solutions (``tutorials/solutions/``) run in quick mode as well.
 """
 
 import json
+import math
 import os
 import re
 import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from ngdual.cli import main
@@ -94,6 +96,74 @@ def check_signorini_uzawa(r: dict) -> None:
     assert r["residuals"]["sigma_n_positive"] < 1e-8 and r["residuals"]["lambda_n_negative"] == 0
 
 
+def check_friction(r: dict) -> None:
+    """(3.62) holds tested with the hats, nested Uzawa = QP, both loop orders, h^ = 2h~."""
+    assert r["box_projection_qp_difference"] < 1e-5
+    assert r["converged"]["tresca"] and r["converged"]["coulomb"]
+    for law, c in r["conditions"].items():
+        assert c["lam_n_min"] >= 0 and c["sigma_n_max"] < 1e-8, (law, c)      # lambda_n, sigma_n
+        assert c["complementarity"] < 1e-8, (law, c)
+        assert c["cone_excess"] < 1e-10 and c["tangential"] < 1e-8, (law, c)  # |sigma_t| <= F
+        assert c["nu_max"] <= 1 and c["slipping_edges"] > 0, (law, c)
+        assert c["nu_sign_mismatch"] < 1e-6, (law, c)                         # nu = sign lam_t
+    for law, a in r["agreement"].items():
+        assert max(a.values()) < 1e-5, (law, a)
+        assert r["loop_order_difference"][law] < 1e-5
+    assert max(r["active_set_difference"].values()) < 1e-5
+    assert r["fixed_point_residual"] < 1e-5
+    assert r["qp_fixed_point_history"][-1] < r["qp_fixed_point_history"][0]
+    for row in r["inf_sup"]:                      # a kernel for h^ = h~ (checkerboard), none else
+        assert row["hhat_h"]["N_A"] == row["hhat_h"]["N_C"] + 1 and row["hhat_h"]["beta"] == 0
+        assert np.allclose(np.abs(row["kernel_hhat_h"]), 1)
+        assert np.allclose(row["kernel_hhat_h"][1:], -np.array(row["kernel_hhat_h"][:-1]))
+        assert row["hhat_2h"]["N_A"] < row["hhat_2h"]["N_C"] and row["hhat_2h"]["beta"] > 0.1
+    betas = [row["hhat_2h"]["beta"] for row in r["inf_sup"]]
+    assert max(betas) / min(betas) < 1.5, betas                               # Lemma 3.29
+    assert r["inf_sup_inner"]["beta"] > 0.01                                  # Lemma 3.31
+    coarse, fine = r["gap0"]["hhat_2h"], r["gap0"]["hhat_h"]
+    assert all(row["converged"] for row in coarse)
+    both = [(a["outer"], b["outer"]) for a, b in zip(fine, coarse) if a["converged"]]
+    assert both and all(f > c for f, c in both), both
+    assert all("hhat_factor" in message for message in r["failure_messages"])
+
+
+def check_estimator(r: dict) -> None:
+    """Terms add up, live where they should; effectivity band, rates, the H(div) variant."""
+    t = r["thesis"]
+    assert t["sum_of_terms_is_eta2"]
+    assert math.isclose(math.sqrt(sum(t["summed"].values())), t["eta"], rel_tol=1e-10)
+    assert t["summed"]["residual"] < 1e-12 * t["eta"] ** 2                   # f = 0 = div sigma_h
+    assert 0 < t["friction_elements"] < t["elements"] and 0 < t["neumann_elements"]
+    effectivity = r["effectivity"]
+    assert 0.2 <= min(effectivity) and max(effectivity) <= 5
+    assert max(effectivity) / min(effectivity) <= 1.5, effectivity
+    rows = r["smooth"]
+    for row in rows[1:]:
+        assert row["rate_error"] > 0.8 and abs(row["rate_eta"] - row["rate_error"]) <= 0.15, row
+    hdiv = r["hdiv_effectivity"]
+    assert all(b > 1.5 * a for a, b in zip(hdiv, hdiv[1:])), hdiv           # grows like 1/h
+    assert rows[-1]["as_hdiv"] > 0.5 * rows[0]["as_hdiv"]                   # does not decay
+    assert rows[-1]["as_l2"] < 0.5 * rows[0]["as_l2"]
+
+
+def check_adaptivity(r: dict) -> None:
+    """Marking as specified; Dörfler beats uniform on the L-shape; every run reduces eta."""
+    assert r["marking_share"]["dorfler"] >= 0.5 and r["marking_example"]["fraction"] >= 26
+    runs = r["l_shape"]
+    assert runs["uniform"]["rates"]["error"] <= 0.35
+    assert runs["dorfler"]["rates"]["error"] >= runs["uniform"]["rates"]["error"] + 0.15
+    for name, run in runs.items():
+        assert run["errors"][-1] < run["errors"][0] and run["etas"][-1] < run["etas"][0], name
+        assert all(b > a for a, b in zip(run["ndofs"], run["ndofs"][1:])), name
+    dorfler = runs["dorfler"]["effectivity"]
+    assert max(dorfler) / min(dorfler) <= 3, dorfler
+    for name, history in r["thesis"].items():
+        assert all(step["converged"] for step in history), name
+        assert history[-1]["eta"] < history[0]["eta"], name
+        assert all(b["elements"] > a["elements"] for a, b in zip(history, history[1:])), name
+        assert all(step["e_tot"] > 0 for step in history), name
+
+
 def check_your_own_scene(r: dict) -> None:
     """Each mistake caught with the right field, CLI exit codes, a convergent contact solve."""
     assert r["caught"] == r["expected_fields"]
@@ -107,7 +177,8 @@ def check_your_own_scene(r: dict) -> None:
     assert all(3.5 < b / a < 4.5 for a, b in zip(dims, dims[1:])), dims
 
 
-CHECKS = {1: check_peers_mixed_elasticity, 2: check_signorini_uzawa, 6: check_your_own_scene}
+CHECKS = {1: check_peers_mixed_elasticity, 2: check_signorini_uzawa, 3: check_friction,
+          4: check_estimator, 5: check_adaptivity, 6: check_your_own_scene}
 
 
 def check_solutions(number: int, r: dict) -> None:
@@ -119,6 +190,39 @@ def check_solutions(number: int, r: dict) -> None:
         assert all(uzawa == qp for uzawa, qp in r["gaps"].values()), r["gaps"]
         assert r["mass_metric_iterations"][-1] > r["mass_metric_iterations"][0]
         assert all(abs(hand - ngdual) <= 1 for hand, ngdual in r["hand_vs_ngdual"])
+    elif number == 3:
+        sweep = r["sweep"]
+        assert all(converged for _, _, converged in sweep.values()), sweep
+        for rho1 in r["rho1s"]:                   # outer steps ~ 1 / rho2 with nu outside
+            outer = [sweep[f"friction-outer {rho1} {rho2}"][0] for rho2 in r["rho2s"]]
+            assert all(b < a for a, b in zip(outer, outer[1:])), outer
+        assert not r["large_rho2"]["8.0"][2]      # far beyond the bound: stalls
+        assert all(r["gap_abs_converged"]) and max(r["gap_abs_difference"].values()) < 1e-2
+        by_mu = r["by_mu"]
+        assert by_mu["0.0"]["sigma_vs_frictionless"] < 1e-8
+        assert by_mu["0.5"]["F_abs"] > by_mu["0.0"]["F_abs"]
+        assert by_mu["1.0"]["stick_nodes"] >= by_mu["0.1"]["stick_nodes"]
+    elif number == 4:
+        assert r["patch_sigma"] < 1e-20 * r["patch_u"] and r["patch_u"] > 0.1
+        l2 = [row["l2"]["max"] for row in r["table_4_2"]]
+        hdiv = [row["hdiv"]["max"] for row in r["table_4_2"]]
+        assert max(l2) / min(l2) < 1.5 and hdiv[-1] > 3 * hdiv[0], (l2, hdiv)
+        assert all(abs(row["l2"]["argmax_xy"][0]) > 3.5 and row["l2"]["argmax_xy"][1] < 0
+                   for row in r["table_4_2"])                      # a lower corner
+        assert r["table_4_2"][-1]["l2"]["q_as"] < r["table_4_2"][0]["l2"]["q_as"]
+        square = r["sum_ratios"]["square"]
+        assert all(0.8 < row["ratio"] / math.sqrt(row["elements"]) <= 1 for row in square)
+        assert all(row["ratio"] <= math.sqrt(row["elements"]) for row in r["sum_ratios"]["thesis"])
+    elif number == 5:
+        d = r["dorfler"]
+        assert d["0.5"]["rate"] > d["0.8"]["rate"] and d["0.5"]["rate"] > 0.45, d
+        assert d["0.2"]["steps"] > d["0.5"]["steps"] > d["0.8"]["steps"], d
+        eta, sigma = r["by_indicator"]["eta"], r["by_indicator"]["eta_sigma"]
+        assert eta["top_edges"] > sigma["top_edges"], (eta, sigma)
+        incompatible, compatible = r["corners"]["0.01"], r["corners"]["0"]
+        assert incompatible["uniform_as_max"][-1] > 0.8 * incompatible["uniform_as_max"][0]
+        assert compatible["uniform_as_max"][-1] < 0.5 * compatible["uniform_as_max"][0]
+        assert compatible["uniform_eta"][-1] < 0.3 * compatible["uniform_eta"][0]
     elif number == 6:
         assert r["touching"]["0.95"] == 0 and r["touching"]["1.05"] >= 1, r["touching"]
         assert sorted(r["arch_errors"].values()) == ["boundary", "geometry.points"]

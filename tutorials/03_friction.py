@@ -1,0 +1,505 @@
+# %% [markdown]
+# # Tutorial 3: Tresca and Coulomb friction, the nested Uzawa algorithm
+#
+# **Problem.** Example 3.46 of the thesis *with* friction: the block [−4,4]×[−1,1],
+# clamped at its ends, pressed by a parabolic traction on top onto a rigid foundation
+# at distance g below Γ_C. On the contact part the body may stick or slip. With a
+# friction bound 𝓕 ≥ 0 (Tresca: given; Coulomb: 𝓕 = μ_f |σ_n|) the conditions read
+#
+#     |σ_t| ≤ 𝓕,   |σ_t| < 𝓕 ⇒ u_t = 0 (stick),   |σ_t| = 𝓕 ⇒ u_t = −κ σ_t, κ ≥ 0 (slip).
+#
+# The dual-dual formulation (3.41) removes the non-differentiable friction work
+# j(λ_t) = ∫ 𝓕|λ_t| with one more multiplier ν ∈ Λ = {|ν| ≤ 1} on A_C = supp 𝓕,
+# "the sign of λ_t" (Remark 3.15): ν λ_t = |λ_t|, σ_t = 𝓕 ν.
+#
+# **Discretisation.** PEERS for (σ, u, η), P1 multipliers φ on Γ_N and λ_t, λ_n on the
+# coarse mesh h̃ = 2h of Γ_C, and ν piecewise constant on a mesh ĥ of Γ_C with
+# |ν| ≤ 1: the discrete variational inequality (3.62) with q(κ, μ) = ∫_{Γ_C} 𝓕 κ μ ds.
+#
+# **What you will learn.**
+# 1. Algorithm 3.41: an inner Uzawa loop for λ_n (the Signorini problem of Tutorial 2
+#    with a prescribed tangential load) inside an outer loop for ν, and the exchanged
+#    loop order of Remark 3.43; the box projection P^Λ of Remark 3.44.
+# 2. Coulomb friction as a fixed point on 𝓕 = μ_f|σ_n| (Remark 3.45, (3.123)), computed
+#    inside the same outer loop, and a check against an independent QP solver.
+# 3. How to read stick, slip and separation on Γ_C, and why ν is the sign of λ_t.
+# 4. Why ĥ = 2h̃ is needed when the contact zone reaches the ends of Γ_C (g ≡ 0,
+#    Lemma 3.29): with ĥ = h̃ a checkerboard ν is invisible to every test function.
+#
+# **References.** M. Andres (2011), Sections 3.1.4, 3.2.2 and 3.3.3: eqs. (3.41), (3.42),
+# (3.62), (3.95), (3.123), Lemmas 3.29 and 3.31, Algorithm 3.41, Theorem 3.42, Remarks
+# 3.43-3.45, Example 3.46, Figs. 3.19-3.25. M. Maischak, *FEM/BEM methods for
+# Signorini-type problems* (Habilitation, Hannover 2004), Section 5.3. R. Glowinski,
+# *Numerical methods for nonlinear variational problems* (1984), Chapter II.5.
+
+# %%
+import matplotlib.pyplot as plt
+import numpy as np
+
+from ngdual import peers, post
+from ngdual.forms import assemble
+from ngdual.friction import build_friction_forms
+from ngdual.mesh import build_mesh
+from ngdual.scene import load_scene
+from ngdual.solve import solve_problem
+from ngdual.solvers.nested import box_projection, box_projection_qp, nested_uzawa
+from ngdual.solvers.projections import metric_matrix
+from ngdual.solvers.reference import solve_qp_friction
+from ngdual.solvers.result import ConvergenceError
+from ngdual.tutorials import draw, output_dir, quick_mode, save_figure, save_results
+
+# %% [markdown]
+# ## Parameters
+
+# %%
+QUICK = quick_mode()
+LEVEL = 3 if QUICK else 4                        # mesh level of Example 3.46
+GAP0_LEVELS = [1, 2, 3] if QUICK else [1, 2, 3, 4]  # levels of the g = 0 study (Section 6)
+LOOP_ORDERS = ["friction-outer", "contact-outer"]  # Algorithm 3.41 and Remark 3.43
+EPS1, EPS2 = 1e-10, 1e-9                         # tight tolerances, to compare with the QP
+OUT = output_dir("03_friction")
+print(f"quick mode: {QUICK}; level {LEVEL}; output in {OUT}")
+
+# %% [markdown]
+# ## 1. The friction multiplier ν and the matrix Q_𝓕
+#
+# Compared with Tutorial 2, (3.62) has two more lines:
+#
+#     d_{C,t}(μ_t, σ) − q(μ_t, ν) = 0      for all μ_t ∈ C_h̃      (σ_t = 𝓕ν, tested)
+#     q(κ − ν, λ_t) ≤ 0                   for all κ ∈ Λ_ĥ        (ν λ_t = |λ_t|)
+#
+# In matrices (3.95)-(3.97): the λ_t rows of the saddle-point system get the load
+# Q_𝓕ᵀν, where (Q_𝓕)_{ji} = q(μ_i, κ_j) couples the h̃ hat μ_i with the indicator κ_j
+# of the ĥ edge j. `build_friction_forms` provides everything on Γ_C: σ_n and σ_t on the
+# fine edges as matrices (`T_n @ x`), the ĥ edge of every fine edge, and `q_matrix(F)`.
+# The Tresca scene has the constant bound 𝓕 = 100 (σ_n reaches about −500 under the load).
+
+# %%
+tresca = load_scene("thesis-3.46-tresca")
+coulomb = load_scene("thesis-3.46-coulomb")
+mu_f = coulomb.friction.mu
+problem_t = assemble(tresca, build_mesh(tresca.geometry, LEVEL))
+problem_c = assemble(coulomb, build_mesh(coulomb.geometry, LEVEL))
+forms = build_friction_forms(problem_t)
+print(f"dofs (Table 3.1, L = nu on the h^ mesh): {problem_t.spaces.dofs()}")
+print(f"fine edges on Gamma_C: {len(forms.lengths)}, h^ edges (nu): {forms.n_nu}, "
+      f"Q_F: {forms.q_matrix(np.ones(len(forms.lengths))).shape} (N_A x N_C)")
+
+# %% [markdown]
+# ## 2. Algorithm 3.41 for Tresca friction
+#
+# The nested Uzawa algorithm alternates two projections:
+#
+# * **inner loop** (steps 4-7): for fixed ν, Algorithm 3.38 on λ_n: solve the saddle
+#   point system with the loads −C_nλ_n and Q_𝓕ᵀν, then λ_n ← P⁺(λ_n + ρ₁Φ(σ));
+# * **outer step** (step 8): ν ← P^Λ(ν + ρ₂ Φ^Λ λ_t), a projected gradient step for ν.
+#
+# Remark 3.44 poses P^Λ like P⁺ (Remark 3.40) as a QP in the mass matrix M of L_ĥ:
+# ν = argmin_{|ψ_j| ≤ 1} ½ψᵀMψ − ψᵀb. ν is piecewise constant, so M is *diagonal* and
+# the QP decouples into clip(b/M, −1, 1); unlike P⁺ in the dense H^{1/2} metric W,
+# here clipping is exact. ngdual uses the closed form (by default with M scaled by the
+# diagonal of the ν operator, `friction_metric="jacobi"`, still diagonal); the cvxpy QP
+# agrees.
+
+# %%
+rng = np.random.default_rng(3)
+masses, loads = rng.uniform(0.5, 2.0, forms.n_nu), rng.normal(scale=2.0, size=forms.n_nu)
+box_qp_difference = float(np.max(np.abs(box_projection_qp(loads, masses)
+                                        - box_projection(loads, masses))))
+print(f"P^Lambda: |cvxpy QP - clip(b / M, -1, 1)| = {box_qp_difference:.1e}")
+
+# %% [markdown]
+# `nested_uzawa` runs Algorithm 3.41 (`loop_order="friction-outer"`) or, with the loops
+# exchanged (Remark 3.43), an inner loop for ν at fixed λ_n inside an outer loop for
+# λ_n (`"contact-outer"`). ρ₂ is dimensionless (relative to the computed stability
+# bound of the ν step, see `FrictionStep`), so 0 < ρ₂ < 2 converges for any E and load.
+# It stops only when the increments *and* the residual of ν λ_t = |λ_t| are below ε₂.
+
+# %%
+tresca_runs = {order: nested_uzawa(problem_t, "tresca", eps1=EPS1, eps2=EPS2, loop_order=order)
+               for order in LOOP_ORDERS}
+for order, solution in tresca_runs.items():
+    print(f"Tresca, {order:14s}: {solution.iterations['outer']:4d} outer, "
+          f"{solution.iterations['inner']:5d} inner iterations, converged {solution.converged}")
+
+# %% [markdown]
+# With ν outside (Algorithm 3.41) each outer step solves a whole contact problem, so
+# there are few outer and many inner steps; exchanged, the cheap ν iteration runs inside.
+# Both reach the same discrete solution: (3.62) has a unique σ, and with ĥ = 2h̃ a unique ν.
+
+# %%
+def relative(a, b) -> float:
+    return float(np.linalg.norm(a - b) / (np.linalg.norm(b) or 1.0))
+
+
+first, second = (tresca_runs[o] for o in LOOP_ORDERS)
+loop_order_difference = {"tresca": relative(second.x, first.x)}
+print(f"Tresca: the two loop orders differ by {loop_order_difference['tresca']:.1e} (relative)")
+
+# %% [markdown]
+# ## 3. An independent check: one QP in (σ, ν)
+#
+# For a *given* 𝓕, (3.62) is the KKT system of
+#
+#     min ½σᵀAσ − gᵀσ   subject to   Bᵀσ − (0, 0, 0, Q_𝓕ᵀν) = b,   C_nᵀσ ≤ 0,   |ν_j| ≤ 1,
+#
+# whose multipliers are (u, η, φ, λ_t) and λ_n ≥ 0; stationarity in ν is exactly
+# ν_j = sign(Q_𝓕λ_t)_j, i.e. (3.62)₇. `solve_qp_friction` hands this QP to Clarabel.
+# It shares only the matrices with the nested Uzawa loops.
+
+
+# %%
+def compare(nested, qp) -> dict:
+    """Relative differences of sigma, lambda_t, lambda_n and nu (where F matters)."""
+    pb = nested.problem
+    fr = build_friction_forms(pb)
+    lam_scale = max(np.linalg.norm(qp.part("lam_n")), np.linalg.norm(qp.part("lam_t")))
+    F_hat = fr.per_hat_edge(qp.friction_bound)
+    relevant = F_hat > 1e-3 * F_hat.max()
+    return {"sigma": relative(nested.part(*peers.STRESS), qp.part(*peers.STRESS)),
+            "lam_t": relative(nested.part("lam_t"), qp.part("lam_t")),
+            "lam_n": float(np.linalg.norm(nested.part("lam_n") - qp.part("lam_n")) / lam_scale),
+            "nu": float(np.max(np.abs(nested.nu - qp.nu)[relevant]))}
+
+
+qp_tresca = solve_qp_friction(problem_t, "tresca")
+agreement = {"tresca": compare(tresca_runs["friction-outer"], qp_tresca)}
+print("nested Uzawa vs QP, Tresca:", {k: f"{v:.1e}" for k, v in agreement["tresca"].items()})
+
+# %% [markdown]
+# ## 4. Coulomb friction: a fixed point on 𝓕
+#
+# Coulomb's law makes the bound depend on the solution, 𝓕 = μ_f|σ_n|: a quasi-variational
+# inequality. Solving Tresca problems for 𝓕ᵏ⁺¹ = μ_f|σ_nᵏ| in turn would add a third loop.
+# Remark 3.45 instead updates 𝓕 *inside* the outer loop of Algorithm 3.41, before each
+# ν step (steps 8'-10'), starting from the frictionless solution. 𝓕 must live in L_ĥ,
+# so (3.123) averages |σ_n| over every ĥ edge: `forms.coulomb_bound_of(sigma_n, mu_f)`.
+# (ngdual uses by default the σ_n that the contact conditions actually see, its
+# projection onto the h̃ hats, so that 𝓕 vanishes where the body separates; see
+# `ngdual.scene.Friction.normal_stress`.)
+
+# %%
+coulomb_runs = {order: nested_uzawa(problem_c, "coulomb", mu_f=mu_f, eps1=EPS1, eps2=EPS2,
+                                    loop_order=order)
+                for order in LOOP_ORDERS}
+for order, solution in coulomb_runs.items():
+    print(f"Coulomb mu_f = {mu_f}, {order:14s}: {solution.iterations['outer']:4d} outer, "
+          f"{solution.iterations['inner']:5d} inner iterations, converged {solution.converged}")
+first, second = (coulomb_runs[o] for o in LOOP_ORDERS)
+loop_order_difference["coulomb"] = relative(second.x, first.x)
+coulomb_solution = coulomb_runs["friction-outer"]
+
+# %% [markdown]
+# At convergence 𝓕 is a fixed point: recomputing it from the final σ_n returns the
+# 𝓕 the final solution was computed with.
+
+# %%
+forms_c = build_friction_forms(problem_c)
+sigma_n_edges = forms_c.T_n @ coulomb_solution.x
+F_again = forms_c.coulomb_bound_of(sigma_n_edges, mu_f)
+fixed_point_residual = float(np.max(np.abs(F_again - coulomb_solution.friction_bound))
+                             / np.max(coulomb_solution.friction_bound))
+print(f"max |F(sigma_n) - F| / max F = {fixed_point_residual:.1e}")
+
+# %% [markdown]
+# The reference solver iterates the QP of Section 3 on 𝓕 by successive substitution,
+# a genuinely *third* loop. Its history shows how fast the fixed point contracts.
+
+# %%
+qp_coulomb = solve_qp_friction(problem_c, "coulomb", mu_f)
+agreement["coulomb"] = compare(coulomb_solution, qp_coulomb)
+print(f"QP fixed point: {len(qp_coulomb.history)} QPs, changes of F: "
+      f"{np.array2string(np.array(qp_coulomb.history), precision=1)}")
+print("nested Uzawa vs QP, Coulomb:", {k: f"{v:.1e}" for k, v in agreement["coulomb"].items()})
+
+# %% [markdown]
+# A third route to the same discrete solution: ngdual's default solver (`solve_problem`
+# with `solver.method = "auto"`) condenses (3.62) onto Γ_C and solves the small contact
+# problem there by a semismooth Newton method, with the same fixed point on 𝓕. It is
+# the faster choice in practice; the nested Uzawa algorithm is what the thesis analyses
+# (Theorem 3.42), and what this tutorial is about.
+
+# %%
+active_set = solve_problem(problem_c)
+active_set_difference = compare(coulomb_solution, active_set)
+print(f"nested Uzawa vs {active_set.method}:",
+      {k: f"{v:.1e}" for k, v in active_set_difference.items()})
+
+fig, ax = plt.subplots(figsize=(7, 4))
+for (law, runs) in (("Tresca", tresca_runs), ("Coulomb", coulomb_runs)):
+    for order, style in zip(LOOP_ORDERS, ("-", "--")):
+        history = np.array(runs[order].history)
+        steps = np.arange(1, len(history) + 1)
+        # an exact 0: nu saturated at +-1 on every edge, the projection fixes it for good
+        ax.semilogy(steps[history > 0], history[history > 0], style, label=f"{law}, {order}")
+ax.semilogy(range(1, len(qp_coulomb.history) + 1), qp_coulomb.history, "k:o", ms=3,
+            label="Coulomb, QP on F (3rd loop)")
+ax.set_xlabel("outer iteration")
+ax.set_ylabel("outer residual / change of F")
+ax.set_title(f"Nested Uzawa on Example 3.46, level {LEVEL}")
+ax.grid(True, which="both", alpha=0.3)
+ax.legend(fontsize=8)
+save_figure(fig, OUT / "outer_histories.png")
+
+# %% [markdown]
+# ## 5. Stick, slip and separation on Γ_C
+#
+# What the discrete solution satisfies, tested with the h̃ hats μ_i (Proposition 3.25):
+#
+# * λ_n ≥ 0 (no penetration), ∫σ_nμ_i ≤ 0 (compression only), λ_n·∫σ_nμ_i = 0;
+# * |∫σ_tμ_i| ≤ ∫𝓕μ_i (the friction cone, tested), and ∫σ_tμ_i = q(μ_i, ν) exactly;
+# * |ν| ≤ 1 and ν = sign(Q_𝓕λ_t) wherever Q_𝓕λ_t ≠ 0 ((3.62)₇, Remark 3.15).
+#
+# The pointwise σ_n of the fine edges is *not* constrained: the RT₀ normal trace of
+# PEERS oscillates on the fine scale, and only its hat moments enter (3.62). A node is
+# in **separation** where λ_n > 0 (gap open), in **slip** where |ν| = 1 on an ĥ edge
+# under its hat, else in **stick**. `post.friction_diagnostics` classifies them.
+
+
+# %%
+def signed_friction_work(solution):
+    """q = Q_F lambda_t per h^ edge, and where it is not zero (slip) beyond round-off."""
+    fr = build_friction_forms(solution.problem)
+    Q, lam_t = fr.q_matrix(solution.friction_bound), solution.part("lam_t")
+    q = Q @ lam_t
+    # q_j = 0 in stick, and round-off where F itself is round-off (separated edges)
+    return q, (np.abs(q) > 1e-4 * (Q @ np.abs(lam_t))) & (np.abs(q) > 1e-6 * np.abs(q).max())
+
+
+def discrete_conditions(solution) -> dict:
+    """The sign, complementarity and friction conditions of (3.62), relative to their scale."""
+    pb = solution.problem
+    fr = build_friction_forms(pb)
+    sigma = solution.x[pb.sigma]
+    t_n = pb.block(pb.sigma, pb.lam_n).T @ sigma                 # int sigma_n mu_i
+    t_t = pb.block(pb.sigma, pb.index("lam_t")).T @ sigma        # int sigma_t mu_i
+    lam_n, lam_t = solution.part("lam_n"), solution.part("lam_t")
+    Q = fr.q_matrix(solution.friction_bound)
+    bound = Q.T @ np.ones(fr.n_nu)                               # int F mu_i
+    q, slipping = signed_friction_work(solution)
+    scale_n, scale_lam = np.max(np.abs(t_n)), np.max(np.abs(np.r_[lam_n, lam_t]))
+    return {
+        "lam_n_min": float(lam_n.min() / scale_lam),
+        "sigma_n_max": float(t_n.max() / scale_n),
+        "complementarity": float(np.max(np.abs(lam_n * t_n)) / (scale_n * scale_lam)),
+        "cone_excess": float(np.max(np.abs(t_t) - bound) / bound.max()),
+        "tangential": float(np.max(np.abs(t_t - Q.T @ solution.nu)) / bound.max()),
+        "nu_max": float(np.max(np.abs(solution.nu))),
+        "slipping_edges": int(slipping.sum()),
+        "nu_sign_mismatch": float(np.max(np.abs(solution.nu - np.sign(q))[slipping],
+                                         initial=0.0)),
+    }
+
+
+conditions = {"tresca": discrete_conditions(tresca_runs["friction-outer"]),
+              "coulomb": discrete_conditions(coulomb_solution)}
+for law, values in conditions.items():
+    print(f"{law:8s}", {k: (f"{v:.1e}" if isinstance(v, float) else v) for k, v in values.items()})
+summaries = {"tresca": post.contact_summary(tresca_runs["friction-outer"]),
+             "coulomb": post.contact_summary(coulomb_solution)}
+for law, summary in summaries.items():
+    print(f"{law:8s} h~ nodes in contact {summary['nodes_in_contact']} (stick "
+          f"{summary['stick_nodes']}, slip {summary['slip_nodes']}), total force "
+          f"F_abs = {summary['F_abs']:.1f}")
+
+# %% [markdown]
+# Along Γ_C: the hat-averaged stresses (markers) against the bound ±𝓕, the sign ν, and
+# the multipliers with the status of every h̃ node. ν = ±1 where the body slips, with
+# the sign of λ_t = −u_t (Fig. 3.21(b)); in the stick zone λ_t ≈ 0 and ν = σ_t/𝓕 lies
+# strictly inside (−1, 1) (3.43). Tresca's bound acts even where the body does not touch
+# the foundation, a known weakness of the model; Coulomb's 𝓕 = μ_f|σ_n| vanishes there.
+
+# %%
+STATUS_COLOURS = {"separation": "0.6", "stick": "tab:blue", "slip": "tab:red"}
+
+
+def plot_zones(solution, title: str, path) -> None:
+    pb = solution.problem
+    fr = build_friction_forms(pb)
+    diag = post.friction_diagnostics(solution)
+    hat_length = fr.midpoint_hats.T @ fr.lengths                 # int mu_i ds
+    x_fine, x_node = fr.midpoints[:, 0], diag.node_xy[:, 0]
+    order = np.argsort(x_fine)
+    fig, axes = plt.subplots(3, 1, figsize=(9, 8), sharex=True)
+    ax = axes[0]
+    ax.plot(x_fine[order], (fr.T_n @ solution.x)[order], drawstyle="steps-mid", lw=0.7,
+            color="0.6", label=r"$\sigma_n$ on fine edges")
+    ax.plot(x_node, diag.t_n / hat_length, "o", color="k", ms=4, label=r"hat mean of $\sigma_n$")
+    ax.plot(x_node, diag.t_t / hat_length, "s", color="tab:green", ms=4,
+            label=r"hat mean of $\sigma_t$")
+    F = solution.friction_bound[order]
+    ax.plot(x_fine[order], F, "r-", drawstyle="steps-mid", lw=1, label=r"$\pm\mathcal{F}$")
+    ax.plot(x_fine[order], -F, "r-", drawstyle="steps-mid", lw=1)
+    scale = 1.3 * np.max(np.abs(diag.t_n / hat_length))
+    ax.set_ylim(-scale, scale)
+    ax.set_ylabel("stress")
+    ax.legend(fontsize=7, ncol=2)
+    ax = axes[1]
+    ax.plot(x_fine[order], solution.nu[fr.edge_of][order], drawstyle="steps-mid",
+            label=r"$\nu$ (per $\hat h$ edge)")
+    _, slipping = signed_friction_work(solution)
+    ax.plot(diag.edge_xy[slipping, 0], diag.sign_lam_t[slipping], "kx",
+            label=r"sign$(Q_\mathcal{F}\lambda_t)$ where $\neq 0$")
+    ax.set_ylim(-1.2, 1.2)
+    ax.set_ylabel(r"$\nu$")
+    ax.legend(fontsize=7)
+    ax = axes[2]
+    ax.plot(x_node, diag.lam_n, "k-", lw=0.8, label=r"$\lambda_n$ (gap left)")
+    ax.plot(x_node, diag.lam_t, "-", color="tab:green", lw=0.8, label=r"$\lambda_t = -u_t$")
+    for status, colour in STATUS_COLOURS.items():
+        chosen = diag.node_status == status
+        ax.plot(x_node[chosen], diag.lam_t[chosen], "o", color=colour, ms=5, label=status)
+    ax.set_xlabel(r"$x_1$ on $\Gamma_C$")
+    ax.set_ylabel("displacement")
+    ax.legend(fontsize=7, ncol=2)
+    for ax in axes:
+        ax.grid(alpha=0.3)
+    fig.suptitle(title)
+    save_figure(fig, path)
+
+
+plot_zones(tresca_runs["friction-outer"], f"Tresca, F = 100, level {LEVEL}",
+           OUT / "zones_tresca.png")
+plot_zones(coulomb_solution, f"Coulomb, mu_f = {mu_f}, level {LEVEL}", OUT / "zones_coulomb.png")
+draw(post.von_mises(post.fields(coulomb_solution).sigma, coulomb.material.nu),
+     problem_c.fes.mesh, "von_mises")
+
+# %% [markdown]
+# ## 6. g ≡ 0: why ĥ = 2h̃
+#
+# With g = 0 the whole of Γ_C touches, A_C = Γ_C, and assumption (3.73) (A_C keeps a
+# distance from ∂Γ_C) fails. Count: λ_t vanishes at the ends of Γ_C, so C_h̃ has N_C
+# interior hats, while L_ĥ with ĥ = h̃ has one ν per h̃ edge, N_A = N_C + 1. Then
+# Q_𝓕ᵀ: ℝ^{N_A} → ℝ^{N_C} *must* have a kernel. For 𝓕 ≡ 1 it is the checkerboard
+# κ = (+1, −1, +1, …): every hat covers two neighbouring edges of equal length and sees
+# ∫μ_iκ = (h̃/2)(κ_i + κ_{i+1}) = 0. Such a ν changes nothing in (3.62)₅, so ν is not
+# unique and the discrete inf-sup condition (3.74) fails. With ĥ = 2h̃ every ĥ edge has an
+# h̃ node in its middle whose hat lies inside it (proof of Lemma 3.29); the constant of
+# (3.72), measured in W (H^{1/2} on C_h̃) and ‖κ‖²_{−1/2,ĥ} = ĥ‖κ‖²_{L²} (Remark 3.30), is
+# then the smallest singular value of (ĥM)^{−1/2} Q_𝓕 W^{−1/2}.
+
+
+# %%
+def inf_sup(problem, F=None) -> dict:
+    """Discrete inf-sup constant of q (3.72) for F (default 1 on Gamma_C), and the kernel."""
+    fr = build_friction_forms(problem)
+    F = np.ones(len(fr.lengths)) if F is None else F
+    rows = fr.per_hat_edge(F) > 0                                # the h^ edges of A_C
+    Q = fr.q_matrix(F).toarray()[rows]
+    W = metric_matrix(problem.spaces.contact, 2.0, "h12")        # ||mu||^2 ~ mu^T W mu
+    values, vectors = np.linalg.eigh(W)
+    W_inv_root = (vectors / np.sqrt(values)) @ vectors.T
+    scaled = (Q / fr.hat_lengths[rows, None]) @ W_inv_root
+    singular = np.linalg.svd(scaled, compute_uv=False)
+    n_a, n_c = Q.shape
+    kernel = np.linalg.svd(Q.T)[2][-1] if n_a > n_c else np.zeros(n_a)
+    return {"N_A": n_a, "N_C": n_c, "beta": float(singular[-1]) if n_a <= n_c else 0.0,
+            "kernel": np.round(kernel / (np.max(np.abs(kernel)) or 1.0), 6).tolist()}
+
+
+gap0 = {factor: load_scene("thesis-3.46-coulomb-gap0", [f"contact.hhat_factor={factor}"])
+        for factor in (1, 2)}
+inf_sup_rows = []
+for level in GAP0_LEVELS:
+    row = {"level": level}
+    for factor, scene in gap0.items():
+        row[factor] = inf_sup(assemble(scene, build_mesh(scene.geometry, level)))
+    inf_sup_rows.append(row)
+    print(f"level {level}: h^ = h~: N_A = {row[1]['N_A']:3d} > N_C = {row[1]['N_C']:3d}, "
+          f"beta = 0; h^ = 2h~: N_A = {row[2]['N_A']:3d}, beta = {row[2]['beta']:.4f}")
+print("kernel of Q_F^T for h^ = h~ on level 1:", inf_sup_rows[0][1]["kernel"])
+
+# %% [markdown]
+# β stays the same on every level for ĥ = 2h̃ (in the mesh-dependent norm of Lemma 3.29).
+# If instead 𝓕 vanishes near the ends of Γ_C (assumption (3.73)), the hats next to the
+# ends of A_C pin the checkerboard and ĥ = h̃ is fine (Lemma 3.31):
+
+# %%
+scene = gap0[1]
+problem_inner = assemble(scene, build_mesh(scene.geometry, GAP0_LEVELS[-1]))
+fr_inner = build_friction_forms(problem_inner)
+inner = inf_sup(problem_inner, (np.abs(fr_inner.midpoints[:, 0]) < 1.5).astype(float))
+print(f"h^ = h~, F = 1 on |x1| < 1.5 only: N_A = {inner['N_A']} <= N_C = {inner['N_C']}, "
+      f"beta = {inner['beta']:.3f}")
+
+# %% [markdown]
+# What the solver sees: the nested Uzawa iteration on the g = 0 scene with both choices.
+# With ĥ = h̃ it needs many more outer steps where it converges at all, and on some
+# levels it stalls: then `nested_uzawa` raises `ConvergenceError`, whose message names
+# the remedy `contact.hhat_factor = 2`.
+
+# %%
+gap0_runs = {1: [], 2: []}
+failure_messages = []
+for level in GAP0_LEVELS:
+    for factor, scene in gap0.items():
+        problem = assemble(scene, build_mesh(scene.geometry, level))
+        try:
+            solution = nested_uzawa(problem, "coulomb", mu_f=scene.friction.mu)
+            gap0_runs[factor].append({"level": level, "outer": solution.iterations["outer"],
+                                      "inner": solution.iterations["inner"],
+                                      "converged": solution.converged})
+        except ConvergenceError as error:
+            failure_messages.append(f"level {level}, h^ = {factor} h~: {error}")
+            gap0_runs[factor].append({"level": level, "outer": len(error.history),
+                                      "inner": None, "converged": False})
+    print(f"level {level}: outer iterations h^ = h~: {gap0_runs[1][-1]['outer']:5d} "
+          f"(converged {gap0_runs[1][-1]['converged']}), h^ = 2h~: "
+          f"{gap0_runs[2][-1]['outer']:4d} (converged {gap0_runs[2][-1]['converged']})")
+for message in failure_messages:
+    print(message)
+
+fig, ax = plt.subplots(figsize=(6, 4))
+for factor, marker in ((1, "s--"), (2, "o-")):
+    rows = gap0_runs[factor]
+    ax.semilogy([r["level"] for r in rows], [r["outer"] for r in rows], marker,
+                label=f"ĥ = {factor}h̃" if factor > 1 else "ĥ = h̃")
+    failed = [r for r in rows if not r["converged"]]
+    ax.semilogy([r["level"] for r in failed], [r["outer"] for r in failed], "rx", ms=12)
+ax.set_xlabel("level")
+ax.set_ylabel("outer iterations (x: ConvergenceError)")
+ax.set_xticks(GAP0_LEVELS)
+ax.set_title("Coulomb, g = 0: nested Uzawa")
+ax.grid(True, which="both", alpha=0.3)
+ax.legend()
+save_figure(fig, OUT / "gap0_iterations.png")
+
+# %%
+results = {
+    "quick": QUICK, "level": LEVEL, "mu_f": mu_f,
+    "box_projection_qp_difference": box_qp_difference,
+    "iterations": {law: {order: runs[order].iterations for order in LOOP_ORDERS}
+                   for law, runs in (("tresca", tresca_runs), ("coulomb", coulomb_runs))},
+    "converged": {law: all(runs[o].converged for o in LOOP_ORDERS)
+                  for law, runs in (("tresca", tresca_runs), ("coulomb", coulomb_runs))},
+    "loop_order_difference": loop_order_difference,
+    "agreement": agreement,
+    "active_set_difference": active_set_difference,
+    "qp_fixed_point_history": qp_coulomb.history,
+    "fixed_point_residual": fixed_point_residual,
+    "conditions": conditions,
+    "summaries": summaries,
+    "inf_sup": [{"level": r["level"], "hhat_h": {k: r[1][k] for k in ("N_A", "N_C", "beta")},
+                 "hhat_2h": {k: r[2][k] for k in ("N_A", "N_C", "beta")},
+                 "kernel_hhat_h": r[1]["kernel"]} for r in inf_sup_rows],
+    "inf_sup_inner": {k: inner[k] for k in ("N_A", "N_C", "beta")},
+    "gap0": {"hhat_h": gap0_runs[1], "hhat_2h": gap0_runs[2]},
+    "failure_messages": failure_messages,
+}
+print(f"wrote {save_results('03_friction', results)}")
+
+# %% [markdown]
+# ## Exercises
+# Solutions: `tutorials/solutions/03_friction_solutions.py`.
+#
+# 1. **Step lengths.** For Coulomb friction on level 3, count the outer and inner
+#    iterations of both loop orders for ρ₁ ∈ {0.5, 1, 1.5} and ρ₂ ∈ {0.25, 0.5, 1, 1.5}
+#    (cf. Fig. 3.23). Which loop order is cheaper, counted in inner iterations (each is
+#    one solve)? What happens for ρ₂ = 2.5, beyond the bound of Theorem 3.42?
+# 2. **ĥ = h̃ is fine under (3.73).** Solve `thesis-3.46-coulomb-gap-abs` (g = |x₁|) with
+#    `contact.hhat_factor` 1 and 2 on level 4 and compare λ_n, λ_t and ν (Figs. 3.26-3.28).
+#    Why do both converge here, unlike for g = 0?
+# 3. **The friction coefficient.** Solve the Coulomb scene for μ_f ∈ {0, 0.1, 0.25, 0.5,
+#    1} (`friction.mu`). How do the numbers of stick and slip nodes and the total force
+#    F_abs = ∫_{A_C}|σ_n| + |σ_t| change? Check that μ_f = 0 reproduces the frictionless
+#    Uzawa solution of Tutorial 2.

@@ -1,0 +1,399 @@
+# %% [markdown]
+# # Tutorial 4: The a posteriori error estimator of Chapter 4
+#
+# **Problem.** Given a discrete solution (σ_h, ν_h; u_h, η_h, φ_h, λ_t, λ_n) of (3.62),
+# how large is its error, and *where* is it made? Theorem 4.8 bounds the error in
+# X × H^{-1/2}(A_C) × Ỹ by computable local quantities,
+#
+#     ‖error‖ ≤ C Σ_T η_{tot,T},   η²_{tot,T} = η²_{σ,T} + η²_{u,T} + η²_{𝓕,T} + η²_{N,T}
+#
+# ((4.49)-(4.50))
+#
+# with η_{σ,T} of (4.15) (residuals of the stress equations), η_{u,T} of (4.31)
+# (residuals of the displacement), the friction term ĥ‖σ_t − 𝓕ν‖² on A_C and the
+# Neumann term log(1 + C̃_N) h̃‖σn − t₀‖² on Γ_N.
+#
+# **Discretisation.** PEERS (3.61) on the fine mesh, P1 multipliers on the coarse
+# boundary meshes. The indicators are element and edge integrals of the discrete fields;
+# `w_h = C⁻¹σ_h + η_h` (the rotation as a skew tensor) approximates ∇u.
+#
+# **What you will learn.**
+# 1. Every term of (4.50): what residual it measures, and where on the mesh it lives
+#    (Example 3.46 with Coulomb friction: corners, Γ_N, the ends of Γ_C, A_C).
+# 2. `ngdual.estimator.estimate` returns one array per term and element (an
+#    `Estimate`); how to sum, split and plot it.
+# 3. The *effectivity index* η / error on a smooth problem with known solution: it stays
+#    in a narrow band, and η decreases at the rate of the error.
+# 4. Why ngdual measures the asymmetry as(σ_h) in L² and not in H(div) as printed in
+#    (4.15): for PEERS ‖div as(σ_h)‖ does not tend to zero (cf. Table 4.2).
+#
+# **References.** M. Andres (2011), Chapter 4: eqs. (4.15), (4.31), (4.49)-(4.50),
+# Theorems 4.2 and 4.8, Table 4.2. C. Carstensen, G. Dolzmann, *A posteriori error
+# estimates for mixed FEM in elasticity*, Numer. Math. 81 (1998). G. N. Gatica, L. F.
+# Gatica, E. P. Stephan, *A dual-mixed finite element method for nonlinear incompressible
+# elasticity with mixed boundary conditions*, CMAME 196 (2007). R. Verfürth, *A posteriori
+# error estimation techniques for finite element methods* (2013).
+
+# %%
+import math
+
+import matplotlib.pyplot as plt
+import matplotlib.tri as mtri
+import ngsolve as ngs
+import numpy as np
+from matplotlib.colors import LogNorm
+
+from ngdual.estimator import OTHER_TERMS, SIGMA_TERMS, TERMS, U_TERMS, estimate
+from ngdual.expr import Expression
+from ngdual.post import fields
+from ngdual.scene import Geometry, Loads, Material, Scene, load_scene, validate
+from ngdual.solve import solve_scene
+from ngdual.tutorials import draw, output_dir, quick_mode, save_figure, save_results
+
+# %% [markdown]
+# ## Parameters
+
+# %%
+QUICK = quick_mode()
+THESIS_LEVEL = 3 if QUICK else 4              # Example 3.46 for the pictures of every term
+LEVELS = [1, 2, 3] if QUICK else [1, 2, 3, 4, 5]   # uniform levels of the smooth problem
+E, NU, MAXH = 100.0, 0.3, 0.4                 # material and mesh size of the smooth problem
+OUT = output_dir("04_estimator")
+print(f"quick mode: {QUICK}; output in {OUT}")
+
+# %% [markdown]
+# ## 1. The terms of (4.50)
+#
+# With t the unit tangent, [·] the jump across an interior edge, u_Γ the value of the
+# piecewise constant u_h at a boundary edge and h̃_e the coarse edge holding e:
+#
+# | name | formula | residual of |
+# |---|---|---|
+# | `residual` | ‖f + div σ_h‖²_T | equilibrium div σ = −f |
+# | `asymmetry` | ‖as(σ_h)‖²_T | symmetry of σ (see Section 4) |
+# | `curl` | h_T² ‖curl w_h‖²_T | w_h = ∇u is a gradient |
+# | `jump_interior` | Σ h_e ‖[w_h t]‖²_e | tangential continuity of ∇u |
+# | `jump_dirichlet` | Σ h_e ‖w_h t − ∂_t u_D‖²_e | u = u_D on Γ_D |
+# | `jump_neumann` | Σ h_e ‖w_h t + ∂_t φ‖²_e | φ = −u on Γ_N |
+# | `jump_contact` | Σ h_e ‖w_h t + ∂_tλ_t t + ∂_t(λ_n − g) n‖²_e | λ = −u on Γ_C (λ_n − g = −u_n) |
+# | `u_volume` | h_T² ‖w_h‖²_T | (4.31): u_h against ∇u |
+# | `u_dirichlet`, `u_neumann`, `u_contact` | Σ h_e ‖…‖²_e | the same traces for u_Γ itself |
+# | `friction` | Σ h̃_e ‖σ_t − 𝓕ν‖²_e on A_C | (3.62)₅ pointwise |
+# | `neumann` | log(1+C̃_N) Σ h̃_e ‖σn − t₀‖²_e | the traction t₀ on Γ_N |
+#
+# The first seven make η_{σ,T} (4.15), the next four η_{u,T} (4.31). Every array of an
+# `Estimate` holds the *squared* contribution per element, so η²_{tot,T} is their sum.
+
+# %%
+print("sigma terms (4.15):", SIGMA_TERMS)
+print("u terms (4.31):    ", U_TERMS)
+print("others of (4.50):  ", OTHER_TERMS)
+
+# %% [markdown]
+# ## 2. Every term on Example 3.46 with Coulomb friction
+#
+# One solve, one call of `estimate`. The squared terms summed over the mesh show which
+# of them dominate η; the pictures show where.
+
+# %%
+thesis = load_scene("thesis-3.46-coulomb")
+solution = solve_scene(thesis, THESIS_LEVEL)
+est = estimate(solution)
+mesh = solution.problem.fes.mesh
+summed = est.summed()
+print(f"level {THESIS_LEVEL}: {mesh.ne} triangles, eta = {est.total:.4e}, "
+      f"estimated in {est.seconds:.2f} s")
+for name, value in sorted(summed.items(), key=lambda item: -item[1]):
+    print(f"  {name:15s} {math.sqrt(value):10.3e}   ({100 * value / est.total**2:5.1f} % of eta^2)")
+assert np.allclose(est.eta**2, sum(est.terms.values()))
+
+
+# %% [markdown]
+# Two observations. `residual` vanishes: f = 0 is piecewise constant, and div σ_h = −Π₀f
+# holds exactly in PEERS (the second row of (3.62)). And η mixes units: the terms in σ
+# (`asymmetry`, `friction`, `neumann`) are stresses, of the size of t₀ ≈ 800, while the
+# terms in w_h ≈ ∇u are strains, about E ≈ 2·10⁵ times smaller. The stress terms decide
+# where η is large, as the thesis observed for Figs. 4.1-4.8. The pictures use one
+# logarithmic colour scale per term; white elements have a zero (or round-off) indicator.
+
+# %%
+def mesh_arrays(mesh: ngs.Mesh) -> mtri.Triangulation:
+    """The NGSolve mesh as a matplotlib triangulation (triangles in element order)."""
+    points = np.array([v.point for v in mesh.vertices])
+    triangles = np.array([[v.nr for v in el.vertices] for el in mesh.Elements(ngs.VOL)])
+    return mtri.Triangulation(points[:, 0], points[:, 1], triangles)
+
+
+def plot_terms(mesh, terms: dict, path, title: str, columns: int = 2) -> None:
+    """One tripcolor panel per (squared) indicator term, log colour scale, zeros blank."""
+    tri = mesh_arrays(mesh)
+    width = np.ptp(tri.x) / np.ptp(tri.y)
+    rows = math.ceil(len(terms) / columns)
+    largest = max(float(np.max(values)) for values in terms.values())
+    fig, axes = plt.subplots(rows, columns, figsize=(6.5 * columns, 6.5 * rows / width + 1.2),
+                             squeeze=False)
+    for ax, (name, values) in zip(axes.flat, terms.items()):
+        positive = values[values > 0]
+        ax.set_aspect("equal")
+        ax.set_xticks([])
+        ax.set_yticks([])
+        ax.triplot(tri, color="0.85", lw=0.2)
+        if positive.size == 0 or positive.max() <= 1e-12 * largest:
+            ax.set_title(f"{name}: zero up to round-off", fontsize=9)
+            continue
+        top = positive.max()
+        masked = np.ma.masked_less_equal(values, 1e-8 * top)
+        art = ax.tripcolor(tri, facecolors=masked, norm=LogNorm(1e-8 * top, top),
+                           cmap="viridis", edgecolors="none")
+        fig.colorbar(art, ax=ax, fraction=0.03, pad=0.01)
+        ax.set_title(f"{name}: sum {np.sum(values):.2e}", fontsize=9)
+    for ax in list(axes.flat)[len(terms):]:
+        ax.axis("off")
+    fig.suptitle(title)
+    fig.tight_layout()
+    save_figure(fig, path)
+
+
+plot_terms(mesh, {"eta_tot^2": est.eta**2, **est.terms}, OUT / "terms_thesis_coulomb.png",
+           f"Squared indicators of (4.50), Example 3.46, mu_f = 0.5, level {THESIS_LEVEL}")
+eta_gf = ngs.GridFunction(ngs.L2(mesh, order=0))
+eta_gf.vec.FV().NumPy()[:] = est.eta
+draw(eta_gf, mesh, "eta_tot")
+
+# %% [markdown]
+# What the pictures show (compare the discussion of Figs. 4.1-4.8):
+#
+# * `asymmetry`, `curl` and the jumps peak in the corners, where the boundary
+#   conditions change and σ is singular. `asymmetry` is largest in the two lower
+#   corners, where Γ_D meets Γ_C (Table 4.2). There λ_n ∈ C_h̃ must vanish, i.e.
+#   u_n = g = 0.01, while u = 0 on Γ_D: the data jump, σ ~ 1/r is not square
+#   integrable, and these indicators do not decrease under refinement (Exercise 2,
+#   Tutorial 5).
+# * `neumann` and `jump_neumann` live on the elements at Γ_N, largest where the
+#   traction t₀ switches off (x₁ = ±2) and at the ends of Γ_N.
+# * `friction` lives on the elements along Γ_C (A_C = supp 𝓕), where it measures how
+#   far the pointwise σ_t is from 𝓕ν: (3.62)₅ holds only tested with the hats.
+# * `jump_contact` and `u_contact` live on Γ_C too, the former largest at the ends of
+#   Γ_C, where λ_n must vanish (C_h̃ of (3.61)) while the body hangs above the gap.
+#
+# ## 3. A smooth problem with a known solution
+#
+# To measure the effectivity index η/e we need the exact error e. The manufactured
+# problem of `tests/test_manufactured_convergence.py`: the convex pentagon with corners
+# (0,0), (2,0), (2,1), (1,2), (0,1), Neumann side from (2,1) to (1,2), Dirichlet
+# elsewhere, and the polynomial displacement
+#
+#     u = Curl ψ + w/λ,   ψ = |x − p₁|²|x − p₂|²,   w = (x² − 3x + y² − 3y + 4, x² + xy − 3x),
+#
+# p₁ = (2,1), p₂ = (1,2): u, σ, f and t₀ are polynomials, u vanishes at the ends of Γ_N.
+# A few lines of exact polynomial arithmetic (2-D NumPy coefficient arrays c[i, j] of
+# xⁱyʲ) produce the scene formulas.
+
+# %%
+P2 = np.polynomial.polynomial
+
+
+def poly(terms: dict) -> np.ndarray:
+    """{(i, j): c} -> coefficient array of sum c x^i y^j."""
+    out = np.zeros((5, 5))
+    for (i, j), c in terms.items():
+        out[i, j] = c
+    return out
+
+
+def pad(a: np.ndarray, shape=(9, 9)) -> np.ndarray:
+    out = np.zeros(shape)
+    out[:a.shape[0], :a.shape[1]] = a
+    return out
+
+
+def mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    out = np.zeros((a.shape[0] + b.shape[0] - 1, a.shape[1] + b.shape[1] - 1))
+    for (i, j), c in np.ndenumerate(a):
+        out[i:i + b.shape[0], j:j + b.shape[1]] += c * b
+    return pad(out[:9, :9])
+
+
+def dx(a):
+    return pad(P2.polyder(a, axis=0))
+
+
+def dy(a):
+    return pad(P2.polyder(a, axis=1))
+
+
+def text(a: np.ndarray) -> str:
+    """A scene formula in x, y (see ngdual.expr)."""
+    terms = (f"({float(c)!r})*x**{i}*y**{j}" for (i, j), c in np.ndenumerate(a) if c)
+    return " + ".join(terms) or "0"
+
+
+POINTS = [(0.0, 0.0), (2.0, 0.0), (2.0, 1.0), (1.0, 2.0), (0.0, 1.0)]
+SIDES = ["bottom", "right", "roof_right", "roof_left", "left"]
+lam, mu = Material(E, NU).lame
+q1 = pad(poly({(2, 0): 1, (1, 0): -4, (0, 2): 1, (0, 1): -2, (0, 0): 5}))   # |x - (2,1)|^2
+q2 = pad(poly({(2, 0): 1, (1, 0): -2, (0, 2): 1, (0, 1): -4, (0, 0): 5}))   # |x - (1,2)|^2
+psi = mul(q1, q2)
+w = [pad(poly({(2, 0): 1, (1, 0): -3, (0, 2): 1, (0, 1): -3, (0, 0): 4})),
+     pad(poly({(2, 0): 1, (1, 1): 1, (1, 0): -3}))]
+u = [dy(psi) + w[0] / lam, -dx(psi) + w[1] / lam]
+grad = [[dx(u[0]), dy(u[0])], [dx(u[1]), dy(u[1])]]
+div_u = grad[0][0] + grad[1][1]
+sigma = [[mu * (grad[i][j] + grad[j][i]) + (lam * div_u if i == j else 0) for j in range(2)]
+         for i in range(2)]
+div_sigma = [dx(sigma[i][0]) + dy(sigma[i][1]) for i in range(2)]
+rotation = 0.5 * (grad[0][1] - grad[1][0])
+normal = np.array([1.0, 1.0]) / math.sqrt(2)                # outward normal of roof_right
+smooth = Scene(name="pentagon-manufactured",
+               geometry=Geometry(kind="polygon", points=POINTS, labels=SIDES, maxh=MAXH),
+               boundary={"dirichlet": ["bottom", "right", "roof_left", "left"],
+                         "neumann": ["roof_right"]},
+               material=Material(E=E, nu=NU),
+               loads=Loads(body_force=[text(-d) for d in div_sigma],
+                           traction=[text(normal[0] * sigma[i][0] + normal[1] * sigma[i][1])
+                                     for i in range(2)],
+                           displacement=[text(c) for c in u]))
+validate(smooth)
+
+
+def cf(a: np.ndarray) -> ngs.CoefficientFunction:
+    return Expression(text(a)).coefficient()
+
+
+EXACT = {"sigma": ngs.CF(tuple(cf(sigma[i][j]) for i in range(2) for j in range(2)), dims=(2, 2)),
+         "div_sigma": ngs.CF(tuple(cf(d) for d in div_sigma)),
+         "u": ngs.CF(tuple(cf(c) for c in u)), "eta": cf(rotation)}
+
+
+def exact_error(solution) -> float:
+    """e = (||sigma - sigma_h||^2 + ||div(sigma - sigma_h)||^2 + ||u - u_h||^2
+    + ||eta - eta_h||^2)^(1/2), computed exactly (polynomials, order 8)."""
+    f = fields(solution)
+    m = solution.problem.fes.mesh
+    diffs = (EXACT["sigma"] - f.sigma, EXACT["div_sigma"] - f.div_sigma, EXACT["u"] - f.u,
+             EXACT["eta"] - f.eta)
+    return math.sqrt(sum(ngs.Integrate(ngs.InnerProduct(d, d), m, order=8) for d in diffs))
+
+
+print(f"u_1 = {text(u[0])[:90]}...")
+
+# %% [markdown]
+# ## 4. Effectivity under uniform refinement
+#
+# For each level: the exact error e, the estimator η = (Σ_T η²_{tot,T})^{1/2} and the
+# effectivity index η/e. Reliability (Theorem 4.8) says η/e is bounded below; a good
+# estimator is also *efficient*, η/e bounded above, so that the index stays in a band.
+
+# %%
+rows = []
+for level in LEVELS:
+    solution_s = solve_scene(smooth, level)
+    l2, hdiv = estimate(solution_s), estimate(solution_s, asymmetry="hdiv")
+    rows.append({"level": level, "ndof": int(sum(solution_s.problem.spaces.dofs().values())),
+                 "error": exact_error(solution_s), "eta": l2.total, "eta_hdiv": hdiv.total,
+                 "terms": {k: math.sqrt(v) for k, v in l2.summed().items()},
+                 "as_l2": math.sqrt(l2.summed()["asymmetry"]),
+                 "as_hdiv": math.sqrt(hdiv.summed()["asymmetry"])})
+for prev, row in zip(rows, rows[1:]):
+    row["rate_error"] = math.log2(prev["error"] / row["error"])
+    row["rate_eta"] = math.log2(prev["eta"] / row["eta"])
+effectivity = [row["eta"] / row["error"] for row in rows]
+print(f"{'level':>5} {'ndof':>7} {'error':>10} {'eta':>10} {'eta/e':>6} {'rate e':>7} "
+      f"{'rate eta':>8}")
+for row, eff in zip(rows, effectivity):
+    rates = (f"{row['rate_error']:7.2f} {row['rate_eta']:8.2f}" if "rate_error" in row
+             else f"{'':>7} {'':>8}")
+    print(f"{row['level']:5d} {row['ndof']:7d} {row['error']:10.3e} {row['eta']:10.3e} "
+          f"{eff:6.3f} {rates}")
+print(f"effectivity band: [{min(effectivity):.3f}, {max(effectivity):.3f}]")
+
+# %% [markdown]
+# The error halves with h (first order, Theorem 3.35), and so does η: the effectivity
+# index hardly moves. Which terms make up η here? No contact, so the contact and
+# friction terms vanish; the rates show that every term decays at first order
+# (log₂ of the ratio between successive levels):
+
+# %%
+active_terms = [k for k in TERMS if rows[-1]["terms"][k] > 1e-12 * rows[-1]["eta"]]
+print(f"{'term':15s} " + " ".join(f"{'level ' + str(r['level']):>10}" for r in rows) + "   rate")
+for name in active_terms:
+    values = [r["terms"][name] for r in rows]
+    print(f"{name:15s} " + " ".join(f"{v:10.3e}" for v in values)
+          + f"   {math.log2(values[-2] / values[-1]):4.2f}")
+
+fig, ax = plt.subplots(figsize=(6.5, 4.5))
+ndofs = [r["ndof"] for r in rows]
+ax.loglog(ndofs, [r["error"] for r in rows], "o-", label="error e")
+ax.loglog(ndofs, [r["eta"] for r in rows], "s-", label=r"$\eta$, as($\sigma_h$) in $L^2$")
+ax.loglog(ndofs, [r["eta_hdiv"] for r in rows], "^--",
+          label=r"$\eta$, as($\sigma_h$) in $H(\mathrm{div})$ (4.15)")
+ax.loglog(ndofs, [rows[0]["error"] * (n / ndofs[0]) ** -0.5 for n in ndofs], "k:",
+          label=r"$N^{-1/2}$ (first order in h)")
+ax.set_xlabel("degrees of freedom N")
+ax.set_ylabel("error / estimator")
+ax.set_title("Smooth problem on the pentagon, uniform refinement")
+ax.grid(True, which="both", alpha=0.3)
+ax.legend(fontsize=8)
+save_figure(fig, OUT / "effectivity.png")
+
+# %% [markdown]
+# ## 5. Why as(σ_h) is measured in L²
+#
+# (4.15) as printed uses ‖as(σ_h)‖²_{H(div,T)} = ‖as(σ_h)‖²_T + ‖div as(σ_h)‖²_T. For
+# the skew part as(σ_h) = [[0, a], [−a, 0]], a = (σ₁₂ − σ₂₁)/2, div as(σ_h) = ∇a up to a
+# rotation. Now look at the RT₀ part of a PEERS row on T: r_i = p_i + c_i(x − x_T), with
+# div r_i = 2c_i = −f̄_i (the mean of f on T, by the second row of (3.62)). Then
+# σ₁₂ − σ₂₁ contains c₁(y − y_T) − c₂(x − x_T), whose gradient (−c₂, c₁) has length
+# |f̄|/2: |∇a| ≈ |f̄_T|/4 on *every* element, whatever h. The Curl bubbles do not remove
+# it. So ‖div as(σ_h)‖ stays of the size ‖f‖/4 although as(σ) = 0, and η with the
+# H(div) norm stalls while the error keeps decreasing: its effectivity index grows like
+# 1/h. With the L² norm (Carstensen-Dolzmann, Gatica et al.) the asymmetry decreases at
+# first order like every other term. This is `asymmetry="l2"`, the default.
+
+# %%
+mesh1 = solve_scene(smooth, LEVELS[0]).problem.fes.mesh
+body = ngs.CF(tuple(cf(-d) for d in div_sigma))
+quarter_f = 0.25 * math.sqrt(ngs.Integrate(body * body, mesh1, order=8))
+hdiv_ratio = [r["eta_hdiv"] / r["error"] for r in rows]
+print(f"||f||/4 = {quarter_f:.3e}")
+print(f"{'level':>5} {'|as|_L2':>10} {'|as|_Hdiv':>10} {'/ (||f||/4)':>11} {'eta_Hdiv/e':>10}")
+for row, ratio in zip(rows, hdiv_ratio):
+    print(f"{row['level']:5d} {row['as_l2']:10.3e} {row['as_hdiv']:10.3e} "
+          f"{row['as_hdiv'] / quarter_f:11.2f} {ratio:10.2f}")
+
+# %% [markdown]
+# ‖as(σ_h)‖_{H(div)} stays at about ‖f‖/4 on every level (the bubbles add a little),
+# while ‖as(σ_h)‖_{L²} halves with h. The H(div) effectivity index
+# roughly doubles per level. This is the growth of η_as^max that the thesis observed in
+# Table 4.2 and blamed for the poor effectivity indices of Table 4.4.
+
+# %%
+results = {
+    "quick": QUICK, "levels": LEVELS,
+    "thesis": {"level": THESIS_LEVEL, "eta": est.total, "summed": summed,
+               "elements": mesh.ne,
+               "sum_of_terms_is_eta2": bool(np.allclose(est.eta**2, sum(est.terms.values()))),
+               "friction_elements": int(np.count_nonzero(est.terms["friction"])),
+               "neumann_elements": int(np.count_nonzero(est.terms["neumann"]))},
+    "smooth": rows, "effectivity": effectivity, "hdiv_effectivity": hdiv_ratio,
+    "quarter_f": quarter_f,
+}
+print(f"wrote {save_results('04_estimator', results)}")
+
+# %% [markdown]
+# ## Exercises
+# Solutions: `tutorials/solutions/04_estimator_solutions.py`.
+#
+# 1. **Patch test.** For an affine displacement u = Gx + c (G not symmetric) PEERS
+#    reproduces σ and η exactly. Build such a scene on the pentagon (u_D = u on Γ_D, the
+#    traction σn on the Neumann side, f = 0) and check that every term of η_{σ,T} and the
+#    Neumann term vanish, while η_{u,T} does not. Why can η_{u,T} not vanish?
+# 2. **Table 4.2.** On Example 3.46 with Coulomb friction, levels 1-4 (uniform), compute
+#    η_as^max = max_T η_{as,T} and q_as, the share of triangles with η_{as,T} ≥ 0.1 η_as^max,
+#    with as(σ_h) in L² and in H(div). Where is the maximum attained?
+# 3. **Sum or square root of the sum of squares?** Theorem 4.8 bounds the error by
+#    Σ_T η_{tot,T} (`Estimate.total_sum`, the η_tot of Table 4.4), not by
+#    (Σ_T η²_{tot,T})^{1/2} (`Estimate.total`). Compute the ratio of the two under uniform
+#    refinement for the smooth clamped square of Tutorial 1 and for Example 3.46 without
+#    friction, and compare it with √(number of triangles). What does this mean for an
+#    effectivity index computed with Σ_T η_{tot,T}?

@@ -1,0 +1,136 @@
+# %% [markdown]
+# # Solutions to Tutorial 4: The a posteriori error estimator of Chapter 4
+#
+# Each exercise is one section; all run in seconds with `NGDUAL_QUICK=1`.
+
+# %%
+import math
+
+import ngsolve as ngs
+import numpy as np
+
+from ngdual.estimator import SIGMA_TERMS, U_TERMS, estimate
+from ngdual.scene import Geometry, Loads, Material, Scene, load_scene, validate
+from ngdual.solve import solve_scene
+from ngdual.tutorials import output_dir, quick_mode, save_results
+
+QUICK = quick_mode()
+LEVELS = [1, 2, 3] if QUICK else [1, 2, 3, 4]
+OUT = output_dir("04_estimator_solutions")
+
+# %% [markdown]
+# ## Exercise 1: the patch test
+#
+# For u = Gx + c the stress σ = C ε(u) is constant and the rotation η = (G₁₂ − G₂₁)/2 is
+# constant: both lie in the PEERS spaces, and the discrete solution reproduces them.
+# Then w_h = C⁻¹σ_h + η_h = G exactly, and every residual of (4.15) vanishes: f + div σ_h
+# = 0, as(σ_h) = 0, curl G = 0, no jumps, w_h t = ∂_t u_D on Γ_D, σn = t₀ on Γ_N.
+# η_{u,T} cannot vanish: u_h is piecewise *constant* and cannot represent an affine u.
+# h_T‖w_h‖_T measures exactly this O(h) error of u_h, and the trace terms compare u_h
+# on the boundary elements with u_D and φ.
+
+# %%
+E, NU = 100.0, 0.3
+PENTAGON = [(0.0, 0.0), (2.0, 0.0), (2.0, 1.0), (1.0, 2.0), (0.0, 1.0)]
+SIDES = ["bottom", "right", "roof_right", "roof_left", "left"]
+g = [[0.3, -0.2], [0.5, 0.1]]                              # not symmetric: eta = -0.35
+G = np.array(g)
+lam, mu = Material(E, NU).lame
+strain = 0.5 * (G + G.T)
+stress = 2 * mu * strain + lam * np.trace(strain) * np.eye(2)
+traction = stress @ np.array([1.0, 1.0]) / math.sqrt(2)   # sigma n on roof_right
+affine = Scene(name="affine-patch-test",
+               geometry=Geometry(kind="polygon", points=PENTAGON, labels=SIDES, maxh=0.5),
+               boundary={"dirichlet": ["bottom", "right", "roof_left", "left"],
+                         "neumann": ["roof_right"]},
+               material=Material(E, NU),
+               loads=Loads(traction=[repr(float(t)) for t in traction],
+                           displacement=[f"{g[0][0]!r}*x + {g[0][1]!r}*y + 0.1",
+                                         f"{g[1][0]!r}*x + {g[1][1]!r}*y - 0.2"]))
+validate(affine)
+patch = estimate(solve_scene(affine, 1)).summed()
+sigma_part = sum(patch[k] for k in (*SIGMA_TERMS, "neumann"))
+u_part = sum(patch[k] for k in U_TERMS)
+print(f"sigma terms and neumann: {sigma_part:.1e};  u terms: {u_part:.2e}")
+print({k: f"{v:.1e}" for k, v in patch.items()})
+
+# %% [markdown]
+# ## Exercise 2: Table 4.2
+#
+# η_{as,T} = ‖as(σ_h)‖_T (L²) or ‖as(σ_h)‖_{H(div,T)}. The maximum sits in the lower
+# corners, where Γ_D meets Γ_C: σ is singular there and PEERS approximates its symmetry
+# poorly. In L² the maximum stays about constant, in H(div) it grows: the ∇a part is
+# not weighted with h. The share q_as of triangles near the maximum shrinks with h: the
+# large indicators concentrate in the corners.
+
+# %%
+thesis = load_scene("thesis-3.46-coulomb")
+table_4_2 = []
+for level in LEVELS:
+    solution = solve_scene(thesis, level)
+    mesh = solution.problem.fes.mesh
+    centroids = np.array([np.mean([mesh[v].point for v in el.vertices], axis=0)
+                          for el in mesh.Elements(ngs.VOL)])
+    row = {"level": level}
+    for norm in ("l2", "hdiv"):
+        eta_as = np.sqrt(estimate(solution, asymmetry=norm).terms["asymmetry"])
+        where = centroids[np.argmax(eta_as)]
+        row[norm] = {"max": float(eta_as.max()),
+                     "q_as": float(np.mean(eta_as >= 0.1 * eta_as.max())),
+                     "argmax_xy": [float(where[0]), float(where[1])]}
+    table_4_2.append(row)
+    print(f"level {level}: L2 max {row['l2']['max']:9.3e} q_as {row['l2']['q_as']:.3f} at "
+          f"{np.round(row['l2']['argmax_xy'], 2)};  H(div) max {row['hdiv']['max']:9.3e} "
+          f"q_as {row['hdiv']['q_as']:.3f} at {np.round(row['hdiv']['argmax_xy'], 2)}")
+
+# %% [markdown]
+# ## Exercise 3: Σ η_T against (Σ η_T²)^{1/2}
+#
+# By Cauchy-Schwarz Σ_T η_T ≤ √N_T (Σ_T η_T²)^{1/2}, with near equality when the
+# indicators are about equal. For the smooth square (u = Curl ψ, ψ = x²(1−x)²y²(1−y)²,
+# clamped, the problem of Tutorial 1) they are, and under uniform refinement the ratio
+# grows like √N_T, by 2 per level: an effectivity index built on Σ_T η_T doubles per
+# level even though η/e is constant. Theorem 4.8 is a reliability statement; the ℓ² sum
+# (Σ η_T²)^{1/2} is what is comparable with the error. In Example 3.46 a few corner
+# elements carry most of η (σ is singular there, and η itself stops decreasing), so the
+# ratio grows more slowly, far below √N_T: the indicators are not equidistributed, which
+# is what adaptive refinement is for (Tutorial 5).
+
+# %%
+P = {"p": "(T**2*(1 - T)**2)", "dp": "(2*T - 6*T**2 + 4*T**3)",
+     "d2p": "(2 - 12*T + 12*T**2)", "d3p": "(24*T - 12)"}
+
+
+def term(first: str, second: str) -> str:
+    return P[first].replace("T", "x") + "*" + P[second].replace("T", "y")
+
+
+shear_modulus = Material(E, NU).lame[1]
+square = Scene(name="clamped-square",
+               geometry=Geometry(kind="polygon", points=[(0, 0), (1, 0), (1, 1), (0, 1)],
+                                 labels=["bottom", "right", "top", "left"], maxh=0.25),
+               boundary={"dirichlet": ["bottom", "right", "top", "left"]},
+               material=Material(E, NU),
+               loads=Loads(body_force=[f"-{shear_modulus}*({term('d2p', 'dp')} + "
+                                       f"{term('p', 'd3p')})",
+                                       f"{shear_modulus}*({term('d3p', 'p')} + "
+                                       f"{term('dp', 'd2p')})"]))
+validate(square)
+frictionless = load_scene("thesis-3.46-frictionless")
+ratios = {"square": [], "thesis": []}
+for level in LEVELS:
+    for name, scene in (("square", square), ("thesis", frictionless)):
+        indicators = estimate(solve_scene(scene, level))
+        ratios[name].append({"level": level, "elements": len(indicators.eta),
+                             "ratio": indicators.total_sum / indicators.total,
+                             "eta": indicators.total})
+    square_row, thesis_row = ratios["square"][-1], ratios["thesis"][-1]
+    print(f"level {level}: sum / sqrt(sum of squares) = {square_row['ratio']:7.2f} "
+          f"(square, sqrt(N_T) = {math.sqrt(square_row['elements']):6.2f}), "
+          f"{thesis_row['ratio']:7.2f} (Example 3.46, sqrt(N_T) = "
+          f"{math.sqrt(thesis_row['elements']):6.2f}, eta = {thesis_row['eta']:.1f})")
+
+# %%
+save_results("04_estimator_solutions",
+             {"patch_sigma": sigma_part, "patch_u": u_part, "table_4_2": table_4_2,
+              "sum_ratios": ratios})

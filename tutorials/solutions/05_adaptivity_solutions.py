@@ -1,0 +1,196 @@
+# %% [markdown]
+# # Solutions to Tutorial 5: Adaptive refinement
+#
+# Each exercise is one section; all run in seconds with `NGDUAL_QUICK=1`.
+
+# %%
+import math
+
+import ngsolve as ngs
+import numpy as np
+
+from ngdual.afem import adapt, convergence_rate, refine
+from ngdual.boundary import BoundaryMeshes
+from ngdual.estimator import estimate
+from ngdual.expr import Expression
+from ngdual.forms import assemble
+from ngdual.marking import mark
+from ngdual.mesh import build_mesh
+from ngdual.post import fields
+from ngdual.scene import Geometry, Loads, Material, Scene, load_scene, validate
+from ngdual.solve import solve_problem, solve_scene
+from ngdual.tutorials import output_dir, quick_mode, save_results
+
+QUICK = quick_mode()
+TARGET_DOFS = 1500 if QUICK else 8000       # Exercise 1: refine until N reaches this
+THETAS = [0.2, 0.5, 0.8]
+THESIS_STEPS = 3 if QUICK else 5            # Exercise 2
+CORNER_STEPS = 4 if QUICK else 9            # Exercise 3
+UNIFORM_LEVELS = [1, 2, 3] if QUICK else [1, 2, 3, 4]
+OUT = output_dir("05_adaptivity_solutions")
+
+
+def adapt_until(scene, marking, theta, max_dofs, level=1, indicator="eta", error=None,
+                max_steps=40):
+    """SOLVE-ESTIMATE-MARK-REFINE until N >= max_dofs, marking with any indicator array.
+
+    ``indicator`` names an `Estimate` attribute ("eta", "eta_sigma", "eta_u").
+    Returns one row (ndof, eta, error or None) per step and the last mesh.
+    """
+    mesh = build_mesh(scene.geometry, level)
+    coarse = BoundaryMeshes.for_scene(scene, mesh)
+    rows = []
+    for _ in range(max_steps):
+        solution = solve_problem(assemble(scene, mesh, coarse))              # SOLVE
+        indicators = estimate(solution)                                      # ESTIMATE
+        ndof = int(sum(solution.problem.spaces.dofs().values()))
+        rows.append({"ndof": ndof, "eta": indicators.total,
+                     "error": error(solution) if error else None})
+        if ndof >= max_dofs:
+            break
+        marked = mark(getattr(indicators, indicator), theta, marking)        # MARK
+        mesh = refine(mesh, marked)                                          # REFINE
+        coarse = coarse.follow(scene, mesh)
+    return rows, mesh
+
+
+# %% [markdown]
+# ## Exercise 1: the Dörfler parameter
+#
+# Every θ restores a rate close to the optimal 1/2 on the L-shape: the bulk criterion
+# refines around the corner whatever θ. Small θ refines few elements per step, so more
+# SOLVE steps are needed to reach the same N (each costing a solve), with a slightly
+# better error per unknown. Large θ refines more and more elements away from the corner;
+# θ = 1 marks every element with η_T > 0, i.e. uniform refinement, and the rate falls
+# back to α/2 ≈ 0.27. θ ≈ 0.5 is the usual compromise.
+
+# %%
+E, NU = 1.0, 0.3
+OMEGA = 3 * math.pi / 4
+L_POINTS = [(-1, -1), (0, -1), (0, 0), (1, 0), (1, 1), (-1, 1)]
+L_LABELS = ["bottom", "corner_v", "corner_h", "right", "top", "left"]
+
+
+def corner_exponent() -> float:
+    alpha = 0.5
+    for _ in range(30):
+        alpha -= ((math.sin(2 * OMEGA * alpha) + alpha * math.sin(2 * OMEGA))
+                  / (2 * OMEGA * math.cos(2 * OMEGA * alpha) + math.sin(2 * OMEGA)))
+    return alpha
+
+
+def corner_displacement() -> list[str]:
+    """Williams' mode I at the re-entrant corner (as in Tutorial 5)."""
+    a, (_, mu) = corner_exponent(), Material(E, NU).lame
+    kappa = 3 - 4 * NU
+    b = -math.cos((a + 1) * OMEGA) / math.cos((a - 1) * OMEGA)
+    r, th = "sqrt(x*x + y*y)", "atan2(-(x + y), y - x)"
+    ph = f"({th} + {OMEGA!r})"
+    ur = (f"({r})**{a!r}*(-({a + 1!r})*cos({a + 1!r}*{th}) "
+          f"+ ({(kappa - a) * b!r})*cos({a - 1!r}*{th}))/{2 * mu!r}")
+    ut = (f"({r})**{a!r}*(({a + 1!r})*sin({a + 1!r}*{th}) "
+          f"+ ({(kappa + a) * b!r})*sin({a - 1!r}*{th}))/{2 * mu!r}")
+    return [f"({ur})*cos({ph}) - ({ut})*sin({ph})", f"({ur})*sin({ph}) + ({ut})*cos({ph})"]
+
+
+l_shape = Scene("l-shape-corner", Geometry(kind="polygon", points=L_POINTS, labels=L_LABELS,
+                                           maxh=0.5),
+                {"dirichlet": ["bottom", "right", "top", "left"],
+                 "neumann": ["corner_v", "corner_h"]},
+                material=Material(E, NU), loads=Loads(displacement=corner_displacement()))
+validate(l_shape)
+u_exact = ngs.CF(tuple(Expression(c).coefficient() for c in corner_displacement()))
+grad_u = ngs.CF((u_exact[0].Diff(ngs.x), u_exact[0].Diff(ngs.y),
+                 u_exact[1].Diff(ngs.x), u_exact[1].Diff(ngs.y)), dims=(2, 2))
+lam_l, mu_l = Material(E, NU).lame
+strain = 0.5 * (grad_u + grad_u.trans)
+sigma_exact = 2 * mu_l * strain + lam_l * ngs.Trace(strain) * ngs.Id(2)
+eta_exact = 0.5 * (grad_u[0, 1] - grad_u[1, 0])
+
+
+def exact_error(solution) -> float:
+    f = fields(solution)
+    mesh = solution.problem.fes.mesh
+
+    def integral(cf):
+        return ngs.Integrate(cf * ngs.dx(bonus_intorder=6), mesh)
+
+    return math.sqrt(integral(ngs.InnerProduct(sigma_exact - f.sigma, sigma_exact - f.sigma))
+                     + integral(f.div_sigma * f.div_sigma)
+                     + integral((u_exact - f.u) * (u_exact - f.u))
+                     + integral((eta_exact - f.eta) ** 2))
+
+
+dorfler = {}
+for theta in THETAS:
+    rows, _ = adapt_until(l_shape, "dorfler", theta, TARGET_DOFS, error=exact_error)
+    ndofs, errors = [r["ndof"] for r in rows], [r["error"] for r in rows]
+    dorfler[str(theta)] = {"steps": len(rows), "ndof": ndofs[-1], "error": errors[-1],
+                           "rate": convergence_rate(ndofs[-3:], errors[-3:])}
+    row = dorfler[str(theta)]
+    print(f"theta = {theta}: {row['steps']:2d} SOLVE steps to N = {row['ndof']:5d}, error "
+          f"{row['error']:.3e}, rate (last 3 steps) {row['rate']:.3f}")
+
+# %% [markdown]
+# ## Exercise 2: which terms refine Example 3.46?
+#
+# Marking with η_{σ,T} alone leaves out η_{u,T} (tiny here: strains, not stresses) and,
+# more importantly, the friction term on Γ_C and the Neumann term on Γ_N. Without them
+# the refinement goes to the corners (asymmetry) and much less along Γ_N and Γ_C: the
+# Neumann term pulls the refinement to where t₀ switches off, the friction term to the
+# contact boundary. Counted below: the fine edges on Γ_N (top) and Γ_C (bottom) of the
+# final meshes.
+
+
+# %%
+def edges_on(mesh: ngs.Mesh, label: str) -> int:
+    return sum(1 for el in mesh.Elements(ngs.BND) if el.mat == label)
+
+
+thesis = load_scene("thesis-3.46-coulomb")
+by_indicator = {}
+for indicator in ("eta", "eta_sigma"):
+    rows, mesh = adapt_until(thesis, "fraction", 0.2, 10**9, level=2, indicator=indicator,
+                             max_steps=THESIS_STEPS)
+    by_indicator[indicator] = {"elements": mesh.ne, "top_edges": edges_on(mesh, "top"),
+                               "bottom_edges": edges_on(mesh, "bottom"),
+                               "eta": [r["eta"] for r in rows]}
+    row = by_indicator[indicator]
+    print(f"marking with {indicator:9s}: {row['elements']} triangles, {row['top_edges']} "
+          f"edges on Gamma_N, {row['bottom_edges']} on Gamma_C; eta_tot "
+          f"{row['eta'][0]:.3e} -> {row['eta'][-1]:.3e}")
+
+# %% [markdown]
+# ## Exercise 3: the corners of Example 3.46
+#
+# With g = 0.01 the multiplier λ_n ∈ C_h̃ vanishes at the ends of Γ_C, so u_n = g there,
+# while u = 0 on Γ_D: the displacement jumps at the lower corners and σ ~ 1/r is not
+# square integrable. Under uniform refinement the asymmetry indicator of the corner
+# element stays at the same value, and η stalls (rate near 0). With g = 0 the data are
+# compatible: the largest asymmetry indicator shrinks with h and η decreases fast.
+# Dörfler marking first chases the largest η_{tot,T}, which for g = 0 sit at the ends of
+# Γ_N (the Neumann terms), and reaches the lower corners only after a few steps: the
+# quick run is still pre-asymptotic. Over 9 steps (without `NGDUAL_QUICK`) η decreases
+# at a rate of about 0.7 for g = 0, while for g = 0.01 it stalls near 420, its largest
+# asymmetry indicator frozen at about 160.
+
+# %%
+corners = {}
+for gap in ("0.01", "0"):
+    scene = load_scene("thesis-3.46-frictionless", [f"contact.gap='{gap}'"])
+    uniform = [estimate(solve_scene(scene, level)) for level in UNIFORM_LEVELS]
+    history = adapt(scene, "dorfler", 0.5, CORNER_STEPS, level=1)
+    ndofs, etas = [r["dofs"]["total"] for r in history], [r["eta"] for r in history]
+    corners[gap] = {"uniform_eta": [e.total for e in uniform],
+                    "uniform_as_max": [float(np.sqrt(e.terms["asymmetry"].max()))
+                                       for e in uniform],
+                    "dorfler_ndofs": ndofs, "dorfler_etas": etas,
+                    "dorfler_rate": convergence_rate(ndofs[-3:], etas[-3:])}
+    row = corners[gap]
+    print(f"g = {gap:4s} uniform levels {UNIFORM_LEVELS}: eta {np.round(row['uniform_eta'], 1)}, "
+          f"max eta_as,T {np.round(row['uniform_as_max'], 1)}")
+    print(f"         Dörfler: eta {np.round(etas, 1)}, rate {row['dorfler_rate']:.2f}")
+
+# %%
+save_results("05_adaptivity_solutions",
+             {"dorfler": dorfler, "by_indicator": by_indicator, "corners": corners})
