@@ -8,6 +8,8 @@ solves one scene, prints the result table and writes ``DIR/result.json``
 runs the adaptive loop and writes ``DIR/history.json`` plus a mesh (.vol, .png) per step.
 ``ngdual tutorials [--notebooks DIR] [--solutions]`` lists the lecture tutorials or
 writes them as Jupyter notebooks.
+``ngdual bench [--levels ...] [--json FILE]`` times the contact solvers against one
+linear solve of the same matrix (the limit ratio, :mod:`ngdual.bench`).
 Exit status: 0 solved and converged, 1 not converged, 2 bad input.
 """
 
@@ -160,6 +162,67 @@ def cmd_adapt(args) -> int:
     return 0 if all(r["converged"] for r in run["history"]) else EXIT_NOT_CONVERGED
 
 
+def cmd_figures(args) -> int:
+    """Regenerate the figures and tables of Sections 3.4 and 4.2 into DIR (see figures/)."""
+    from .figures import run_figures
+
+    try:
+        summary = run_figures(args.max_level, args.out, args.scheduler, args.workers,
+                              not args.threads, args.only, args.source)
+    except (FileNotFoundError, ValueError) as err:
+        print(f"ngdual: error: {err}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    failed = {k: v for k, v in summary["scripts"].items() if v["status"] != "ok"}
+    print(f"{len(summary['scripts'])} scripts, {summary['tasks']} tasks "
+          f"({summary['computed_tasks']} computed, {len(summary['failed_tasks'])} not ok) "
+          f"in {summary['seconds']:.0f} s; wrote {Path(args.out) / 'index.md'}")
+    for stem, info in failed.items():
+        print(f"ngdual: figure script {stem}: {info['status']}", file=sys.stderr)
+    if args.gallery:
+        from .figures import write_gallery
+
+        for path in write_gallery(args.out, args.gallery):
+            print(f"wrote {path}")
+    return 1 if failed else 0
+
+
+def cmd_bench(args) -> int:
+    """Limit ratios of the contact solvers (ngdual.bench): table on stdout, JSON with --json."""
+    from .bench import CASES, SOLVERS, bench, summary_rows
+    from .io import write_json
+
+    bad = [c for c in args.cases if c not in CASES] + [s for s in args.solvers if s not in SOLVERS]
+    if bad:
+        print(f"ngdual: error: unknown case or solver {bad[0]!r}; cases: {', '.join(CASES)}; "
+              f"solvers: {', '.join(SOLVERS)}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    header = (f"{'case':20s} {'lvl':>3} {'solver':12s} {'unknowns':>9} {'assemble':>8} "
+              f"{'linear':>8} {'contact':>8} {'ratio':>6} {'r_fast':>6} {'outer':>6} "
+              f"{'inner':>6} {'RSS MB':>7}")
+    print(header)
+
+    def on_record(run):
+        if args.json:
+            write_json(run, args.json)
+        row = summary_rows({"records": run["records"][-1:]})[0]
+        if row["total"] is None:
+            print(f"{row['case']:20s} {row['level']:3d} {row['solver']:12s}  {row['error']}")
+            return
+        print(f"{row['case']:20s} {row['level']:3d} {row['solver']:12s} {row['ndof']:9d} "
+              f"{row['assemble']:8.2f} {row['linear']:8.2f} {row['total']:8.2f} "
+              f"{row['ratio']:6.2f} {row['ratio_fastest']:6.2f} {row['outer']!s:>6} "
+              f"{row['inner']!s:>6} {row['rss']:7.0f}"
+              + ("" if row["converged"] else f"  NOT CONVERGED {row['error'] or ''}"),
+              flush=True)
+
+    run = bench(args.levels, args.cases, args.solvers, args.isolate, args.timeout, on_record,
+                args.blas_threads or None)
+    if args.json:
+        write_json(run, args.json)
+        print(f"wrote {args.json}")
+    return 0 if all(r["converged"] for r in run["records"]) else EXIT_NOT_CONVERGED
+
+
 def cmd_tutorials(args) -> int:
     """List the tutorials; with --notebooks DIR write them (and their solutions) as notebooks."""
     from .tutorials import list_tutorials, write_notebooks
@@ -224,6 +287,42 @@ def parser() -> argparse.ArgumentParser:
     tu.add_argument("--source", metavar="DIR", default=None,
                     help="tutorials folder (default: tutorials/ of the source checkout)")
     tu.set_defaults(func=cmd_tutorials)
+    fg = sub.add_parser("figures", help="regenerate every figure and table of Sections 3.4 "
+                                        "and 4.2 (and the work-precision study)")
+    fg.add_argument("--max-level", type=int, default=None, metavar="K",
+                    help="finest uniform level; every other size follows from it "
+                         "(default 5: 8-11 min on 2 cores; 8 = the thesis scale)")
+    fg.add_argument("--out", default="figures-output", help="output folder (default: "
+                                                            "figures-output)")
+    fg.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                    help="address of a running dask scheduler (default: a LocalCluster)")
+    fg.add_argument("--workers", type=int, default=None,
+                    help="LocalCluster workers (default: one per CPU core)")
+    fg.add_argument("--threads", action="store_true",
+                    help="one LocalCluster worker thread in this process: quick to start, one "
+                         "task at a time")
+    fg.add_argument("--only", nargs="+", default=None, metavar="NAME",
+                    help="run only the scripts whose name contains one of these")
+    fg.add_argument("--source", default=None, metavar="DIR",
+                    help="figure scripts folder (default: figures/ of the source checkout)")
+    fg.add_argument("--gallery", default=None, metavar="DIR",
+                    help="also write small copies of a few figures into DIR (docs/gallery "
+                         "for the README)")
+    fg.set_defaults(func=cmd_figures)
+    be = sub.add_parser("bench", help="contact-solve time / one linear solve, per level and "
+                                      "solver (Example 3.46), JSON with --json")
+    be.add_argument("--levels", type=int, nargs="+", default=[1, 2, 3, 4, 5])
+    be.add_argument("--cases", nargs="+", default=["thesis-3.46", "thesis-3.46-coulomb"])
+    be.add_argument("--solvers", nargs="+", default=["uzawa", "uzawa-tuned", "active-set"])
+    be.add_argument("--json", default=None, metavar="FILE",
+                    help="write all records (with package versions) to FILE, atomically")
+    be.add_argument("--isolate", choices=["auto", "always", "never"], default="auto",
+                    help="one process per record for its own peak memory (auto: level >= 4)")
+    be.add_argument("--timeout", type=float, default=None, metavar="S",
+                    help="bound on one isolated record (s)")
+    be.add_argument("--blas-threads", type=int, default=1, metavar="N",
+                    help="BLAS threads for every solver (default 1; 0: the libraries' own)")
+    be.set_defaults(func=cmd_bench)
     return p
 
 

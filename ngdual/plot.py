@@ -101,7 +101,8 @@ def figure_texts(fig) -> dict:
                                            if not line.get_label().startswith("_")),
                      "filled": bool(ax.collections or ax.images)})
     suptitle = fig._suptitle.get_text() if fig._suptitle is not None else ""
-    return {"suptitle": suptitle, "axes": axes}
+    legends = [t.get_text() for legend in fig.legends for t in legend.get_texts()]
+    return {"suptitle": suptitle, "axes": axes, "figure_legend": legends}
 
 
 def save_figure(fig, stem: Path, dpi: int = 130) -> list[Path]:
@@ -128,23 +129,23 @@ def save_figure(fig, stem: Path, dpi: int = 130) -> list[Path]:
 
 def plot_field_pair(points: np.ndarray, triangles: np.ndarray, values: list[np.ndarray],
                     titles: list[str], label: str, suptitle: str, stem: Path,
-                    clip_percentile: float | None = None) -> list[Path]:
+                    vmax: float | None = None) -> list[Path]:
     """Element fields on one mesh side by side with one colour bar (Figs. 3.11-3.14).
 
-    With ``clip_percentile`` the colour scale ends at that percentile of all values
-    (the colour bar is extended), so that corner singularities do not wash out the rest.
+    With ``vmax`` below the largest value the colour scale ends there (the colour bar
+    is extended), so that corner singularities do not wash out the rest.
     """
     fig, axes = plt.subplots(1, len(values), figsize=(6.2 * len(values), 2.6),
                              constrained_layout=True)
     axes = np.atleast_1d(axes)
     tri = mtri.Triangulation(points[:, 0], points[:, 1], triangles)
     allv = np.concatenate(values)
-    vmin, vmax = float(allv.min()), float(allv.max())
+    vmin = float(allv.min())
     extend = "neither"
-    if clip_percentile is not None:
-        top = float(np.percentile(allv, clip_percentile))
-        if top < vmax:
-            vmax, extend = top, "max"
+    if vmax is not None and vmax < allv.max():
+        extend = "max"
+    else:
+        vmax = float(allv.max())
     for ax, v, title in zip(axes, values, titles):
         art = ax.tripcolor(tri, facecolors=v, cmap="viridis", vmin=vmin, vmax=vmax,
                            edgecolors="none", rasterized=True)
@@ -158,10 +159,14 @@ def plot_field_pair(points: np.ndarray, triangles: np.ndarray, values: list[np.n
 
 
 def plot_curves(panels: list[dict], stem: Path, suptitle: str, ncols: int = 2,
-                panel_size: tuple[float, float] = (5.6, 3.4)) -> list[Path]:
+                panel_size: tuple[float, float] = (5.6, 3.4),
+                figure_legend: bool = False) -> list[Path]:
     """Line plots, one panel per dict: ``title``, ``xlabel``, ``ylabel``, ``curves`` (dicts of
     ``x``, ``y``, ``label`` and matplotlib style keywords), optional ``loglog``, ``hlines``
-    (``(y, label, style)``), ``note`` (text in the corner), ``xlim``, ``ylim``."""
+    (``(y, label, style)``), ``note`` (text in the corner), ``xlim``, ``ylim``.
+
+    ``figure_legend``: one legend below all panels (the labels of all panels, once each)
+    instead of one per panel."""
     n = len(panels)
     ncols = min(ncols, n)
     nrows = int(np.ceil(n / ncols))
@@ -189,10 +194,18 @@ def plot_curves(panels: list[dict], stem: Path, suptitle: str, ncols: int = 2,
         ax.set_xlabel(panel["xlabel"])
         ax.set_ylabel(panel["ylabel"])
         ax.grid(alpha=0.3, which="both" if panel.get("loglog") else "major")
-        if any(not line.get_label().startswith("_") for line in ax.get_lines()):
+        labelled = any(not line.get_label().startswith("_") for line in ax.get_lines())
+        if labelled and not figure_legend:
             ax.legend(loc=panel.get("legend_loc", "best"), fontsize=8)
     for ax in axes.ravel()[n:]:
         ax.remove()
+    if figure_legend:
+        handles = {}
+        for ax in axes.ravel()[:n]:
+            for handle, label in zip(*ax.get_legend_handles_labels()):
+                handles.setdefault(label, handle)
+        fig.legend(handles.values(), handles.keys(), loc="outside lower center",
+                   ncol=min(3, len(handles)), fontsize=8)
     fig.suptitle(suptitle)
     return save_figure(fig, stem)
 
@@ -244,4 +257,42 @@ def plot_adaptive_mesh(points: np.ndarray, triangles: np.ndarray, marked: np.nda
     ax.set_title(title)
     ax.legend(handles=[*ax.get_legend_handles_labels()[0][:1], *handles], loc="upper center",
               bbox_to_anchor=(0.5, -0.25), ncol=2, fontsize=8)
+    return save_figure(fig, stem)
+
+
+def plot_domain(points: np.ndarray, triangles: np.ndarray, x: np.ndarray, load: np.ndarray,
+                foundations: list, gaps: list, stem: Path, suptitle: str) -> list[Path]:
+    """Fig. 3.10: Example 3.46 with Gamma_D, Gamma_N (load arrows), Gamma_C and foundations
+    (``(x, y, label, style)``) on the left, the gap functions (same form) on the right."""
+    fig, (ax, ag) = plt.subplots(1, 2, figsize=(13, 3.8), constrained_layout=True,
+                                 gridspec_kw={"width_ratios": [1.6, 1]})
+    tri = mtri.Triangulation(points[:, 0], points[:, 1], triangles)
+    ax.triplot(tri, color="0.75", lw=0.5)
+    ax.plot([-4, -4], [-1, 1], color="k", lw=4, label=r"$\Gamma_D$ (clamped)")
+    ax.plot([4, 4], [-1, 1], color="k", lw=4)
+    ax.plot([-4, 4], [1, 1], color="tab:orange", lw=3, label=r"$\Gamma_N$")
+    ax.plot([-4, 4], [-1, -1], color="tab:green", lw=3, label=r"$\Gamma_C$")
+    scale = 0.6 / max(float(np.max(np.abs(load))), 1e-300)
+    for xi, ti in zip(x[::40], load[::40]):
+        if abs(ti) > 0:
+            ax.annotate("", (xi, 1), (xi, 1 - ti * scale),
+                        arrowprops={"arrowstyle": "->", "color": "tab:orange", "lw": 1})
+    ax.plot([], [], color="tab:orange", marker=r"$\downarrow$", ls="none",
+            label=rf"$t_0$ (max {float(np.max(np.abs(load))):.0f})")
+    for fx, fy, label, style in foundations:
+        ax.plot(fx, fy, label=label, **style)
+    ax.set_aspect("equal")
+    ax.set_ylim(-3.3, 1.9)
+    ax.set_xlabel(r"$x_1$ [length]")
+    ax.set_ylabel(r"$x_2$ [length]")
+    ax.set_title(r"$\Omega = [-4, 4] \times [-1, 1]$, level-1 mesh")
+    ax.legend(loc="upper center", ncol=3, fontsize=8)
+    for gx, gy, label, style in gaps:
+        ag.plot(gx, gy, label=label, **style)
+    ag.set_xlabel(r"$x_1$ on $\Gamma_C$ [length]")
+    ag.set_ylabel(r"gap $g(x_1)$ [length]")
+    ag.set_title("Gap functions of the shipped scenes")
+    ag.grid(alpha=0.3)
+    ag.legend(fontsize=8)
+    fig.suptitle(suptitle)
     return save_figure(fig, stem)

@@ -1,8 +1,15 @@
 """Solve a scene: build only what it calls for, then run the matching algorithm.
 
+``solver.method = "uzawa"`` (the thesis' algorithms):
+
 no contact boundary  -> one linear saddle-point solve
 contact, no friction -> Algorithm 3.38 (Uzawa)
 Tresca / Coulomb     -> Algorithm 3.41 / Remark 3.45 (nested Uzawa)
+
+``solver.method = "active-set"`` or ``"auto"`` (default): the hybridised system, one
+Cholesky factorisation, and for contact the semismooth Newton method on Gamma_C
+(:mod:`ngdual.solvers.fast`): the same discrete solution at about the cost of one linear
+solve.
 """
 
 from __future__ import annotations
@@ -13,6 +20,7 @@ from collections.abc import Callable
 from .forms import DiscreteProblem, assemble
 from .mesh import build_mesh
 from .scene import Scene
+from .solvers.fast import fast_solve
 from .solvers.nested import nested_uzawa
 from .solvers.result import Solution
 from .solvers.uzawa import solve_linear, uzawa
@@ -33,7 +41,10 @@ def solve_problem(problem: DiscreteProblem,
                   progress: Callable[[int, float], None] | None = None) -> Solution:
     """Run the algorithm the scene of an assembled ``problem`` calls for (any mesh)."""
     scene = problem.scene
-    if not scene.has_contact:
+    if scene.solver.method in ("auto", "active-set"):
+        solution = fast_solve(problem, max_iter=scene.solver.max_iter, metric=scene.solver.metric,
+                              progress=progress)
+    elif not scene.has_contact:
         solution = solve_linear(problem)
     elif not scene.has_friction:
         s = scene.solver

@@ -26,7 +26,7 @@ CASES = [(name, level) for name in ("thesis-3.46-coulomb", "thesis-3.46-coulomb-
 
 @cache
 def solutions(name, level):
-    scene = load_scene(name, ["solver.eps1=1e-11", "solver.eps2=1e-10"])
+    scene = load_scene(name, ["solver.method=uzawa", "solver.eps1=1e-11", "solver.eps2=1e-10"])
     problem = assemble(scene, build_mesh(scene.geometry, level))
     return (scene, solve_problem(problem),
             solve_qp_friction(problem, scene.friction.law, scene.friction.mu))

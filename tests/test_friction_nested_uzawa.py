@@ -26,7 +26,7 @@ def test_box_projection_qp_equals_closed_form():
 
 @functools.cache
 def _solve(name):
-    scene = load_scene(name, ["solver.eps2=1e-8"])
+    scene = load_scene(name, ["solver.method=uzawa", "solver.eps2=1e-8"])
     return scene, solve_scene(scene, 2)
 
 

@@ -1,0 +1,46 @@
+"""Fig. 3.11: plane-strain von Mises equivalent stress in Omega, mu_f = 0 and mu_f = 0.5.
+
+sigma_0 = ((nu^2 - nu + 1)(s11^2 + s22^2) + (2nu^2 - 2nu - 1) s11 s22 + 3 s12^2)^(1/2) with
+s12 the symmetrised shear stress (Section 3.4). The colour scale ends at the largest value
+away from the corners (|x_1| <= 3): the corner singularities would wash out the rest.
+"""
+
+import numpy as np
+
+from ngdual import plot
+from ngdual.figures import element_rows, field_summary, script_main
+
+THESIS = "Fig. 3.11"
+STUDIES = ("uniform-frictionless", "uniform-coulomb")
+AWAY = 3.0  # |x_1| <= AWAY: away from the corner singularities at x_1 = +-4
+
+
+def run(ctx):
+    # COMPUTE: the solves of both problems on the field level (shared with Tables 3.2/3.3)
+    fields = ctx.both_fields()
+    a0, a1 = (fields[p][1] for p in ("frictionless", "coulomb"))
+    centroids = a0["points"][a0["triangles"]].mean(axis=1)
+    away = np.abs(centroids[:, 0]) <= AWAY
+    # WRITE
+    data = ctx.write_csv("fig_3_11_von_mises.csv", element_rows(fields, "von_mises"),
+                         "plane-strain von Mises stress per element (centroid), both problems")
+    # PLOT
+    figs = plot.plot_field_pair(a0["points"], a0["triangles"],
+                                [a0["von_mises"], a1["von_mises"]], ctx.titles(),
+                                r"$\sigma_0$ [stress units]",
+                                "Fig. 3.11: von Mises equivalent stress (plane strain)",
+                                ctx.figure_stem("fig_3_11_von_mises"),
+                                vmax=max(float(a["von_mises"][away].max()) for a in (a0, a1)))
+    numbers = {}
+    for name, a in (("mu_f = 0", a0), ("mu_f = 0.5", a1)):
+        s = field_summary(a["von_mises"][away], a["points"], a["triangles"][away])
+        numbers[f"max sigma_0 for |x_1| <= {AWAY}, {name}"] = s["max"]
+        numbers[f"  at (x_1, x_2), {name}"] = s["argmax"]
+        numbers[f"max sigma_0 overall (corners), {name}"] = float(a["von_mises"].max())
+    ctx.entry(THESIS, "Von Mises equivalent stress in Omega", [*figs, data], numbers,
+              thesis_says="singularities in the corners; with friction the maximal value is "
+                          "smaller and its zone moves to where the body slides.")
+
+
+if __name__ == "__main__":
+    script_main(__file__)

@@ -1,0 +1,45 @@
+"""Fig. 3.14: rotation eta^h (the skew part of grad u, continuous P1) in Omega, both problems.
+
+Plotted at the element centroids. The thesis: without friction eta is nearly zero on the
+active part of Gamma_C (x_1 in (-1.3, 1.3)); with friction it has local extrema where the
+body starts to slide; the extrema lie on the boundary.
+"""
+
+import numpy as np
+
+from ngdual import plot
+from ngdual.figures import element_rows, script_main
+
+THESIS = "Fig. 3.14"
+STUDIES = ("uniform-frictionless", "uniform-coulomb")
+
+
+def run(ctx):
+    # COMPUTE: the solves of both problems on the field level (shared with Tables 3.2/3.3)
+    fields = ctx.both_fields()
+    a0, a1 = (fields[p][1] for p in ("frictionless", "coulomb"))
+    centroids = a0["points"][a0["triangles"]].mean(axis=1)
+    h = float(np.ptp(a0["points"][a0["triangles"][0]][:, 0]))
+    # the bottom row of triangles under the central part of the contact zone
+    contact_row = (centroids[:, 1] < -1 + h) & (np.abs(centroids[:, 0]) < 1.0)
+    # WRITE
+    data = ctx.write_csv("fig_3_14_rotation.csv", element_rows(fields, "eta"),
+                         "rotation eta^h at the element centroids, both problems")
+    # PLOT
+    figs = plot.plot_field_pair(a0["points"], a0["triangles"], [a0["eta"], a1["eta"]],
+                                ctx.titles(), r"$\eta^h$ [rad]",
+                                r"Fig. 3.14: rotation $\eta^h$",
+                                ctx.figure_stem("fig_3_14_rotation"))
+    ctx.entry(THESIS, "Rotation eta in Omega", [*figs, data],
+              {"max |eta| on the bottom row, |x_1| < 1, mu_f = 0":
+                   float(np.abs(a0["eta"][contact_row]).max()),
+               "max |eta| on the bottom row, |x_1| < 1, mu_f = 0.5":
+                   float(np.abs(a1["eta"][contact_row]).max()),
+               "max |eta| overall, mu_f = 0 / 0.5": [float(np.abs(a0["eta"]).max()),
+                                                     float(np.abs(a1["eta"]).max())]},
+              thesis_says="frictionless: eta nearly zero on A_C; with friction local extrema "
+                          "where sliding starts; extrema on the boundaries.")
+
+
+if __name__ == "__main__":
+    script_main(__file__)

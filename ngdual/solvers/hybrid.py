@@ -1,0 +1,306 @@
+"""Hybridisation of the PEERS system: the same discrete solution from a symmetric positive
+definite matrix, with the contact tractions as its last unknowns.
+
+The saddle-point matrix [[A, B], [B^T, 0]] of (3.97) is indefinite, which rules out a
+Cholesky factorisation. Breaking the normal continuity of the Raviart-Thomas rows
+(Arnold-Brezzi hybridisation) and enforcing it again by a multiplier mu per edge and row,
+
+    a~(sigma, tau) + b(u, tau) + s(eta, tau) + sum_T int_{dT} mu . tau n_T ds = ...,
+
+makes sigma, the bubbles and u element-local. NGSolve eliminates them element by element
+(``condense=True``); what remains couples only the edge multipliers mu and the rotation eta,
+and its negative is symmetric positive definite (the negated Schur complement of an
+invertible saddle point whose multipliers satisfy the inf-sup condition).
+
+mu is minus the displacement trace. On the boundary it is what the formulation already
+prescribes: mu = -mean_e(u_D) on Gamma_D (the right-hand side of (3.62)), the edge means of
+the coarse P1 phi on Gamma_N (d_N of (3.24)), and on every fine Gamma_C edge e
+
+    mu_e = n_e zeta_n,e + t_e zeta_t,e,   zeta_n = M lambda_n - mean_e(g),  zeta_t = M lambda_t,
+
+with M the edge means of the coarse h~ hats (the RT_0 normal trace is constant on e, so
+int_e lambda tau.n ds = |e| mean_e(lambda) (tau.n)_e: d_{C,n}, d_{C,t} and g(tau) of (3.24)
+are reproduced exactly). The fine contact values zeta are left free in the matrix H and
+ordered last; a Cholesky factorisation with them last yields the Schur complement
+S = H_zz - H_zJ H_JJ^{-1} H_Jz (the Steklov-Poincare operator of Gamma_C) at no extra
+cost: the edge moments of the traction, t_e = (int_e sigma_n, int_e sigma_t), are the
+affine function t(zeta) = t_hat - S zeta of zeta (:class:`ContactSchur`).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import ngsolve as ngs
+import numpy as np
+import scipy.sparse as sp
+
+from .. import peers
+from ..forms import DiscreteProblem, boundary_regex
+
+
+@dataclass
+class ContactEdges:
+    """The fine edges of Gamma_C, chain by chain (the order of :mod:`ngdual.friction`).
+
+    ``edges`` are their facet dofs; ``hat_means`` (n_edges x N_C) is M: the mean of
+    every coarse h~ hat on every fine edge; ``normals`` the outward unit normals,
+    ``lengths`` |e|, ``gap`` mean_e(g).
+    """
+
+    edges: np.ndarray
+    lengths: np.ndarray
+    normals: np.ndarray
+    hat_means: sp.csr_matrix
+    gap: np.ndarray
+
+    @property
+    def tangents(self) -> np.ndarray:
+        """t = (n_2, -n_1), the tangent of (3.24)."""
+        return np.column_stack([self.normals[:, 1], -self.normals[:, 0]])
+
+    def __len__(self) -> int:
+        return len(self.edges)
+
+
+def _boundary_edges(mesh: ngs.Mesh, facet: ngs.FESpace, hdiv: ngs.FESpace
+                    ) -> dict[str, np.ndarray]:
+    """Rows (facet dof, RT_0 dof, vertex a, vertex b) of every boundary segment, by label.
+
+    Dof numbers, not edge numbers: netgen keeps the edges of coarser levels after
+    ``mesh.Refine()``, and the facet space numbers only the edges in use.
+    """
+    out: dict[str, list] = {}
+    for el in mesh.Elements(ngs.BND):
+        a, b = (v.nr for v in el.vertices)
+        out.setdefault(el.mat, []).append((facet.GetDofNrs(el)[0], hdiv.GetDofNrs(el)[0], a, b))
+    return {label: np.array(rows, dtype=int) for label, rows in out.items()}
+
+
+def _normal_fluxes(hdiv: ngs.FESpace, mesh: ngs.Mesh, labels: list[str]) -> np.ndarray:
+    """int_e psi_e.n ds and int_e n_i psi_e.n ds (i = 1, 2) per RT_0 dof of the edges ``labels``.
+
+    The normal trace of an RT_0 basis function is constant on its edge, so the data moments
+    of :mod:`ngdual.forms` are (flux) x (edge mean of the data), and the edge means follow
+    from the assembled right-hand side exactly, whatever quadrature produced it.
+    """
+    v = hdiv.TestFunction()
+    n = ngs.specialcf.normal(2)
+    ds = ngs.ds(definedon=mesh.Boundaries(boundary_regex(labels)))
+    out = []
+    for f in (ngs.CF(1.0), n[0], n[1]):
+        form = ngs.LinearForm(hdiv)
+        form += f * (v.Trace() * n) * ds
+        form.Assemble()
+        out.append(form.vec.FV().NumPy().copy())
+    return np.array(out)
+
+
+class HybridSystem:
+    """The hybridised, statically condensed system of (3.62), reduced to H w = r.
+
+    Unknowns w: mu on the interior edges (two rows), eta, the coarse phi, and last the
+    fine contact values zeta = (zeta_n, zeta_t) (``contact_index``). H is symmetric
+    positive definite; with zeta prescribed, the other rows of H w = r are exactly
+    the rows of (3.62) for sigma, u, eta, phi, and t(zeta) = r_z - (H w)_z are the
+    traction moments (int_e sigma_n, int_e sigma_t) on the fine Gamma_C edges.
+
+    Parameters
+    ----------
+    problem : DiscreteProblem
+        The assembled problem (its mesh, spaces, prolongations and phi right-hand side).
+    """
+
+    def __init__(self, problem: DiscreteProblem):
+        start = time.perf_counter()
+        self.problem = problem
+        scene, mesh = problem.scene, problem.fes.mesh
+        self.mesh = mesh
+        lam, mu = scene.material.lame
+        rt = ngs.HDiv(mesh, order=0, discontinuous=True)
+        bubble, p0 = peers.cubic_bubbles(mesh), ngs.L2(mesh, order=0)
+        facet = ngs.FacetFESpace(mesh, order=0)
+        comps = {"r1": rt, "r2": rt, "b1": bubble, "b2": bubble, "u1": p0, "u2": p0,
+                 "eta": ngs.H1(mesh, order=1), "m1": facet, "m2": facet}
+        self.names = list(comps)
+        self.fes = ngs.FESpace(list(comps.values()))
+        self.rt = rt
+        trial = dict(zip(self.names, self.fes.TrialFunction()))
+        test = dict(zip(self.names, self.fes.TestFunction()))
+        n = ngs.specialcf.normal(2)
+
+        def parts(f):
+            sig = peers.stress(f["r1"], f["r2"], f["b1"], f["b2"])
+            return (sig, peers.stress_divergence(f["r1"], f["r2"]),
+                    ngs.CF((f["r1"] * n, f["r2"] * n)), ngs.CF((f["u1"], f["u2"])), f["eta"],
+                    ngs.CF((f["m1"], f["m2"])))
+
+        sig, div_sig, trac_sig, u, eta, m = parts(trial)
+        tau, div_tau, trac_tau, v, xi, k = parts(test)
+        a = ngs.BilinearForm(self.fes, condense=True)
+        # the integrands are polynomials of degree <= 4 (RT_0 + Curl of cubic bubbles times
+        # the same, or times P1): exact rules of that degree, on compiled integrands
+        dx = ngs.dx(intrules={ngs.TRIG: ngs.IntegrationRule(ngs.TRIG, 4)})
+        dT = ngs.dx(element_boundary=True, intrules={ngs.SEGM: ngs.IntegrationRule(ngs.SEGM, 2)})
+        a += ngs.InnerProduct(peers.compliance(sig, lam, mu), tau).Compile() * dx
+        a += (u * div_tau + v * div_sig).Compile() * dx
+        a += (eta * peers.asym(tau) + xi * peers.asym(sig)).Compile() * dx
+        a += (m * trac_tau + k * trac_sig).Compile() * dT
+        with ngs.TaskManager():
+            a.Assemble()
+        # the only local load is -f(v) in the u rows: taken from the assembled F of (3.62)
+        self.rhs = a.mat.CreateColVector()
+        self.rhs[:] = 0.0
+        values = self.rhs.FV().NumPy()
+        for name in ("u1", "u2"):
+            rg = self.fes.Range(self.names.index(name))
+            values[rg.start:rg.stop] = problem.F[problem.blocks[name]]
+        condensed = self.rhs.CreateVector()
+        condensed.data = self.rhs
+        with ngs.TaskManager():
+            condensed.data += a.harmonic_extension_trans * self.rhs
+        self.form = a
+        self.assemble_seconds = time.perf_counter() - start
+
+        start = time.perf_counter()
+        self._reduction(scene, facet, condensed.FV().NumPy())
+        self.reduce_seconds = time.perf_counter() - start
+
+    def _reduction(self, scene, facet: ngs.FESpace, r_cond: np.ndarray) -> None:
+        """Build c = T w + c0 (coupling values from the reduced unknowns), H and r."""
+        pb, mesh, fes = self.problem, self.mesh, self.fes
+        ranges = {name: fes.Range(i) for i, name in enumerate(self.names)}
+        m1, m2, eta = ranges["m1"].start, ranges["m2"].start, ranges["eta"]
+        hdiv = pb.spaces.components["r1"]
+        labelled = _boundary_edges(mesh, facet, hdiv)
+        fluxes = _normal_fluxes(hdiv, mesh, scene.labels("dirichlet") + scene.labels("contact"))
+        F1 = pb.F[pb.blocks["r1"]]
+        F2 = pb.F[pb.blocks["r2"]]
+
+        def edges_of(role):
+            rows = [labelled[lab] for lab in scene.labels(role) if lab in labelled]
+            return np.vstack(rows) if rows else np.zeros((0, 4), dtype=int)
+
+        dirichlet, neumann = edges_of("dirichlet"), edges_of("neumann")
+        coo = self.form.mat.COO()
+        K = sp.csr_matrix((np.asarray(coo[2]), (np.asarray(coo[0]), np.asarray(coo[1]))),
+                          shape=(fes.ndof, fes.ndof))
+        interior = np.setdiff1d(np.arange(facet.ndof),
+                                np.concatenate([e[:, 0] for e in labelled.values()]))
+        self.contact = self._contact_edges(scene, labelled, fluxes, F1, F2)
+        n_int, n_v = len(interior), ranges["eta"].stop - ranges["eta"].start
+        n_phi = pb.spaces.coarse_ndof("phi1") if "phi1" in pb.blocks else 0
+        n_c = len(self.contact)
+        blocks = np.cumsum([0, n_int, n_int, n_v, n_phi, n_phi, n_c, n_c])
+        self.n_w = int(blocks[-1])
+        self.contact_index = np.arange(blocks[5], blocks[7])
+        self.phi_index = np.arange(blocks[3], blocks[5])
+        rows, cols, vals = [], [], []
+
+        def put(r, c, v):
+            rows.append(np.asarray(r)), cols.append(np.asarray(c))
+            vals.append(np.broadcast_to(np.asarray(v, dtype=float), np.shape(r)))
+
+        k = np.arange(n_int)
+        put(m1 + interior, blocks[0] + k, 1.0)
+        put(m2 + interior, blocks[1] + k, 1.0)
+        put(eta.start + np.arange(n_v), blocks[2] + np.arange(n_v), 1.0)
+        c0 = np.zeros(fes.ndof)
+        if len(dirichlet):  # F = int_e u_D . tau n ds (3.62): minus the mean of u_D
+            rt = dirichlet[:, 1]
+            c0[m1 + dirichlet[:, 0]] = -F1[rt] / fluxes[0][rt]
+            c0[m2 + dirichlet[:, 0]] = -F2[rt] / fluxes[0][rt]
+        if len(neumann):
+            space = pb.spaces.components["phi1"]
+            dof = np.array([[space.GetDofNrs(ngs.NodeId(ngs.VERTEX, int(v)))[0] for v in e[2:]]
+                            for e in neumann])
+            P = pb.spaces.prolongations["phi1"].tocsr()
+            mean = (0.5 * (P[dof[:, 0]] + P[dof[:, 1]])).tocoo()
+            lift_range = pb.fes.Range(pb.names.index("phi1"))
+            lift2_range = pb.fes.Range(pb.names.index("phi2"))
+            for comp, start, lr in ((0, m1, lift_range), (1, m2, lift2_range)):
+                put(start + neumann[mean.row, 0], blocks[3 + comp] + mean.col, mean.data)
+                lift = pb.lift[lr.start:lr.stop]
+                c0[start + neumann[:, 0]] = 0.5 * (lift[dof[:, 0]] + lift[dof[:, 1]])
+        ce = self.contact
+        j = np.arange(n_c)
+        for comp, start in ((0, m1), (1, m2)):
+            put(start + ce.edges, blocks[5] + j, ce.normals[:, comp])
+            put(start + ce.edges, blocks[6] + j, ce.tangents[:, comp])
+        T = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                          shape=(fes.ndof, self.n_w))
+        self.T, self.c0 = T, c0
+        # T vanishes on the local dofs, so only the condensed coupling block enters
+        self.H = (-(T.T @ (K @ T))).tocsr()
+        self.H.sum_duplicates()
+        r = -(T.T @ (r_cond - K @ c0))
+        if n_phi:
+            r[self.phi_index] -= pb.F[pb.index("phi1", "phi2")]
+        self.r = r
+        self._continuous = peers.raviart_thomas(mesh)
+        self._convert = ngs.ConvertOperator(self.rt, self._continuous)
+
+    def _contact_edges(self, scene, labelled: dict, fluxes: np.ndarray, F1: np.ndarray,
+                       F2: np.ndarray) -> ContactEdges:
+        """Fine Gamma_C edges; mean_e(g) from F = int_e g n.tau n ds, the right-hand side of g."""
+        pb = self.problem
+        contact = pb.spaces.contact
+        if contact is None:
+            return ContactEdges(np.zeros(0, dtype=int), np.zeros(0), np.zeros((0, 2)),
+                                sp.csr_matrix((0, 0)), np.zeros(0))
+        edge_of = {}
+        for lab in scene.labels("contact"):
+            for row in labelled.get(lab, []):
+                edge_of[frozenset(int(v) for v in row[2:])] = row[:2]
+        space = pb.spaces.components["lam_n"]
+        P = pb.spaces.prolongations["lam_n"].tocsr()
+        edges, ends = [], []
+        for chain in contact.chains:
+            verts = chain.path_vertices
+            for a, b in zip(verts[:-1], verts[1:]):
+                edges.append(edge_of[frozenset((int(a), int(b)))])
+                ends.append([space.GetDofNrs(ngs.NodeId(ngs.VERTEX, int(v)))[0] for v in (a, b)])
+        edges, ends = np.array(edges).reshape(-1, 2), np.array(ends)
+        rt = edges[:, 1]
+        flux = fluxes[0][rt]
+        normals = np.column_stack([fluxes[1][rt], fluxes[2][rt]]) / flux[:, None]
+        normals /= np.linalg.norm(normals, axis=1)[:, None]
+        gap = (normals[:, 0] * F1[rt] + normals[:, 1] * F2[rt]) / flux
+        lengths = np.concatenate([np.diff(chain.arclength) for chain in contact.chains])
+        return ContactEdges(edges[:, 0], lengths, normals,
+                            (0.5 * (P[ends[:, 0]] + P[ends[:, 1]])).tocsr(), gap)
+
+    def unknowns(self, w: np.ndarray, lam_t: np.ndarray | None = None,
+                 lam_n: np.ndarray | None = None) -> np.ndarray:
+        """The unknown vector of ``problem.K`` from w (and the contact multipliers).
+
+        Recovers the element-local sigma, bubbles and u (NGSolve's harmonic extension
+        and inner solve) and maps the broken Raviart-Thomas rows to the continuous ones.
+        """
+        pb, fes = self.problem, self.fes
+        gf = ngs.GridFunction(fes)
+        vec = gf.vec
+        vec.FV().NumPy()[:] = self.T @ w + self.c0
+        with ngs.TaskManager():
+            vec.data += self.form.harmonic_extension * vec
+            vec.data += self.form.inner_solve * self.rhs
+        values = vec.FV().NumPy()
+        x = np.zeros(pb.K.shape[0])
+        ranges = {name: fes.Range(i) for i, name in enumerate(self.names)}
+        broken = ngs.GridFunction(self.rt)
+        cont = ngs.GridFunction(self._continuous)
+        for name in ("r1", "r2"):
+            rg = ranges[name]
+            broken.vec.FV().NumPy()[:] = values[rg.start:rg.stop]
+            cont.vec.data = self._convert * broken.vec
+            x[pb.blocks[name]] = cont.vec.FV().NumPy()
+        for name in ("b1", "b2", "u1", "u2", "eta"):
+            rg = ranges[name]
+            x[pb.blocks[name]] = values[rg.start:rg.stop]
+        if "phi1" in pb.blocks:
+            x[pb.index("phi1", "phi2")] = w[self.phi_index]
+        if lam_t is not None:
+            x[pb.index("lam_t")] = lam_t
+            x[pb.index("lam_n")] = lam_n
+        return x

@@ -1,0 +1,277 @@
+"""The active-set solver (condensation onto Gamma_C, semismooth Newton) reaches the discrete
+solution of (3.62) that the thesis' Uzawa algorithms converge to, on every shipped scene.
+
+Reference: Algorithm 3.38 / nested Uzawa (Algorithm 3.41, Remark 3.45) at tight tolerances;
+where nested Uzawa stagnates (a Coulomb bound made of round-off on a separated Gamma_C,
+h^ = h~ with g = 0 ...) the independent QP solver of :mod:`ngdual.solvers.reference`.
+Where h^ = h~ and the contact zone reaches the ends of Gamma_C, nu is not unique
+(Lemma 3.29), sigma is: only sigma (and F) are compared there.
+"""
+
+from functools import cache
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from ngdual import post
+from ngdual.afem import refine
+from ngdual.boundary import BoundaryMeshes
+from ngdual.forms import assemble
+from ngdual.friction import build_friction_forms
+from ngdual.mesh import build_mesh
+from ngdual.scene import SceneError, load_scene, shipped_scenes
+from ngdual.solve import solve_problem, solve_scene
+from ngdual.solvers.cholesky import SchurCholesky
+from ngdual.solvers.fast import fast_solve
+from ngdual.solvers.hybrid import HybridSystem
+from ngdual.solvers.reference import solve_qp_friction
+from ngdual.solvers.result import ConvergenceError
+from ngdual.solvers.semismooth import kkt_residuals, semismooth_newton
+from ngdual.solvers.uzawa import uzawa
+
+RTOL = 1e-8
+TIGHT = ["solver.eps=1e-11", "solver.eps1=1e-11", "solver.eps2=1e-10"]
+LEVELS = (1, 2, 3)
+
+
+def rel(a, b):
+    return float(np.linalg.norm(a - b) / max(np.linalg.norm(b), 1e-300))
+
+
+@cache
+def problem(name, level, *overrides):
+    scene = load_scene(name, [*TIGHT, *overrides])
+    pb = assemble(scene, build_mesh(scene.geometry, level))
+    pb.level = level
+    return pb
+
+
+@cache
+def reference(name, level, *overrides):
+    """Uzawa at tight tolerances, or the QP reference where Uzawa does not converge.
+
+    Where Gamma_C does not touch, the Coulomb bound is round-off, on which nested Uzawa
+    stagnates and the QP's fixed point on F does not settle: there F = 0 and the Coulomb
+    solution is the frictionless one, the reference is then Algorithm 3.38.
+    """
+    pb = problem(name, level, "solver.method=uzawa", *overrides)
+    scene = pb.scene
+    if scene.friction.law == "coulomb" and fast(name, level, *overrides).friction_bound.max() == 0:
+        sol = uzawa(pb, eps=1e-11)
+        assert sol.converged
+        return sol, "frictionless"
+    try:
+        sol = solve_problem(pb)
+        if sol.converged:
+            return sol, "uzawa"
+    except ConvergenceError:
+        pass
+    return solve_qp_friction(pb, scene.friction.law, scene.friction.mu), "qp"
+
+
+@cache
+def fast(name, level, *overrides):
+    return solve_problem(problem(name, level, "solver.method=active-set", *overrides))
+
+
+def assert_same_solution(sol, ref, unique_nu=True):
+    pb = sol.problem
+    assert rel(sol.x[pb.sigma], ref.x[ref.problem.sigma]) <= RTOL
+    if not pb.scene.has_contact:
+        return
+    lam = np.concatenate([sol.part("lam_n"), sol.part("lam_t")])
+    lam_ref = np.concatenate([ref.part("lam_n"), ref.part("lam_t")])
+    # lambda = 0 in full stick and contact (g = 0): measure against the displacements
+    u = ref.part("u1", "u2")
+    scale = max(np.linalg.norm(lam_ref), np.sqrt(np.mean(u**2) * len(lam)))
+    assert np.linalg.norm(lam - lam_ref) <= RTOL * scale
+    if sol.friction_bound is None:
+        return
+    F = sol.friction_bound
+    if ref.friction_bound is None:  # frictionless reference: valid only for F = 0
+        assert F.max() == 0.0
+        return
+    F_ref = ref.friction_bound
+    assert np.abs(F - F_ref).max() <= RTOL * max(F_ref.max(), 1.0)
+    if unique_nu:  # nu is arbitrary where F = 0 (or is round-off: no contact)
+        forms = build_friction_forms(pb)
+        relevant = forms.per_hat_edge(F) > 1e-3 * max(F.max(), 1e-300)
+        assert np.abs(sol.nu - ref.nu)[relevant].max(initial=0.0) <= 1e-6
+
+
+SHIPPED = [(name, level) for name in shipped_scenes() for level in LEVELS]
+
+
+@pytest.mark.parametrize(("name", "level"), SHIPPED)
+def test_active_set_reaches_the_uzawa_solution_of_every_shipped_scene(name, level):
+    sol = fast(name, level)
+    ref, _ = reference(name, level)
+    assert sol.converged and sol.method.startswith(("active-set", "linear"))
+    assert_same_solution(sol, ref)
+
+
+@pytest.mark.parametrize("level", LEVELS)
+@pytest.mark.parametrize("name", ["thesis-3.46-coulomb-gap0", "thesis-3.46-coulomb-gap-abs",
+                                  "thesis-3.46-coulomb-gap-3125"])
+def test_hhat_equal_htilde_gives_the_unique_sigma(name, level):
+    """h^ = h~: the reference is the QP wherever nested Uzawa stagnates; sigma and F agree."""
+    sol = fast(name, level, "contact.hhat_factor=1")
+    ref, _ = reference(name, level, "contact.hhat_factor=1")
+    assert sol.converged
+    assert_same_solution(sol, ref, unique_nu=False)
+
+
+@pytest.mark.parametrize(("name", "level"), [(n, 3) for n in shipped_scenes()])
+def test_every_row_and_condition_of_3_62_holds_to_round_off(name, level):
+    r = fast(name, level).residuals
+    assert r["linear"] <= 1e-11
+    for key in ("lambda_n_negative", "sigma_n_positive", "complementarity", "natural",
+                "nu_sign", "nu_bound", "tangential", "sigma_t_bound", "coulomb_bound"):
+        assert r.get(key, 0.0) <= 1e-10, key
+
+
+def test_default_method_is_active_set_and_uzawa_stays_available():
+    auto = solve_scene(load_scene("thesis-3.46-coulomb"), 2)
+    uzawa = solve_scene(load_scene("thesis-3.46-coulomb", ["solver.method=uzawa"]), 2)
+    assert auto.method == "active-set-coulomb"
+    assert uzawa.method.startswith("nested-uzawa-coulomb")
+    assert post.result_record(auto)["parameters"]["solver"]["method"] == "auto"
+    linear = solve_scene(load_scene("thesis-3.46-coulomb", ["boundary.contact=[]",
+                                                            "boundary.dirichlet=[\"left\", "
+                                                            "\"right\", \"bottom\"]",
+                                                            "friction.law=\"none\""]), 2)
+    assert linear.method == "linear"
+
+
+def test_unknown_solver_method_is_named():
+    with pytest.raises(SceneError, match="solver.method"):
+        load_scene("thesis-3.46-coulomb", ["solver.method=newton"])
+
+
+def test_physical_units_scale_exactly():
+    base = fast("thesis-3.46-coulomb", 3)
+    scaled = fast("thesis-3.46-coulomb", 3, "material.E=2e11",
+                  'loads.traction=["0", "-8e8*ifpos(4 - x*x, 1 - x*x/2 + x**4/16, 0)"]')
+    assert scaled.iterations == base.iterations
+    pb = base.problem
+    assert rel(scaled.x[pb.sigma], 1e6 * base.x[pb.sigma]) <= 1e-9
+    assert rel(scaled.x[pb.lam_n], base.x[pb.lam_n]) <= 1e-9
+
+
+@pytest.mark.parametrize("override", ["friction.mu=1.0", "friction.mu=2.0", "material.nu=0.4999",
+                                      "material.E=2e11"])
+def test_hard_parameters_agree_with_the_reference(override):
+    sol = fast("thesis-3.46-coulomb", 3, override)
+    ref, _ = reference("thesis-3.46-coulomb", 3, override)
+    assert_same_solution(sol, ref)
+
+
+def test_strongly_graded_mesh_agrees_with_the_qp_reference():
+    scene = load_scene("thesis-3.46-coulomb", ["solver.method=active-set"])
+    mesh = build_mesh(scene.geometry, 2)
+    coarse = BoundaryMeshes.for_scene(scene, mesh)
+    corner = np.array([-4.0, 0.0])
+    for _ in range(6):
+        at_corner = np.array([any(np.allclose(mesh[v].point, corner) for v in el.vertices)
+                              for el in mesh.Elements()])
+        mesh = refine(mesh, at_corner)
+        coarse = coarse.follow(scene, mesh)
+    pb = assemble(scene, mesh, coarse)
+    sol = fast_solve(pb)
+    ref = solve_qp_friction(pb, "coulomb", scene.friction.mu)
+    assert rel(sol.x[pb.sigma], ref.x[pb.sigma]) <= 1e-7
+
+
+def test_hybridisation_reproduces_the_rows_of_the_assembled_system():
+    """For any lambda, the hybrid solve satisfies the sigma, u, eta, phi rows of K x = F, and
+    t(zeta) are the moments C_n^T sigma, C_t^T sigma and the fine-edge sigma_n of friction.py."""
+    pb = problem("thesis-3.46-coulomb", 2)
+    hs = HybridSystem(pb)
+    H, last = hs.H, hs.contact_index
+    assert abs(H - H.T).max() <= 1e-14 * abs(H).max()
+    rest = np.setdiff1d(np.arange(hs.n_w), last)
+    ce = hs.contact
+    rng = np.random.default_rng(0)
+    lam_t, lam_n = rng.normal(size=(2, ce.hat_means.shape[1])) * 1e-3
+    zeta = np.concatenate([ce.hat_means @ lam_n - ce.gap, ce.hat_means @ lam_t])
+    w = np.zeros(hs.n_w)
+    w[last] = zeta
+    w[rest] = spla.spsolve(H[rest][:, rest].tocsc(), hs.r[rest] - H[rest][:, last] @ zeta)
+    x = hs.unknowns(w, lam_t, lam_n)
+    Kx = pb.K @ x
+    rows = np.concatenate([pb.sigma, pb.index("u1", "u2", "eta", "phi1", "phi2")])
+    assert np.abs(Kx[rows] - pb.F[rows]).max() <= 1e-10 * np.abs(Kx).max()
+    t_f = hs.r[last] - (H @ w)[last]
+    n = len(ce)
+    assert np.allclose(ce.hat_means.T @ t_f[:n], Kx[pb.lam_n], rtol=0, atol=1e-10 * n)
+    assert np.allclose(ce.hat_means.T @ t_f[n:], Kx[pb.index("lam_t")], rtol=0, atol=1e-10 * n)
+    forms = build_friction_forms(pb)
+    assert np.allclose(forms.T_n @ x, t_f[:n] / ce.lengths, rtol=1e-10,
+                       atol=1e-10 * np.abs(t_f).max())
+
+
+@pytest.mark.parametrize("ordering", ["amd", "metis"])
+def test_cholesky_with_chosen_unknowns_last_gives_their_schur_complement(ordering):
+    rng = np.random.default_rng(1)
+    A = sp.random(200, 200, density=0.03, random_state=2)
+    H = (A @ A.T + sp.identity(200)).tocsr()
+    last = rng.choice(200, 15, replace=False)
+    chol = SchurCholesky(H, last, ordering)
+    D = H.toarray()
+    rest = np.setdiff1d(np.arange(200), last)
+    S = D[np.ix_(last, last)] - D[np.ix_(last, rest)] @ np.linalg.solve(
+        D[np.ix_(rest, rest)], D[np.ix_(rest, last)])
+    np.testing.assert_allclose(chol.schur, S, atol=1e-12 * np.abs(S).max())
+    b = rng.normal(size=200)
+    np.testing.assert_allclose(H @ chol.solve(b), b, atol=1e-10)
+    y = chol.forward(b)
+    x_last = rng.normal(size=15)
+    x = chol.solve_with_last(y, x_last)
+    np.testing.assert_allclose(x[last], x_last, atol=1e-12)
+    np.testing.assert_allclose((H @ x - b)[rest], 0.0, atol=1e-10)
+    # t(x_last) = r_I - (H x)_I = reduced_rhs - S x_last
+    np.testing.assert_allclose(chol.reduced_rhs(y) - chol.schur @ x_last, (b - H @ x)[last],
+                               atol=1e-10)
+
+
+def _random_contact(n_c, n_a, seed):
+    rng = np.random.default_rng(seed)
+    X = rng.normal(size=(2 * n_c, 2 * n_c))
+    G = X @ X.T + 2 * n_c * np.eye(2 * n_c)
+    b = rng.normal(size=2 * n_c) * 5
+    Q = np.abs(rng.normal(size=(n_a, n_c))) * (rng.random((n_a, n_c)) < 0.4)
+    return G, b, Q
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_semismooth_newton_solves_random_tresca_problems(seed):
+    G, b, Q = _random_contact(12, 6, seed)
+    sol = semismooth_newton(G, b, 12, Q)
+    assert max(kkt_residuals(G, b, Q, sol.lam_n, sol.lam_t, sol.nu).values()) <= 1e-10
+    # the primal z is the unique minimiser of 1/2 z^T G z - b^T z + |Q lambda_t|_1, lambda_n >= 0
+    z = np.concatenate([sol.lam_n, sol.lam_t])
+    energy = 0.5 * z @ G @ z - b @ z + np.abs(Q @ sol.lam_t).sum()
+    rng = np.random.default_rng(seed)
+    for _ in range(20):
+        w = z + 1e-3 * rng.normal(size=z.shape)
+        w[:12] = np.maximum(w[:12], 0)
+        assert 0.5 * w @ G @ w - b @ w + np.abs(Q @ w[12:]).sum() >= energy - 1e-12
+
+
+def test_qp_fallback_when_newton_is_cut_short():
+    G, b, Q = _random_contact(10, 5, 7)
+    exact = semismooth_newton(G, b, 10, Q)
+    cut = semismooth_newton(G, b, 10, Q, max_iter=1)
+    assert cut.fallback
+    np.testing.assert_allclose(np.concatenate([cut.lam_n, cut.lam_t]),
+                               np.concatenate([exact.lam_n, exact.lam_t]), atol=1e-9)
+
+
+def test_dependent_stick_rows_leave_z_unique():
+    """Two identical rows of Q_F (nu not unique, as for h^ = h~ at the ends of Gamma_C)."""
+    G, b, Q = _random_contact(8, 3, 3)
+    Q = np.vstack([Q, Q[:1]])
+    sol = semismooth_newton(G, b, 8, Q * 1e3)
+    assert max(kkt_residuals(G, b, Q * 1e3, sol.lam_n, sol.lam_t, sol.nu).values()) <= 1e-10

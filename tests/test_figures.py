@@ -1,0 +1,248 @@
+"""``ngdual figures`` regenerates every figure and table of Sections 3.4 and 4.2, and a sweep
+that is killed half way loses nothing.
+
+* Smoke test, documented coarse mode ``--max-level 2`` (one worker thread): every thesis
+  figure and table has an entry, every file an entry or the index names exists and is not
+  empty, every number in the CSV files is finite, every data file records the package
+  versions, Table 3.1 matches the thesis, and the norms and DOFs of Tables 3.1-3.3 are
+  those of ``ngdual solve`` on the same scene and level.
+* Figures are readable without the thesis: the JSON sidecar of every figure shows a
+  title, axis labels with units, a legend where curves are labelled, and a colour bar
+  with a label where a field is coloured.
+* A sweep run in a subprocess is killed (SIGKILL) after some records exist; the re-run
+  completes, recomputes only the missing tasks and leaves the finished records untouched
+  (same file modification time and start stamp).
+* The pieces: plan sizes (the thesis' step counts at K = 8), task ids, failed and
+  not-converged tasks recorded with their message, the Aitken / e_tot / rate helpers.
+"""
+
+import csv
+import json
+import math
+import os
+import re
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from ngdual.cli import main
+from ngdual.figures import Plan, best, errors, markdown_table, rates, reference_norms
+from ngdual.sweep import Task, execute, load_record, run_task
+
+COARSE = "2"
+EXPECTED = ([f"Fig. 3.{n}" for n in range(10, 29)] + [f"Table 3.{n}" for n in range(1, 7)]
+            + ["Figs. 4.1-4.8", "Figs. 4.9-4.13"] + [f"Table 4.{n}" for n in range(1, 5)]
+            + ["Work-precision (beyond the thesis)"])
+UNIT = re.compile(r"\[[^\]]+\]")
+
+
+@pytest.fixture(scope="module")
+def coarse_run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("figures")
+    start = time.perf_counter()
+    code = main(["figures", "--max-level", COARSE, "--threads", "--out", str(out)])
+    print(f"\nngdual figures --max-level {COARSE}: {time.perf_counter() - start:.0f} s")
+    assert code == 0
+    return out
+
+
+def entries(out: Path) -> list[dict]:
+    return [json.loads(p.read_text()) for p in sorted((out / "entries").glob("*.json"))]
+
+
+def read_csv(path: Path) -> list[dict]:
+    lines = [line for line in path.read_text().splitlines() if not line.startswith("#")]
+    return list(csv.DictReader(lines))
+
+
+def test_every_figure_and_table_has_its_files(coarse_run):
+    run = json.loads((coarse_run / "run.json").read_text())
+    assert all(s["status"] == "ok" for s in run["scripts"].values()), run["scripts"]
+    found = {e["thesis"] for e in entries(coarse_run)}
+    assert set(EXPECTED) <= found
+    for e in entries(coarse_run):
+        assert e["files"], e["script"]
+        for name in e["files"]:
+            assert (coarse_run / name).stat().st_size > 0, name
+        if any(name.endswith(".png") for name in e["files"]):
+            assert any(name.endswith(".pdf") for name in e["files"])
+    index = (coarse_run / "index.md").read_text()
+    for link in re.findall(r"\]\(([^)]+)\)", index):
+        assert (coarse_run / link).stat().st_size > 0, link
+    for thesis in EXPECTED:
+        assert f"### {thesis}" in index
+    # one file per thesis figure of the adaptive sequences
+    assert len(list((coarse_run / "figures").glob("fig_4_*.png"))) == 13
+
+
+def test_tabulated_numbers_are_finite_and_carry_versions(coarse_run):
+    data = sorted((coarse_run / "data").iterdir())
+    assert len(data) >= 30
+    for path in data:
+        text = path.read_text()
+        assert "versions" in text and "ngsolve" in text, path.name
+        if path.suffix != ".csv":
+            continue
+        rows = read_csv(path)
+        assert rows, path.name
+        for row in rows:
+            for key, value in row.items():
+                assert value.lower() not in ("nan", "inf", "-inf"), (path.name, key)
+                try:
+                    number = float(value)
+                except ValueError:
+                    continue
+                assert math.isfinite(number), (path.name, key)
+    for record in (coarse_run / "records").glob("*.json"):
+        assert "ngsolve" in json.loads(record.read_text())["versions"]
+
+
+@pytest.mark.parametrize("problem, table", [("frictionless", "tab_3_3_norms_frictionless"),
+                                            ("coulomb", "tab_3_2_norms_coulomb")])
+def test_tables_agree_with_ngdual_solve(coarse_run, tmp_path, problem, table, capsys):
+    level = int(COARSE)
+    assert main(["solve", f"thesis-3.46-{problem}", "--level", str(level), "--out",
+                 str(tmp_path), "--no-plots"]) == 0
+    capsys.readouterr()
+    solved = json.loads((tmp_path / "result.json").read_text())
+    row = next(r for r in read_csv(coarse_run / "data" / f"{table}.csv")
+               if r["level"] == str(level))
+    for key, value in solved["norms"].items():
+        if value is not None and key in row:
+            assert float(row[key]) == pytest.approx(value, rel=1e-9), key
+    assert int(row["ndof"]) == sum(solved["dofs"].values())
+    dofs = next(r for r in read_csv(coarse_run / "data" / "tab_3_1_dofs.csv")
+                if r["level"] == str(level))
+    # Table 3.1 counts the frictional spaces (nu: L); the frictionless problem has no nu
+    assert all(int(dofs[k]) == v for k, v in solved["dofs"].items() if v)
+
+
+def test_table_3_1_matches_the_thesis(coarse_run):
+    rows = read_csv(coarse_run / "data" / "tab_3_1_dofs.csv")
+    assert len(rows) == int(COARSE) and all(r["matches_thesis"] == "True" for r in rows)
+
+
+def test_figures_are_readable_without_the_thesis(coarse_run):
+    sidecars = sorted((coarse_run / "figures").glob("*.json"))
+    assert len(sidecars) >= 30
+    for path in sidecars:
+        texts = json.loads(path.read_text())
+        assert texts["suptitle"] or all(a.get("title") for a in texts["axes"]), path.name
+        plots = [a for a in texts["axes"] if not a["colorbar"]]
+        colorbars = [a for a in texts["axes"] if a["colorbar"]]
+        assert plots, path.name
+        for ax in plots:
+            assert ax["title"], path.name
+            assert UNIT.search(ax["xlabel"]) and UNIT.search(ax["ylabel"]), (path.name, ax)
+            if ax["labelled_lines"]:
+                assert ax["legend"] or texts["figure_legend"], (path.name, ax["title"])
+            if ax["filled"]:
+                assert colorbars or ax["legend"], (path.name, ax["title"])
+        for bar in colorbars:
+            assert UNIT.search(bar["label"]), (path.name, bar)
+
+
+def test_a_rerun_computes_nothing(coarse_run, capsys):
+    assert main(["figures", "--max-level", COARSE, "--threads", "--out", str(coarse_run),
+                 "--only", "tab_3_1", "tab_3_3"]) == 0
+    run = json.loads((coarse_run / "run.json").read_text())
+    assert run["computed_tasks"] == 0 and run["tasks"] > 0
+    assert "0 computed" in capsys.readouterr().out
+
+
+# --- killing a sweep --------------------------------------------------------------------------
+
+def test_a_killed_sweep_resumes_without_recomputing(tmp_path):
+    """tab_3_6 at level 2: the (rho_1, rho_2) grid on levels 1 and 2 (20 nested Uzawa solves)."""
+    out = tmp_path / "out"
+    command = [sys.executable, "-m", "ngdual", "figures", "--max-level", COARSE, "--threads",
+               "--only", "tab_3_6", "--out", str(out)]
+    env = dict(os.environ, MPLBACKEND="Agg")
+    records = out / "records"
+    proc = subprocess.Popen(command, env=env, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL, start_new_session=True)
+    try:
+        deadline = time.monotonic() + 120
+        while len(list(records.glob("*.json"))) < 4:
+            assert proc.poll() is None, "the sweep ended before it could be killed"
+            assert time.monotonic() < deadline
+            time.sleep(0.05)
+        os.killpg(proc.pid, signal.SIGKILL)
+    finally:
+        proc.wait()
+    before = {p.name: (p.stat().st_mtime_ns, json.loads(p.read_text())["started"])
+              for p in records.glob("*.json")}
+    assert not (out / "run.json").exists()
+    subprocess.run(command, env=env, check=True, capture_output=True, timeout=300)
+    run = json.loads((out / "run.json").read_text())
+    after = {p.name: (p.stat().st_mtime_ns, json.loads(p.read_text())["started"])
+             for p in records.glob("*.json")}
+    assert len(before) < run["tasks"] == len(after)
+    assert run["computed_tasks"] == run["tasks"] - len(before)
+    for name, stamp in before.items():
+        assert after[name] == stamp, name
+    assert not list(records.glob("*.tmp"))
+    assert json.loads((out / "entries" / "tab_3_6_iterations_coulomb.json").read_text())
+
+
+# --- the pieces ------------------------------------------------------------------------------
+
+def test_the_thesis_scale_plan_uses_the_thesis_steps():
+    plan = Plan(8)
+    assert plan.levels == list(range(1, 9)) and plan.reference_levels == [6, 7, 8]
+    assert plan.max_marking_snapshots == [0, 4, 8, 12, 16, 20, 24, 28]
+    assert plan.fraction_snapshots == [1, 3, 5, 7, 9]
+    assert plan.rho_level == 4
+    small = Plan(2)
+    assert len(small.max_marking_snapshots) == 8 and len(small.fraction_snapshots) == 5
+    with pytest.raises(ValueError, match="max-level"):
+        Plan(9)
+    assert main(["figures", "--max-level", "1", "--out", "unused"]) == 2
+
+
+def test_task_ids_are_stable_and_distinguish_parameters():
+    a = Task("solve", {"scene": "thesis-3.46-coulomb", "level": 2, "overrides": []}, "x", 1.0)
+    b = Task("solve", {"level": 2, "overrides": [], "scene": "thesis-3.46-coulomb"}, "y", 9.0)
+    c = Task("solve", {"scene": "thesis-3.46-coulomb", "level": 3, "overrides": []})
+    assert a.id == b.id != c.id and a.id.startswith("solve-thesis-3.46-coulomb-L2-")
+
+
+def test_failed_and_unconverged_solves_are_records_with_their_message(tmp_path):
+    failing = Task("solve", {"scene": "thesis-3.46-coulomb", "level": 1,
+                             "overrides": ['solver.method="uzawa"', "solver.max_iter=2"]})
+    record, arrays = execute(failing)
+    assert record["status"] == "failed" and "max_iter" in record["message"]
+    assert arrays == {} and record["versions"]["ngdual"]
+    stopped = Task("solve", {"scene": "thesis-3.46-frictionless", "level": 1,
+                             "overrides": ['solver.method="uzawa"', "solver.max_iter=2"]})
+    run_task(stopped, str(tmp_path))
+    assert load_record(tmp_path, stopped)["status"] == "not-converged"
+    broken = Task("solve", {"scene": "no-such-scene", "level": 1})
+    record, _ = execute(broken)
+    assert record["status"] == "error" and "no-such-scene" in record["message"]
+    run_task(broken, str(tmp_path))
+    assert load_record(tmp_path, broken) is None  # retried by the next run
+
+
+def test_error_helpers():
+    records = [{"norms": {"u": 1.5, "nu": None}, "ndof": 10},
+               {"norms": {"u": 1.25, "nu": None}, "ndof": 40},
+               {"norms": {"u": 1.125, "nu": None}, "ndof": 160}]
+    reference = reference_norms(records)
+    assert reference["u"] == pytest.approx(1.0) and reference["nu"] is None
+    e = [r["e_tot"] for r in errors(records, reference)]
+    assert e[0] == pytest.approx(math.sqrt(1.5**2 - 1))
+    alpha = rates([10, 40, 160], e)
+    assert alpha[0] is None and alpha[1] == pytest.approx(
+        -2 * math.log(e[0] / e[1]) / math.log(10 / 40))
+    ok = {"a": {"status": "ok", "iterations": {"outer": 9, "inner": 50},
+                "timings_s": {"solve": 1.0}},
+          "b": {"status": "ok", "iterations": {"outer": 5, "inner": 80},
+                "timings_s": {"solve": 0.5}},
+          "c": {"status": "failed"}}
+    assert best(ok) == "a"
+    assert "| 1 | - |" in markdown_table([{"a": 1}], {"a": "A", "b": "B"})
