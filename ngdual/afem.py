@@ -138,7 +138,8 @@ def step_record(step: int, solution: Solution, indicators: Estimate,
         "norms": norms(solution),
         "marked": 0,
         "timings_s": {"assemble": float(timings.get("assemble", pb.assemble_seconds)),
-                      "solve": float(timings.get("factorize", 0.0) + timings.get("solve", 0.0)),
+                      "solve": float(timings.get("factorize", 0.0) + timings.get("condense", 0.0)
+                                       + timings.get("solve", 0.0)),
                       "estimate": indicators.seconds, "mark": 0.0, "refine": 0.0},
     }
     if reference is not None:

@@ -334,7 +334,8 @@ def friction_diagnostics(solution: Solution, slip_tol: float = 1e-6) -> Friction
     held = under_hat @ np.ones(forms.n_nu)  # no F under the hat: the node slides freely
     node_status = np.where(_in_contact(lam_n, lam_t),
                            np.where((slips > 0) | (held == 0), "slip", "stick"), "separation")
-    ratio = np.abs(t_t) / np.maximum(np.abs(t_n), np.finfo(float).tiny)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.where(t_n != 0, np.abs(t_t) / np.abs(t_n), np.inf)
     hat_mid = np.array([forms.midpoints[forms.edge_of == j].mean(axis=0)
                         for j in range(forms.n_nu)])
     return FrictionDiagnostics(pb.spaces.contact.node_points(), lam_n, lam_t, t_n, t_t, ratio,
