@@ -1,7 +1,7 @@
 """``ngdual figures`` regenerates every figure and table of Sections 3.4 and 4.2, and a sweep
 that is killed half way loses nothing.
 
-* Smoke test, documented coarse mode ``--max-level 2`` (one worker thread): every thesis
+* Smoke test, ``ngdual figures --max-level 3`` (one worker thread, ~1 min): every thesis
   figure and table has an entry, every file an entry or the index names exists and is not
   empty, every number in the CSV files is finite, every data file records the package
   versions, Table 3.1 matches the thesis, and the norms and DOFs of Tables 3.1-3.3 are
@@ -33,7 +33,8 @@ from ngdual.cli import main
 from ngdual.figures import Plan, best, errors, markdown_table, rates, reference_norms
 from ngdual.sweep import Task, execute, load_record, run_task
 
-COARSE = "2"
+SMOKE = "3"     # the smoke run of every script
+COARSE = "2"    # the sweep that is killed and resumed
 EXPECTED = ([f"Fig. 3.{n}" for n in range(10, 29)] + [f"Table 3.{n}" for n in range(1, 7)]
             + ["Figs. 4.1-4.8", "Figs. 4.9-4.13"] + [f"Table 4.{n}" for n in range(1, 5)]
             + ["Work-precision (beyond the thesis)"])
@@ -44,8 +45,8 @@ UNIT = re.compile(r"\[[^\]]+\]")
 def coarse_run(tmp_path_factory):
     out = tmp_path_factory.mktemp("figures")
     start = time.perf_counter()
-    code = main(["figures", "--max-level", COARSE, "--threads", "--out", str(out)])
-    print(f"\nngdual figures --max-level {COARSE}: {time.perf_counter() - start:.0f} s")
+    code = main(["figures", "--max-level", SMOKE, "--threads", "--out", str(out)])
+    print(f"\nngdual figures --max-level {SMOKE}: {time.perf_counter() - start:.0f} s")
     assert code == 0
     return out
 
@@ -104,7 +105,7 @@ def test_tabulated_numbers_are_finite_and_carry_versions(coarse_run):
 @pytest.mark.parametrize("problem, table", [("frictionless", "tab_3_3_norms_frictionless"),
                                             ("coulomb", "tab_3_2_norms_coulomb")])
 def test_tables_agree_with_ngdual_solve(coarse_run, tmp_path, problem, table, capsys):
-    level = int(COARSE)
+    level = int(SMOKE)
     assert main(["solve", f"thesis-3.46-{problem}", "--level", str(level), "--out",
                  str(tmp_path), "--no-plots"]) == 0
     capsys.readouterr()
@@ -123,7 +124,7 @@ def test_tables_agree_with_ngdual_solve(coarse_run, tmp_path, problem, table, ca
 
 def test_table_3_1_matches_the_thesis(coarse_run):
     rows = read_csv(coarse_run / "data" / "tab_3_1_dofs.csv")
-    assert len(rows) == int(COARSE) and all(r["matches_thesis"] == "True" for r in rows)
+    assert len(rows) == int(SMOKE) and all(r["matches_thesis"] == "True" for r in rows)
 
 
 def test_figures_are_readable_without_the_thesis(coarse_run):
@@ -147,7 +148,7 @@ def test_figures_are_readable_without_the_thesis(coarse_run):
 
 
 def test_a_rerun_computes_nothing(coarse_run, capsys):
-    assert main(["figures", "--max-level", COARSE, "--threads", "--out", str(coarse_run),
+    assert main(["figures", "--max-level", SMOKE, "--threads", "--out", str(coarse_run),
                  "--only", "tab_3_1", "tab_3_3"]) == 0
     run = json.loads((coarse_run / "run.json").read_text())
     assert run["computed_tasks"] == 0 and run["tasks"] > 0
