@@ -31,7 +31,7 @@ ORDERINGS = ("amd", "metis")
 BLAS_THREADS = 1
 
 
-def fill_reducing_order(H: sp.spmatrix, method: str = "metis") -> np.ndarray:
+def fill_reducing_order(H: sp.spmatrix, method: str = "amd") -> np.ndarray:
     """A fill-reducing permutation of the symmetric matrix H (nested dissection or AMD)."""
     if method not in ORDERINGS:
         raise ValueError(f"unknown ordering {method!r}; use one of {ORDERINGS}")

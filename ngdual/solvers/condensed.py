@@ -12,9 +12,10 @@ lambda_t rows. The iteration only ever looks at a few linear functionals of y
 
 every step costs a small dense matrix-vector product instead of a sparse
 forward/back solve. Z is never stored: it is computed in blocks of columns and
-reduced at once to G = O Z and (optionally, for m more solves) to the Gram
-data Z^T Z = R^T K^{-1} Z (K is symmetric) and y_0^T Z that give the norm of y
-and of its increments exactly, so the Uzawa loops keep the thesis' stopping
+reduced at once to G = O Z and (optionally) to the Gram data Z^T Z and y_0^T Z
+that give the norm of y and of its increments exactly (Z^T Z from Z itself when
+it fits in ``KEEP_Z_BYTES``, else as R^T K^{-1} Z with m more solves, K being
+symmetric), so the Uzawa loops keep the thesis' stopping
 rule (relative increment of all unknowns, step 5 of Algorithm 3.38) and their
 iterates are those of the uncondensed loops up to rounding.
 """
@@ -27,6 +28,7 @@ import scipy.sparse as sp
 from .linear import Factorization
 
 BLOCK = 64
+KEEP_Z_BYTES = 2 * 2**30
 
 
 class CondensedResponse:
@@ -62,15 +64,23 @@ class CondensedResponse:
         self.gram = np.zeros((m, m)) if gram else None
         self.y0_Z = np.zeros(m)
         self.n_solves = 1
+        # Z itself, if it fits, gives the Gram data Z^T Z without the m further solves of
+        # R^T K^{-1} Z (the same matrix, K being symmetric)
+        keep = gram and len(r0) * m * 8 <= KEEP_Z_BYTES
+        Z_all = np.empty((len(r0), m)) if keep else None
         for start in range(0, m, BLOCK):
             blk = slice(start, min(start + BLOCK, m))
             Z = fact.solve_many(self.inputs[:, blk].toarray())
             self.G[:, blk] = self.outputs @ Z
             self.y0_Z[blk] = self.y0 @ Z
             self.n_solves += Z.shape[1]
-            if gram:  # Z^T Z = R^T K^{-1} Z (K symmetric): no need to keep Z
+            if keep:
+                Z_all[:, blk] = Z
+            elif gram:  # Z^T Z = R^T K^{-1} Z (K symmetric): no need to keep Z
                 self.gram[:, blk] = self.inputs.T @ fact.solve_many(Z)
                 self.n_solves += Z.shape[1]
+        if keep:
+            self.gram = Z_all.T @ Z_all
         if gram:
             self.gram = 0.5 * (self.gram + self.gram.T)
         self.y0_y0 = float(self.y0 @ self.y0)

@@ -29,6 +29,7 @@ affine function t(zeta) = t_hat - S zeta of zeta (:class:`ContactSchur`).
 
 from __future__ import annotations
 
+import contextlib
 import time
 from dataclasses import dataclass
 
@@ -97,6 +98,15 @@ def _normal_fluxes(hdiv: ngs.FESpace, mesh: ngs.Mesh, labels: list[str]) -> np.n
     return np.array(out)
 
 
+# NGSolve's task manager starts its threads on entry (0.2-0.4 s on 2 cores): worth it only
+# from this many elements on (level 5 of Example 3.46)
+PARALLEL_ELEMENTS = 8192
+
+
+def _tasks(mesh: ngs.Mesh):
+    return ngs.TaskManager() if mesh.ne >= PARALLEL_ELEMENTS else contextlib.nullcontext()
+
+
 class HybridSystem:
     """The hybridised, statically condensed system of (3.62), reduced to H w = r.
 
@@ -147,7 +157,7 @@ class HybridSystem:
         a += (u * div_tau + v * div_sig).Compile() * dx
         a += (eta * peers.asym(tau) + xi * peers.asym(sig)).Compile() * dx
         a += (m * trac_tau + k * trac_sig).Compile() * dT
-        with ngs.TaskManager():
+        with _tasks(self.mesh):
             a.Assemble()
         # the only local load is -f(v) in the u rows: taken from the assembled F of (3.62)
         self.rhs = a.mat.CreateColVector()
@@ -158,7 +168,7 @@ class HybridSystem:
             values[rg.start:rg.stop] = problem.F[problem.blocks[name]]
         condensed = self.rhs.CreateVector()
         condensed.data = self.rhs
-        with ngs.TaskManager():
+        with _tasks(self.mesh):
             condensed.data += a.harmonic_extension_trans * self.rhs
         self.form = a
         self.assemble_seconds = time.perf_counter() - start
@@ -282,7 +292,7 @@ class HybridSystem:
         gf = ngs.GridFunction(fes)
         vec = gf.vec
         vec.FV().NumPy()[:] = self.T @ w + self.c0
-        with ngs.TaskManager():
+        with _tasks(self.mesh):
             vec.data += self.form.harmonic_extension * vec
             vec.data += self.form.inner_solve * self.rhs
         values = vec.FV().NumPy()

@@ -24,10 +24,11 @@ inequalities as the equations
 
 whose Newton steps are linear systems on the current sets: separation (t_n = 0) or
 contact (lambda_n = 0); stick (q_j = 0) or slip (nu_j = sign(nu_j + c_t q_j)). The sets
-of the next step are those of the new iterate; the method stops when they repeat. If it
-cycles or the last step does not satisfy the conditions, the problem is solved as a convex
-QP (Clarabel through cvxpy) and polished by one Newton step on the QP's sets. The result is
-always checked (:func:`kkt_residuals`).
+of the next step are those of the new iterate; the method stops as soon as the conditions
+hold to round-off. If the sets repeat first (cycling), the problem is solved as a convex
+QP (Clarabel through cvxpy) and Newton restarts from the QP's solution. The result is
+always checked (:func:`kkt_residuals`); a :class:`ConvergenceError` says when neither
+path satisfies the conditions.
 """
 
 from __future__ import annotations
@@ -180,8 +181,8 @@ def semismooth_newton(G: np.ndarray, b: np.ndarray, n_c: int, Q: np.ndarray | No
     G, b : numpy.ndarray
         t(z) = b - G z, z = (lambda_n, lambda_t), each of length ``n_c``.
     Q : numpy.ndarray, optional
-        Q_F (N_A x N_C); rows of zeros (F = 0) leave nu_j = 0. Without Q, lambda_t is
-        free and t_t = 0 (no friction).
+        Q_F (N_A x N_C); on rows that vanish (F = 0 on the h^ edge) nu_j = sign(q_j).
+        Without Q, lambda_t is free and t_t = 0 (no friction).
     start : BoundarySolution, optional
         Warm start (the previous fixed-point step of Coulomb friction).
 
