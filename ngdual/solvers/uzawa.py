@@ -96,8 +96,9 @@ class ContactLoop:
 
     With ``condensed=True`` the linear solve of step 3 is replaced by the
     Gamma_C response of :class:`~ngdual.solvers.condensed.CondensedResponse`
-    (4 N_C + 1 solves once: 2 N_C for the response, 2 N_C for the Gram data of
-    the stopping rule; then small dense products): the same iterates and
+    (2 N_C + 1 solves once for the response; the Gram data of the stopping rule
+    come from the same solves, or from 2 N_C more where the responses do not fit in
+    memory; then small dense products): the same iterates and
     the same stopping rule at a fraction of the cost when there are many steps.
     ``extra_outputs`` (k x saddle, sparse) are further functionals of y to observe.
     """
