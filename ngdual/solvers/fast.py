@@ -91,7 +91,17 @@ def fast_solve(problem: DiscreteProblem, law: str | None = None, mu_f: float = 0
     # the dense work is small (at most a few thousand unknowns): one BLAS thread is as fast
     # and immune to the spin-waiting of threaded BLAS on busy cores
     with threadpool_limits(limits=BLAS_THREADS, user_api="blas"):
-        return _fast_solve(problem, law, mu_f, tol, max_iter, ordering, metric, progress)
+        try:
+            return _fast_solve(problem, law, mu_f, tol, max_iter, ordering, metric, progress)
+        except ConvergenceError as err:
+            scene = problem.scene
+            if (law or scene.friction.law) in ("tresca", "coulomb") \
+                    and scene.contact.hhat_factor == 1:
+                raise ConvergenceError(f"{err}; with h^ = h~ the inf-sup condition (3.74) "
+                                       "for nu fails where the contact zone reaches the end of "
+                                       "Gamma_C: try contact.hhat_factor = 2",
+                                       err.history) from err
+            raise
 
 
 def _fast_solve(problem: DiscreteProblem, law: str | None, mu_f: float, tol: float,
