@@ -26,11 +26,10 @@ import pytest
 from ngdual.afem import adapt, convergence_rate, reference_norms, refine
 from ngdual.boundary import BoundaryMeshes, CoarseMesh
 from ngdual.cli import main
-from ngdual.expr import Expression
+from ngdual.corner import LABELS, POINTS, corner_exponent, exact_error, exact_fields, l_shape_scene
 from ngdual.marking import mark_fraction, mark_max
 from ngdual.mesh import polygon_mesh, refine_uniformly, thesis_mesh
-from ngdual.post import fields
-from ngdual.scene import Geometry, Loads, Material, Scene, load_scene, validate
+from ngdual.scene import Geometry, Scene, load_scene, validate
 
 # --- coarse boundary meshes ----------------------------------------------------------------------
 
@@ -123,66 +122,10 @@ def test_coarse_meshes_stay_nested_and_twice_as_coarse_under_local_refinement(ca
 
 # --- L-shaped domain -----------------------------------------------------------------------------
 
-E, NU = 1.0, 0.3
-OMEGA = 3 * math.pi / 4  # half the interior angle at the re-entrant corner
-L_POINTS = [(-1, -1), (0, -1), (0, 0), (1, 0), (1, 1), (-1, 1)]
-L_LABELS = ["bottom", "corner_v", "corner_h", "right", "top", "left"]
-
-
-def corner_exponent() -> float:
-    """alpha in (0, 1) with sin(2 omega alpha) + alpha sin(2 omega) = 0 (Newton)."""
-    alpha = 0.5
-    for _ in range(30):
-        alpha -= ((math.sin(2 * OMEGA * alpha) + alpha * math.sin(2 * OMEGA))
-                  / (2 * OMEGA * math.cos(2 * OMEGA * alpha) + math.sin(2 * OMEGA)))
-    return alpha
-
-
-def corner_displacement() -> list[str]:
-    """Williams' symmetric mode at the corner, plane strain, as scene formulas in x, y.
-
-    In polar coordinates (r, theta) about the corner, theta from the bisector of the
-    domain: 2 mu u_r = r^a (-(a+1) cos((a+1) th) + (kappa - a) B cos((a-1) th)),
-    2 mu u_th = r^a ((a+1) sin((a+1) th) + (kappa + a) B sin((a-1) th)),
-    kappa = 3 - 4 nu, B = -cos((a+1) omega) / cos((a-1) omega).
-    """
-    a, (_, mu) = corner_exponent(), Material(E, NU).lame
-    kappa = 3 - 4 * NU
-    b = -math.cos((a + 1) * OMEGA) / math.cos((a - 1) * OMEGA)
-    r = "sqrt(x*x + y*y)"
-    th = "atan2(-(x + y), y - x)"  # the bisector points along (-1, 1)
-    ph = f"({th} + {OMEGA!r})"
-    ur = (f"({r})**{a!r}*(-({a + 1!r})*cos({a + 1!r}*{th}) "
-          f"+ ({(kappa - a) * b!r})*cos({a - 1!r}*{th}))/{2 * mu!r}")
-    ut = (f"({r})**{a!r}*(({a + 1!r})*sin({a + 1!r}*{th}) "
-          f"+ ({(kappa + a) * b!r})*sin({a - 1!r}*{th}))/{2 * mu!r}")
-    return [f"({ur})*cos({ph}) - ({ut})*sin({ph})", f"({ur})*sin({ph}) + ({ut})*cos({ph})"]
-
-
-def l_shape_scene() -> Scene:
-    sc = Scene("l-shape-corner-singularity",
-               Geometry(kind="polygon", points=L_POINTS, labels=L_LABELS, maxh=0.5),
-               {"dirichlet": ["bottom", "right", "top", "left"],
-                "neumann": ["corner_v", "corner_h"]},
-               material=Material(E, NU), loads=Loads(displacement=corner_displacement()))
-    validate(sc)
-    return sc
-
-
-def exact_fields():
-    u = ngs.CF(tuple(Expression(c).coefficient() for c in corner_displacement()))
-    grad = ngs.CF((u[0].Diff(ngs.x), u[0].Diff(ngs.y), u[1].Diff(ngs.x), u[1].Diff(ngs.y)),
-                  dims=(2, 2))
-    eps = 0.5 * (grad + grad.trans)
-    lam, mu = Material(E, NU).lame
-    sigma = 2 * mu * eps + lam * ngs.Trace(eps) * ngs.Id(2)
-    return u, sigma, 0.5 * (grad[0, 1] - grad[1, 0])
-
-
 def test_corner_solution_is_an_equilibrium_free_at_the_corner_sides():
     """div sigma = 0 in the domain and sigma n = 0 on the two sides at the corner."""
     u, sigma, _ = exact_fields()
-    mesh = polygon_mesh(L_POINTS, L_LABELS, 0.25)
+    mesh = polygon_mesh(POINTS, LABELS, 0.25)
     div = ngs.CF(tuple(sigma[i, 0].Diff(ngs.x) + sigma[i, 1].Diff(ngs.y) for i in range(2)))
     # away from the corner, where sigma ~ r^(alpha - 1) is smooth
     far = ngs.IfPos(ngs.x * ngs.x + ngs.y * ngs.y - 0.04, 1, 0)
@@ -195,20 +138,6 @@ def test_corner_solution_is_an_equilibrium_free_at_the_corner_sides():
     assert free < 1e-20 * scale
 
 
-def error(solution, exact) -> float:
-    """(||sigma - sigma_h||^2 + ||div sigma_h||^2 + ||u - u_h||^2 + ||eta - eta_h||^2)^{1/2}."""
-    u, sigma, eta = exact
-    f = fields(solution)
-    mesh = solution.problem.fes.mesh
-
-    def integral(cf):
-        return ngs.Integrate(cf * ngs.dx(bonus_intorder=6), mesh)
-
-    return math.sqrt(integral(ngs.InnerProduct(sigma - f.sigma, sigma - f.sigma))
-                     + integral(f.div_sigma * f.div_sigma) + integral((u - f.u) * (u - f.u))
-                     + integral((eta - f.eta) ** 2))
-
-
 @cache
 def l_shape_runs():
     scene, exact = l_shape_scene(), exact_fields()
@@ -218,7 +147,7 @@ def l_shape_runs():
         rows = []
 
         def on_step(record, solution, estimate, marked, rows=rows):
-            rows.append((record["dofs"]["total"], error(solution, exact), record["eta"]))
+            rows.append((record["dofs"]["total"], exact_error(solution, exact), record["eta"]))
 
         adapt(scene, marking, theta, steps, level=1, asymmetry="l2", on_step=on_step)
         runs[name] = rows

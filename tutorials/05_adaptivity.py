@@ -37,12 +37,11 @@ import matplotlib.tri as mtri
 import ngsolve as ngs
 import numpy as np
 
+from ngdual import corner
 from ngdual.afem import adapt, convergence_rate, reference_norms
 from ngdual.estimator import estimate
-from ngdual.expr import Expression
 from ngdual.marking import STRATEGIES, mark
-from ngdual.post import fields
-from ngdual.scene import Geometry, Loads, Material, Scene, load_scene, validate
+from ngdual.scene import load_scene
 from ngdual.solve import solve_scene
 from ngdual.tutorials import output_dir, quick_mode, save_figure, save_results
 
@@ -152,71 +151,20 @@ plot_meshes([(level2, marked_sets[s], f"{s}, theta = {examples[s]}: {marked_sets
 # σ ∈ H^{α−ε}: uniform refinement gives e ~ h^α ~ N^{−α/2}.
 
 # %%
-E, NU = 1.0, 0.3
-OMEGA = 3 * math.pi / 4                                  # half the interior angle
-L_POINTS = [(-1, -1), (0, -1), (0, 0), (1, 0), (1, 1), (-1, 1)]
-L_LABELS = ["bottom", "corner_v", "corner_h", "right", "top", "left"]
+# The exact solution is in `ngdual.corner` (read its source: Williams' formulas written as
+# scene expressions in x and y), with the scene and the exact error of PEERS,
+# (‖σ − σ_h‖² + ‖div σ_h‖² + ‖u − u_h‖² + ‖η − η_h‖²)^{1/2}.
 
-
-def corner_exponent() -> float:
-    """alpha with sin(2 omega alpha) + alpha sin(2 omega) = 0, by Newton from 1/2."""
-    alpha = 0.5
-    for _ in range(30):
-        alpha -= ((math.sin(2 * OMEGA * alpha) + alpha * math.sin(2 * OMEGA))
-                  / (2 * OMEGA * math.cos(2 * OMEGA * alpha) + math.sin(2 * OMEGA)))
-    return alpha
-
-
-def corner_displacement() -> list[str]:
-    """Williams' mode I at the corner, plane strain, as scene formulas in x and y.
-
-    Polar coordinates (r, th) about the corner, th from the bisector (-1, 1):
-    2 mu u_r = r^a (-(a+1) cos((a+1) th) + (kappa - a) B cos((a-1) th)),
-    2 mu u_th = r^a ((a+1) sin((a+1) th) + (kappa + a) B sin((a-1) th)),
-    kappa = 3 - 4 nu, B = -cos((a+1) omega) / cos((a-1) omega).
-    """
-    a, (_, mu) = corner_exponent(), Material(E, NU).lame
-    kappa = 3 - 4 * NU
-    b = -math.cos((a + 1) * OMEGA) / math.cos((a - 1) * OMEGA)
-    r = "sqrt(x*x + y*y)"
-    th = "atan2(-(x + y), y - x)"
-    ph = f"({th} + {OMEGA!r})"                           # the polar angle of (x, y)
-    ur = (f"({r})**{a!r}*(-({a + 1!r})*cos({a + 1!r}*{th}) "
-          f"+ ({(kappa - a) * b!r})*cos({a - 1!r}*{th}))/{2 * mu!r}")
-    ut = (f"({r})**{a!r}*(({a + 1!r})*sin({a + 1!r}*{th}) "
-          f"+ ({(kappa + a) * b!r})*sin({a - 1!r}*{th}))/{2 * mu!r}")
-    return [f"({ur})*cos({ph}) - ({ut})*sin({ph})", f"({ur})*sin({ph}) + ({ut})*cos({ph})"]
-
-
-l_shape = Scene("l-shape-corner", Geometry(kind="polygon", points=L_POINTS, labels=L_LABELS,
-                                           maxh=0.5),
-                {"dirichlet": ["bottom", "right", "top", "left"],
-                 "neumann": ["corner_v", "corner_h"]},
-                material=Material(E, NU), loads=Loads(displacement=corner_displacement()))
-validate(l_shape)
-alpha = corner_exponent()
-u_exact = ngs.CF(tuple(Expression(c).coefficient() for c in corner_displacement()))
-grad_u = ngs.CF((u_exact[0].Diff(ngs.x), u_exact[0].Diff(ngs.y),
-                 u_exact[1].Diff(ngs.x), u_exact[1].Diff(ngs.y)), dims=(2, 2))
-lam_l, mu_l = Material(E, NU).lame
-strain = 0.5 * (grad_u + grad_u.trans)
-sigma_exact = 2 * mu_l * strain + lam_l * ngs.Trace(strain) * ngs.Id(2)
-eta_exact = 0.5 * (grad_u[0, 1] - grad_u[1, 0])
+# %%
+l_shape = corner.l_shape_scene()
+alpha = corner.corner_exponent()
 print(f"corner exponent alpha = {alpha:.4f}: uniform rate alpha/2 = {alpha / 2:.3f}")
+exact = corner.exact_fields()
 
 
 def exact_error(solution) -> float:
-    """(||sigma - sigma_h||^2 + ||div sigma_h||^2 + ||u - u_h||^2 + ||eta - eta_h||^2)^(1/2)."""
-    f = fields(solution)
-    mesh = solution.problem.fes.mesh
-
-    def integral(cf):
-        return ngs.Integrate(cf * ngs.dx(bonus_intorder=6), mesh)
-
-    return math.sqrt(integral(ngs.InnerProduct(sigma_exact - f.sigma, sigma_exact - f.sigma))
-                     + integral(f.div_sigma * f.div_sigma)
-                     + integral((u_exact - f.u) * (u_exact - f.u))
-                     + integral((eta_exact - f.eta) ** 2))
+    """The error of PEERS against Williams' corner solution."""
+    return corner.exact_error(solution, exact)
 
 
 # %% [markdown]

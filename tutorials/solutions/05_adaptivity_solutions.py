@@ -4,20 +4,18 @@
 # Each exercise is one section; all run in seconds with `NGDUAL_QUICK=1`.
 
 # %%
-import math
 
 import ngsolve as ngs
 import numpy as np
 
+from ngdual import corner
 from ngdual.afem import adapt, convergence_rate, refine
 from ngdual.boundary import BoundaryMeshes
 from ngdual.estimator import estimate
-from ngdual.expr import Expression
 from ngdual.forms import assemble
 from ngdual.marking import mark
 from ngdual.mesh import build_mesh
-from ngdual.post import fields
-from ngdual.scene import Geometry, Loads, Material, Scene, load_scene, validate
+from ngdual.scene import load_scene
 from ngdual.solve import solve_problem, solve_scene
 from ngdual.tutorials import output_dir, quick_mode, save_results
 
@@ -65,60 +63,12 @@ def adapt_until(scene, marking, theta, max_dofs, level=1, indicator="eta", error
 # back to α/2 ≈ 0.27. θ ≈ 0.5 is the usual compromise.
 
 # %%
-E, NU = 1.0, 0.3
-OMEGA = 3 * math.pi / 4
-L_POINTS = [(-1, -1), (0, -1), (0, 0), (1, 0), (1, 1), (-1, 1)]
-L_LABELS = ["bottom", "corner_v", "corner_h", "right", "top", "left"]
-
-
-def corner_exponent() -> float:
-    alpha = 0.5
-    for _ in range(30):
-        alpha -= ((math.sin(2 * OMEGA * alpha) + alpha * math.sin(2 * OMEGA))
-                  / (2 * OMEGA * math.cos(2 * OMEGA * alpha) + math.sin(2 * OMEGA)))
-    return alpha
-
-
-def corner_displacement() -> list[str]:
-    """Williams' mode I at the re-entrant corner (as in Tutorial 5)."""
-    a, (_, mu) = corner_exponent(), Material(E, NU).lame
-    kappa = 3 - 4 * NU
-    b = -math.cos((a + 1) * OMEGA) / math.cos((a - 1) * OMEGA)
-    r, th = "sqrt(x*x + y*y)", "atan2(-(x + y), y - x)"
-    ph = f"({th} + {OMEGA!r})"
-    ur = (f"({r})**{a!r}*(-({a + 1!r})*cos({a + 1!r}*{th}) "
-          f"+ ({(kappa - a) * b!r})*cos({a - 1!r}*{th}))/{2 * mu!r}")
-    ut = (f"({r})**{a!r}*(({a + 1!r})*sin({a + 1!r}*{th}) "
-          f"+ ({(kappa + a) * b!r})*sin({a - 1!r}*{th}))/{2 * mu!r}")
-    return [f"({ur})*cos({ph}) - ({ut})*sin({ph})", f"({ur})*sin({ph}) + ({ut})*cos({ph})"]
-
-
-l_shape = Scene("l-shape-corner", Geometry(kind="polygon", points=L_POINTS, labels=L_LABELS,
-                                           maxh=0.5),
-                {"dirichlet": ["bottom", "right", "top", "left"],
-                 "neumann": ["corner_v", "corner_h"]},
-                material=Material(E, NU), loads=Loads(displacement=corner_displacement()))
-validate(l_shape)
-u_exact = ngs.CF(tuple(Expression(c).coefficient() for c in corner_displacement()))
-grad_u = ngs.CF((u_exact[0].Diff(ngs.x), u_exact[0].Diff(ngs.y),
-                 u_exact[1].Diff(ngs.x), u_exact[1].Diff(ngs.y)), dims=(2, 2))
-lam_l, mu_l = Material(E, NU).lame
-strain = 0.5 * (grad_u + grad_u.trans)
-sigma_exact = 2 * mu_l * strain + lam_l * ngs.Trace(strain) * ngs.Id(2)
-eta_exact = 0.5 * (grad_u[0, 1] - grad_u[1, 0])
+l_shape = corner.l_shape_scene()          # Williams' corner solution (ngdual.corner)
+exact = corner.exact_fields()
 
 
 def exact_error(solution) -> float:
-    f = fields(solution)
-    mesh = solution.problem.fes.mesh
-
-    def integral(cf):
-        return ngs.Integrate(cf * ngs.dx(bonus_intorder=6), mesh)
-
-    return math.sqrt(integral(ngs.InnerProduct(sigma_exact - f.sigma, sigma_exact - f.sigma))
-                     + integral(f.div_sigma * f.div_sigma)
-                     + integral((u_exact - f.u) * (u_exact - f.u))
-                     + integral((eta_exact - f.eta) ** 2))
+    return corner.exact_error(solution, exact)
 
 
 dorfler = {}
