@@ -11,7 +11,7 @@ lambda_t rows. The iteration only ever looks at a few linear functionals of y
     y = y_0 + Z z,    O y = O y_0 + (O Z) z     (O: the observed functionals)
 
 every step costs a small dense matrix-vector product instead of a sparse
-forward/back solve. Z is never stored: it is computed in blocks of columns and
+forward/back solve. Z is computed in blocks of columns (and kept only for the Gram data) and
 reduced at once to G = O Z and (optionally) to the Gram data Z^T Z and y_0^T Z
 that give the norm of y and of its increments exactly (Z^T Z from Z itself when
 it fits in ``KEEP_Z_BYTES``, else as R^T K^{-1} Z with m more solves, K being
