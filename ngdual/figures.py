@@ -815,3 +815,67 @@ def field_summary(values: np.ndarray, points: np.ndarray, triangles: np.ndarray)
     return {"min": float(values.min()), "max": float(values.max()),
             "argmax": [round(float(c), 3) for c in centroids[k]]}
 
+
+
+def gamma_c_stress(ctx: Context, fields: dict, thesis: str, key: str, tex: str, what: str,
+                   stem: str, away: float = 3.0) -> tuple[list, Path, dict]:
+    """Figs. 3.18 / 3.20: ``key`` (sigma_n or sigma_t, constant per fine Gamma_C edge) for
+    both problems (``fields`` = :meth:`Context.both_fields`): the CSV, one panel per
+    problem, and the maxima for the index.
+
+    The y-range comes from the values with |x_1| <= ``away``, leaving the corner
+    singularities at x_1 = +-4 off scale (their size is a note on the panel and in the CSV).
+    Returns the figure files, the CSV and the numbers, for the script's index entry.
+    """
+    from . import plot
+
+    data = ctx.write_csv(f"{stem}.csv", curve_rows(fields, "edge_x", [key, "edge_active"]),
+                         f"{key}^h at the midpoints of the fine Gamma_C edges")
+    panels, numbers = [], {}
+    span = max(float(np.abs(a[key][np.abs(a["edge_x"]) <= away]).max())
+               for _, a in fields.values()) or 1.0
+    for p, (_, a) in fields.items():
+        order = np.argsort(a["edge_x"])
+        panels.append({"title": f"{PROBLEM_TITLES[p]}, level {ctx.plan.field_level}",
+                       "ylim": (-1.25 * span, 1.25 * span),
+                       "note": f"corner singularities at x_1 = +-4 off scale "
+                               f"(|{key}| up to {np.abs(a[key]).max():.3g}; see the CSV)",
+                       "xlabel": r"$x_1$ on $\Gamma_C$ [length]",
+                       "ylabel": rf"${tex}^h$ [stress units]",
+                       "curves": [{"x": a["edge_x"][order], "y": a[key][order],
+                                   "drawstyle": "steps-mid", "label": rf"${tex}^h$"}]})
+        active = a["edge_active"].astype(bool)
+        numbers[f"max |{key}| on A_C, {PROBLEM_TITLES[p]}"] = float(np.abs(a[key][active]).max())
+        numbers[f"max |{key}| overall (corners), {PROBLEM_TITLES[p]}"] = float(
+            np.abs(a[key]).max())
+    figs = plot.plot_curves(panels, ctx.figure_stem(stem),
+                            rf"{thesis}: {what} ${tex}^h$ on $\Gamma_C$")
+    return figs, data, numbers
+
+
+NEUMANN_STYLE = {"frictionless": {"color": "tab:blue"}, "coulomb": {"color": "tab:red", "ls": "--"}}
+
+
+def neumann_multiplier(ctx: Context, thesis: str, component: int, stem: str) -> None:
+    """Figs. 3.15 / 3.16: phi_i^h on Gamma_N for both problems (CSV, plot, index entry)."""
+    from . import plot
+
+    key, tex = f"phi{component}", rf"\varphi_{component}"
+    fields = ctx.both_fields()
+    a0, a1 = (fields[p][1] for p in ("frictionless", "coulomb"))
+    data = ctx.write_csv(f"{stem}.csv", curve_rows(fields, "phi_x", [key]),
+                         f"phi_{component}^h at the fine vertices of Gamma_N (x_2 = 1), "
+                         "both problems")
+    panels = [{"title": f"{PROBLEM_TITLES[p]}, level {ctx.plan.field_level}",
+               "xlabel": r"$x_1$ on $\Gamma_N$ [length]", "ylabel": rf"${tex}^h$ [length]",
+               "curves": [{"x": a["phi_x"], "y": a[key], "label": PROBLEM_TITLES[p],
+                           **NEUMANN_STYLE[p]}]}
+              for p, (_, a) in fields.items()]
+    figs = plot.plot_curves(panels, ctx.figure_stem(stem),
+                            rf"{thesis}: ${tex}^h$ on the Neumann boundary $\Gamma_N$")
+    name = f"phi_{component}"
+    ctx.entry(thesis, f"{name} on Gamma_N", [*figs, data],
+              {f"range {name}, mu_f = 0": [float(a0[key].min()), float(a0[key].max())],
+               f"range {name}, mu_f = 0.5": [float(a1[key].min()), float(a1[key].max())],
+               f"max |{name}(0.5) - {name}(0)|": float(np.abs(a1[key] - a0[key]).max())},
+              thesis_says="no difference between the frictionless and the frictional case.")
