@@ -51,6 +51,20 @@ def refine(mesh: ngs.Mesh, marked: np.ndarray) -> ngs.Mesh:
     return fine
 
 
+def refine_towards(scene: Scene, mesh: ngs.Mesh, point, times: int
+                   ) -> tuple[ngs.Mesh, BoundaryMeshes]:
+    """``times`` refinements of the triangles touching the vertex ``point``, with the coarse
+    boundary meshes following: a mesh graded towards ``point`` (h ratio about 2^times)."""
+    coarse = BoundaryMeshes.for_scene(scene, mesh)
+    point = np.asarray(point, dtype=float)
+    for _ in range(times):
+        touching = np.array([any(np.allclose(mesh[v].point, point) for v in el.vertices)
+                             for el in mesh.Elements()])
+        mesh = refine(mesh, touching)
+        coarse = coarse.follow(scene, mesh)
+    return mesh, coarse
+
+
 def adapt(scene: Scene, marking: str = "dorfler", theta: float = 0.5, steps: int = 5,
           level: int | None = None, asymmetry: str = "l2", reference: dict | None = None,
           on_step: StepCallback | None = None) -> list[dict]:

@@ -16,8 +16,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ngdual import post
-from ngdual.afem import refine
-from ngdual.boundary import BoundaryMeshes
+from ngdual.afem import refine_towards
 from ngdual.forms import assemble
 from ngdual.friction import build_friction_forms
 from ngdual.mesh import build_mesh
@@ -170,14 +169,7 @@ def test_hard_parameters_agree_with_the_reference(override):
 
 def test_strongly_graded_mesh_agrees_with_the_qp_reference():
     scene = load_scene("thesis-3.46-coulomb", ["solver.method=active-set"])
-    mesh = build_mesh(scene.geometry, 2)
-    coarse = BoundaryMeshes.for_scene(scene, mesh)
-    corner = np.array([-4.0, 0.0])
-    for _ in range(6):
-        at_corner = np.array([any(np.allclose(mesh[v].point, corner) for v in el.vertices)
-                              for el in mesh.Elements()])
-        mesh = refine(mesh, at_corner)
-        coarse = coarse.follow(scene, mesh)
+    mesh, coarse = refine_towards(scene, build_mesh(scene.geometry, 2), (-4.0, 0.0), 6)
     pb = assemble(scene, mesh, coarse)
     sol = fast_solve(pb)
     ref = solve_qp_friction(pb, "coulomb", scene.friction.mu)

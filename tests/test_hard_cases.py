@@ -8,8 +8,7 @@ import numpy as np
 import pytest
 
 from ngdual import post
-from ngdual.afem import refine
-from ngdual.boundary import BoundaryMeshes
+from ngdual.afem import refine_towards
 from ngdual.forms import assemble
 from ngdual.mesh import build_mesh
 from ngdual.scene import load_scene
@@ -109,14 +108,7 @@ def test_large_friction_coefficients_converge_or_fail_clearly(mu_f):
 def test_strongly_graded_mesh_at_a_corner_of_the_contact_boundary():
     """Eight refinements of the triangles at the left end of Gamma_C (h ratio 2^8)."""
     scene = load_scene("thesis-3.46-coulomb", TIGHT)
-    mesh = build_mesh(scene.geometry, 2)
-    coarse = BoundaryMeshes.for_scene(scene, mesh)
-    corner = np.array([-4.0, 0.0])
-    for _ in range(8):
-        at_corner = np.array([any(np.allclose(mesh[v].point, corner) for v in el.vertices)
-                              for el in mesh.Elements()])
-        mesh = refine(mesh, at_corner)
-        coarse = coarse.follow(scene, mesh)
+    mesh, coarse = refine_towards(scene, build_mesh(scene.geometry, 2), (-4.0, 0.0), 8)
     problem = assemble(scene, mesh, coarse)
     sol = solve_problem(problem)
     assert sol.converged
