@@ -140,7 +140,8 @@ def _fast_solve(problem: DiscreteProblem, law: str | None, mu_f: float, tol: flo
                                   forms.q_matrix(F).toarray() if F is not None else None)
         history, iterations = [], {"outer": 1, "inner": state.iterations}
     ce = hybrid.contact                                                         # step 4
-    zeta = np.concatenate([ce.hat_means @ state.lam_n - ce.gap, ce.hat_means @ state.lam_t])
+    zeta = np.concatenate([ce.hat_means @ state.lam_n - ce.gap,
+                           ce.hat_means @ state.lam_t - ce.offset_t])
     x = hybrid.unknowns(chol.solve_with_last(y, zeta), state.lam_t, state.lam_n)
     nu = state.nu if F is not None else None
     timings["solve"] = time.perf_counter() - start
@@ -180,7 +181,7 @@ class BoundaryProblem:
         self.lengths, n_f, self.n_c = ce.lengths, len(ce), ce.hat_means.shape[1]
         M = sp.block_diag([ce.hat_means, ce.hat_means]).tocsr()  # z -> zeta (+ shift)
         S = chol.schur
-        self.a_f = chol.reduced_rhs(y) + S @ np.concatenate([ce.gap, np.zeros(n_f)])
+        self.a_f = chol.reduced_rhs(y) + S @ np.concatenate([ce.gap, ce.offset_t])
         self.B_f = (M.T @ S).T  # S M
         G = M.T @ self.B_f
         self.G, self.b = 0.5 * (G + G.T), M.T @ self.a_f

@@ -18,6 +18,8 @@ the coarse P1 phi on Gamma_N (d_N of (3.24)), and on every fine Gamma_C edge e
 
     mu_e = n_e zeta_n,e + t_e zeta_t,e,   zeta_n = M lambda_n - mean_e(g),  zeta_t = M lambda_t,
 
+(plus the known end values of lambda where Gamma_C meets Gamma_D, :class:`ContactEdges`)
+
 with M the edge means of the coarse h~ hats (the RT_0 normal trace is constant on e, so
 int_e lambda tau.n ds = |e| mean_e(lambda) (tau.n)_e: d_{C,n}, d_{C,t} and g(tau) of (3.24)
 are reproduced exactly). The fine contact values zeta are left free in the matrix H and
@@ -47,7 +49,10 @@ class ContactEdges:
 
     ``edges`` are their facet dofs; ``hat_means`` (n_edges x N_C) is M: the mean of
     every coarse h~ hat on every fine edge; ``normals`` the outward unit normals,
-    ``lengths`` |e|, ``gap`` mean_e(g).
+    ``lengths`` |e|. ``gap`` and ``offset_t`` are the known parts of the fine contact
+    values, zeta_n = M lambda_n - gap and zeta_t = M lambda_t - offset_t: ``gap`` is
+    mean_e(g) minus the edge mean of the prescribed end values of lambda_n (where
+    Gamma_C meets Gamma_D), ``offset_t`` minus that of lambda_t.
     """
 
     edges: np.ndarray
@@ -55,6 +60,7 @@ class ContactEdges:
     normals: np.ndarray
     hat_means: sp.csr_matrix
     gap: np.ndarray
+    offset_t: np.ndarray
 
     @property
     def tangents(self) -> np.ndarray:
@@ -258,7 +264,7 @@ class HybridSystem:
         contact = pb.spaces.contact
         if contact is None:
             return ContactEdges(np.zeros(0, dtype=int), np.zeros(0), np.zeros((0, 2)),
-                                sp.csr_matrix((0, 0)), np.zeros(0))
+                                sp.csr_matrix((0, 0)), np.zeros(0), np.zeros(0))
         edge_of = {}
         for lab in scene.labels("contact"):
             for row in labelled.get(lab, []):
@@ -276,10 +282,12 @@ class HybridSystem:
         flux = fluxes[0][rt]
         normals = np.column_stack([fluxes[1][rt], fluxes[2][rt]]) / flux[:, None]
         normals /= np.linalg.norm(normals, axis=1)[:, None]
+        # the sigma rows of F hold int_e (g - lift_n) tau_n - int_e lift_t tau_t on e
         gap = (normals[:, 0] * F1[rt] + normals[:, 1] * F2[rt]) / flux
+        offset_t = (normals[:, 1] * F1[rt] - normals[:, 0] * F2[rt]) / flux
         lengths = np.concatenate([np.diff(chain.arclength) for chain in contact.chains])
         return ContactEdges(edges[:, 0], lengths, normals,
-                            (0.5 * (P[ends[:, 0]] + P[ends[:, 1]])).tocsr(), gap)
+                            (0.5 * (P[ends[:, 0]] + P[ends[:, 1]])).tocsr(), gap, offset_t)
 
     def unknowns(self, w: np.ndarray, lam_t: np.ndarray | None = None,
                  lam_n: np.ndarray | None = None) -> np.ndarray:
