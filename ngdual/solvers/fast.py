@@ -178,7 +178,7 @@ class BoundaryProblem:
 
     def __init__(self, hybrid: HybridSystem, chol: SchurCholesky, y: np.ndarray):
         ce = hybrid.contact
-        self.lengths, n_f, self.n_c = ce.lengths, len(ce), ce.hat_means.shape[1]
+        self.lengths, self.n_c = ce.lengths, ce.hat_means.shape[1]
         M = sp.block_diag([ce.hat_means, ce.hat_means]).tocsr()  # z -> zeta (+ shift)
         S = chol.schur
         self.a_f = chol.reduced_rhs(y) + S @ np.concatenate([ce.gap, ce.offset_t])
