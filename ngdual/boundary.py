@@ -27,14 +27,21 @@ import ngsolve as ngs
 import numpy as np
 import scipy.sparse as sp
 
+from .scene import contact_junctions
+
 
 @dataclass(frozen=True)
 class Chain:
-    """A connected piece of a boundary part: fine vertices in order along it."""
+    """A connected piece of a boundary part: fine vertices in order along it.
+
+    ``ccw`` is true when the order runs with the boundary's orientation (the body on
+    the left), which fixes the sign of the outward normals (:func:`edge_normals`).
+    """
 
     vertices: np.ndarray
     points: np.ndarray
     closed: bool
+    ccw: bool = True
 
     @property
     def path_vertices(self) -> np.ndarray:
@@ -57,11 +64,44 @@ class Chain:
         return len(self.vertices) if self.closed else len(self.vertices) - 1
 
 
-def boundary_chains(mesh: ngs.Mesh, labels: list[str]) -> list[Chain]:
-    """Order the fine boundary edges carrying one of ``labels`` into chains."""
+def boundary_chains(mesh: ngs.Mesh, labels: list[str], breaks: frozenset = frozenset()
+                    ) -> list[Chain]:
+    """Order the fine boundary edges carrying one of ``labels`` into chains.
+
+    A chain ends where the boundary part ends and at the vertices ``breaks`` (the kinks
+    of Gamma_C, where the normal and tangential multipliers are discontinuous).
+    """
+    return [piece for chain in _chains(mesh, labels) for piece in _split_at(chain, breaks)]
+
+
+def _split_at(chain: Chain, breaks: frozenset) -> list[Chain]:
+    """``chain`` cut at the vertices in ``breaks`` (a closed chain opens at the first)."""
+    cuts = [k for k, v in enumerate(chain.vertices) if int(v) in breaks]
+    if not cuts:
+        return [chain]
+    verts, pts = chain.vertices, chain.points
+    if chain.closed:
+        k = cuts[0]
+        verts = np.append(np.roll(verts, -k), verts[k])
+        pts = np.vstack([np.roll(pts, -k, axis=0), pts[k:k + 1]])
+        cuts = [c - k if c >= k else c - k + len(chain.vertices) for c in cuts]
+        cuts = sorted(cuts) + [len(verts) - 1]
+    else:
+        cuts = [c for c in cuts if 0 < c < len(verts) - 1] + [len(verts) - 1]
+    pieces, start = [], 0
+    for c in cuts:
+        if c > start:
+            pieces.append(Chain(verts[start:c + 1], pts[start:c + 1], False, chain.ccw))
+        start = c
+    return pieces
+
+
+def _chains(mesh: ngs.Mesh, labels: list[str]) -> list[Chain]:
+    """Connected chains of the fine boundary edges carrying one of ``labels``."""
     wanted = set(labels)
     segments = [tuple(v.nr for v in el.vertices) for el in mesh.Elements(ngs.BND)
                 if el.mat in wanted]
+    directed = set(segments)
     neighbours: dict[int, list[int]] = {}
     for a, b in segments:
         neighbours.setdefault(a, []).append(b)
@@ -82,8 +122,16 @@ def boundary_chains(mesh: ngs.Mesh, labels: list[str]) -> list[Chain]:
             unvisited.discard(nxt[0])
         closed = not ends
         verts = np.array(order)
-        chains.append(Chain(verts, np.array([coords[v] for v in verts]), closed))
+        ccw = (order[0], order[1]) in directed
+        chains.append(Chain(verts, np.array([coords[v] for v in verts]), closed, ccw))
     return chains
+
+
+def edge_normals(chain: Chain) -> np.ndarray:
+    """Outward unit normals of the fine edges of ``chain``, in chain order."""
+    d = np.diff(chain.path_points, axis=0)
+    n = np.column_stack([d[:, 1], -d[:, 0]]) / np.linalg.norm(d, axis=1)[:, None]
+    return n if chain.ccw else -n
 
 
 def _group(n_edges: int, factor: int) -> np.ndarray:
@@ -123,28 +171,90 @@ def _split(points: np.ndarray, arclength: np.ndarray, factor: int) -> list[int]:
 
 
 @dataclass(frozen=True)
+class EndRule:
+    """Where the chains of a boundary part break and which of their ends are free.
+
+    ``breaks``: fine vertex numbers where a chain is cut; ``free_points``: coordinates
+    of the chain ends that carry a dof (all other ends of open chains are fixed).
+    """
+
+    breaks: frozenset = frozenset()
+    free_points: tuple = ()
+
+    def is_free(self, point: np.ndarray) -> bool:
+        return any(np.linalg.norm(point - q) <= 1e-9 * (1 + np.linalg.norm(q))
+                   for q in self.free_points)
+
+    def free_ends(self, chains) -> tuple[tuple[bool, bool], ...]:
+        return tuple((False, False) if ch.closed
+                     else (self.is_free(ch.points[0]), self.is_free(ch.points[-1]))
+                     for ch in chains)
+
+
+def end_rule(scene, mesh: ngs.Mesh, role: str) -> EndRule:
+    """The :class:`EndRule` of Gamma_C (``role = "contact"``) or Gamma_N (``"neumann"``).
+
+    Gamma_C breaks at its kinks, and its multipliers are free there; with
+    ``contact.ends = "consistent"`` they are also free where Gamma_C meets Gamma_N, and
+    phi on Gamma_N is free where Gamma_N meets Gamma_C. Every other end (where a part
+    meets Gamma_D, and all ends for ``"thesis"``) is fixed (see :class:`ngdual.scene.Contact`).
+    """
+    junctions = contact_junctions(scene) if scene.has_contact else []
+    kinks = [p for p, kind in junctions if kind == "kink"]
+    touching = [p for p, kind in junctions if kind == "neumann"]
+    consistent = scene.contact.ends == "consistent"
+    if role == "contact":
+        coords = {v.nr: np.array(v.point) for v in mesh.vertices}
+        breaks = frozenset(nr for nr, xy in coords.items()
+                           if any(np.linalg.norm(xy - k) <= 1e-9 * (1 + np.linalg.norm(k))
+                                  for k in kinks))
+        return EndRule(breaks, tuple(kinks) + (tuple(touching) if consistent else ()))
+    return EndRule(frozenset(), tuple(touching) if consistent else ())
+
+
+@dataclass(frozen=True)
 class CoarseMesh:
     """A coarse 1D mesh on a boundary part, nested in the fine boundary edges.
 
     ``nodes[c]`` holds the positions (indices into ``chains[c].vertices``,
     position ``n_edges`` meaning the chain's end) of the coarse nodes of chain c.
+    ``free[c]`` says for the first and the last node of an open chain whether the P1
+    space has a dof there (a free end, where the part meets Gamma_N or a kink) or not
+    (a fixed end: its value is prescribed, zero or lifted from the data; the thesis'
+    C_h~ of (3.61) has only fixed ends). ``breaks`` are the fine vertices where chains
+    are cut (kinks).
     """
 
     chains: tuple[Chain, ...]
     nodes: tuple[np.ndarray, ...]
+    free: tuple[tuple[bool, bool], ...] = ()
+    breaks: frozenset = frozenset()
+
+    def __post_init__(self):
+        if not self.free:
+            object.__setattr__(self, "free", tuple((False, False) for _ in self.chains))
 
     @classmethod
-    def from_fine(cls, mesh: ngs.Mesh, labels: list[str], factor: int) -> CoarseMesh:
-        """Group the fine boundary edges of ``labels`` ``factor`` at a time."""
-        chains = tuple(boundary_chains(mesh, labels))
-        return cls(chains, tuple(_group(c.n_edges, factor) for c in chains))
+    def from_fine(cls, mesh: ngs.Mesh, labels: list[str], factor: int,
+                  ends: EndRule | None = None) -> CoarseMesh:
+        """Group the fine boundary edges of ``labels`` ``factor`` at a time.
+
+        ``ends`` says where chains break and which chain ends are free (default: no
+        breaks, all ends fixed).
+        """
+        ends = ends or EndRule()
+        chains = tuple(boundary_chains(mesh, labels, ends.breaks))
+        return cls(chains, tuple(_group(c.n_edges, factor) for c in chains),
+                   ends.free_ends(chains), ends.breaks)
 
     def coarsened(self, factor: int) -> CoarseMesh:
         """Group this mesh's edges ``factor`` at a time (h^ = factor * h~, nested)."""
         return CoarseMesh(self.chains,
-                          tuple(n[_group(len(n) - 1, factor)] for n in self.nodes))
+                          tuple(n[_group(len(n) - 1, factor)] for n in self.nodes),
+                          self.free, self.breaks)
 
-    def follow(self, mesh: ngs.Mesh, labels: list[str], factor: int) -> CoarseMesh:
+    def follow(self, mesh: ngs.Mesh, labels: list[str], factor: int,
+               ends: EndRule | None = None) -> CoarseMesh:
         """This coarse mesh carried over to the (locally) refined fine ``mesh``.
 
         Netgen keeps the numbers of the old vertices when it refines, so every
@@ -164,8 +274,10 @@ class CoarseMesh:
 
         Under uniform refinement this reproduces :meth:`from_fine` of the finer level.
         """
-        chains = tuple(boundary_chains(mesh, labels))
-        return self._follow(chains, [np.arange(c.n_edges + 1) for c in chains], factor)
+        ends = ends or EndRule(self.breaks)
+        chains = tuple(boundary_chains(mesh, labels, ends.breaks))
+        followed = self._follow(chains, [np.arange(c.n_edges + 1) for c in chains], factor)
+        return CoarseMesh(followed.chains, followed.nodes, ends.free_ends(chains), ends.breaks)
 
     def follow_within(self, fine: CoarseMesh, factor: int) -> CoarseMesh:
         """This h^ mesh carried over to the refined h~ mesh ``fine`` (see :meth:`follow`).
@@ -173,7 +285,8 @@ class CoarseMesh:
         The units are now the edges of ``fine``: h^ edges stay unions of
         ``factor`` to ``2 * factor - 1`` h~ edges and nested across steps.
         """
-        return self._follow(fine.chains, list(fine.nodes), factor)
+        followed = self._follow(fine.chains, list(fine.nodes), factor)
+        return CoarseMesh(followed.chains, followed.nodes, fine.free, fine.breaks)
 
     def _follow(self, chains: tuple[Chain, ...], units: list[np.ndarray],
                 factor: int) -> CoarseMesh:
@@ -183,7 +296,10 @@ class CoarseMesh:
         nodes = []
         for new, unit in zip(chains, units):
             position = {int(v): p for p, v in enumerate(new.vertices)}
-            old = next(c for c, ch in enumerate(self.chains) if int(ch.vertices[0]) in position)
+            # the old chain whose vertices all lie on the new one (chains cut at a kink
+            # share the kink vertex, so one vertex does not identify a chain)
+            old = next(c for c, ch in enumerate(self.chains)
+                       if all(int(v) in position for v in ch.vertices))
             old_vertices = self.chains[old].path_vertices[self.nodes[old]]
             if new.closed:
                 corners = sorted(position[int(v)] for v in old_vertices[:-1]) + [new.n_edges]
@@ -204,23 +320,40 @@ class CoarseMesh:
         return sum(len(n) - 1 for n in self.nodes)
 
     def dof_positions(self, c: int) -> np.ndarray:
-        """Coarse node positions carrying a dof: all but the ends of an open chain."""
+        """Coarse node positions carrying a dof: all but the fixed ends of an open chain."""
         n = self.nodes[c]
-        return n[:-1] if self.chains[c].closed else n[1:-1]
+        if self.chains[c].closed:
+            return n[:-1]
+        first, last = self.free[c]
+        return n[(0 if first else 1):(len(n) if last else len(n) - 1)]
 
     def _ends(self, c: int) -> np.ndarray:
-        """Positions of the end nodes of chain c (none for a closed chain)."""
+        """Positions of the fixed end nodes of chain c (none for a closed chain)."""
         n = self.nodes[c]
-        return n[:0] if self.chains[c].closed else n[[0, -1]]
+        if self.chains[c].closed:
+            return n[:0]
+        return n[[k for k, free in zip((0, len(n) - 1), self.free[c]) if not free]]
 
     def end_points(self) -> np.ndarray:
-        """Coordinates of the end nodes of all open chains, in the order of ``ends=True``."""
+        """Coordinates of the fixed end nodes, in the order of ``ends=True``."""
         pts = [self.chains[c].points[self._ends(c)] for c in range(len(self.chains))]
         return np.vstack(pts) if pts else np.zeros((0, 2))
 
+    def end_normals(self) -> np.ndarray:
+        """Outward unit normals of the fine edges at the fixed end nodes (``end_points``).
+
+        At a fixed end the P1 hat lives on the end edge, whose normal is the one used.
+        """
+        out = []
+        for c, chain in enumerate(self.chains):
+            normals = edge_normals(chain)
+            for pos in self._ends(c):
+                out.append(normals[min(int(pos), chain.n_edges - 1)])
+        return np.array(out).reshape(-1, 2)
+
     @property
     def n_p1_dofs(self) -> int:
-        """dim of the coarse P1 space vanishing at the ends of every open chain."""
+        """dim of the coarse P1 space vanishing at the fixed ends of every open chain."""
         return sum(len(self.dof_positions(c)) for c in range(len(self.chains)))
 
     def node_points(self) -> np.ndarray:
@@ -334,9 +467,11 @@ class BoundaryMeshes:
         factor = scene.contact.htilde_factor
         neumann = contact = friction = None
         if scene.labels("neumann"):
-            neumann = CoarseMesh.from_fine(mesh, scene.labels("neumann"), factor)
+            neumann = CoarseMesh.from_fine(mesh, scene.labels("neumann"), factor,
+                                           end_rule(scene, mesh, "neumann"))
         if scene.has_contact:
-            contact = CoarseMesh.from_fine(mesh, scene.labels("contact"), factor)
+            contact = CoarseMesh.from_fine(mesh, scene.labels("contact"), factor,
+                                           end_rule(scene, mesh, "contact"))
             if scene.has_friction:
                 friction = contact.coarsened(scene.contact.hhat_factor)
         return cls(neumann, contact, friction)
@@ -346,9 +481,11 @@ class BoundaryMeshes:
         factor = scene.contact.htilde_factor
         neumann = contact = friction = None
         if self.neumann is not None:
-            neumann = self.neumann.follow(mesh, scene.labels("neumann"), factor)
+            neumann = self.neumann.follow(mesh, scene.labels("neumann"), factor,
+                                          end_rule(scene, mesh, "neumann"))
         if self.contact is not None:
-            contact = self.contact.follow(mesh, scene.labels("contact"), factor)
+            contact = self.contact.follow(mesh, scene.labels("contact"), factor,
+                                          end_rule(scene, mesh, "contact"))
             if self.friction is not None:
                 friction = self.friction.follow_within(contact, scene.contact.hhat_factor)
         return BoundaryMeshes(neumann, contact, friction)

@@ -92,7 +92,7 @@ def cmd_scenes(args) -> int:
     for name in shipped_scenes():
         scene = load_scene(name)
         print(f"{name:34s} {scene.geometry.kind:12s} friction={scene.friction.law:8s} "
-              f"gap={scene.contact.gap}")
+              f"gap={'foundation line' if scene.contact.foundation else scene.contact.gap_formula}")
     return 0
 
 

@@ -45,6 +45,7 @@ import ngsolve as ngs
 import numpy as np
 
 from . import peers
+from .contact import gap_coefficient
 from .expr import Expression
 from .forms import boundary_regex
 from .post import fields
@@ -287,7 +288,7 @@ def estimate(solution: Solution, asymmetry: str = "l2") -> Estimate:
     labels_c = scene.labels("contact")
     if f.lam_n is not None:
         gf = dict(zip(pb.names, f.gf.components))
-        g = Expression(scene.contact.gap).coefficient()
+        g = gap_coefficient(scene)
         dg = g.Diff(ngs.x) * t[0] + g.Diff(ngs.y) * t[1]
         d_mult = (ngs.grad(gf["lam_t"]) * t) * t + (ngs.grad(gf["lam_n"]) * t - dg) * n
         mult = f.lam_t * t + (f.lam_n - g) * n

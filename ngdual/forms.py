@@ -23,6 +23,7 @@ import scipy.sparse as sp
 
 from . import peers
 from .boundary import BoundaryMeshes, CoarseMesh
+from .contact import ContactBoundary, gap_coefficient
 from .expr import Expression
 from .scene import Scene
 
@@ -58,6 +59,7 @@ class Spaces:
     friction: CoarseMesh | None
     prolongations: dict[str, sp.csr_matrix] = field(default_factory=dict)
     end_hats: dict[str, sp.csr_matrix] = field(default_factory=dict)
+    gamma_c: ContactBoundary | None = None
 
     @classmethod
     def build(cls, scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes | None = None) -> Spaces:
@@ -74,15 +76,19 @@ class Spaces:
                                                                         space.ndof)
             end_hats["phi1"] = end_hats["phi2"] = neumann.p1_prolongation(
                 _vertex_dof(space), space.ndof, ends=True)
+        gamma_c = None
         if scene.has_contact:
             contact = coarse.contact
             space = _trace_space(mesh, scene.labels("contact"))
             comps["lam_t"] = comps["lam_n"] = space
             prolong["lam_t"] = prolong["lam_n"] = contact.p1_prolongation(_vertex_dof(space),
                                                                           space.ndof)
+            end_hats["lam_t"] = end_hats["lam_n"] = contact.p1_prolongation(
+                _vertex_dof(space), space.ndof, ends=True)
             if scene.has_friction:
                 friction = coarse.friction
-        return cls(mesh, comps, neumann, contact, friction, prolong, end_hats)
+            gamma_c = ContactBoundary.build(scene, contact, friction)
+        return cls(mesh, comps, neumann, contact, friction, prolong, end_hats, gamma_c)
 
     def coarse_ndof(self, name: str) -> int:
         if name in self.prolongations:
@@ -202,8 +208,7 @@ def _forms(scene: Scene, fes: ngs.FESpace, names: list[str]):
                       bonus_intorder=TRACE_BONUS_ORDER)
         a += (trial["lam_t"] * (t * trac_tau) + test["lam_t"] * (t * trac_sig)) * ds_c  # d_Ct
         a += (trial["lam_n"] * (n * trac_tau) + test["lam_n"] * (n * trac_sig)) * ds_c  # d_Cn
-        gap = Expression(scene.contact.gap).coefficient()
-        rhs += gap * (n * trac_tau) * ds_c                                    # g(tau)
+        rhs += gap_coefficient(scene) * (n * trac_tau) * ds_c                 # g(tau)
     return a, rhs
 
 
@@ -242,13 +247,21 @@ def assemble(scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes | None = None
 
 
 def _end_lift(scene: Scene, spaces: Spaces, fes: ngs.FESpace, names: list[str]) -> np.ndarray:
-    """phi = -u_D at the ends of Gamma_N, where the coarse P1 space has no dofs."""
+    """The known values at the fixed ends of the coarse P1 spaces, where they have no dofs.
+
+    phi = -u_D where Gamma_N meets Gamma_D; lambda_n = g - u_D.n and lambda_t = -u_D.t
+    where Gamma_C meets Gamma_D (zero with ``contact.ends = "thesis"``,
+    :meth:`ContactBoundary.end_values`).
+    """
+    values = {}
+    if spaces.neumann is not None:
+        ends = spaces.neumann.end_points()
+        for comp, formula in zip(("phi1", "phi2"), scene.loads.displacement):
+            values[comp] = -Expression(formula).numpy(ends[:, 0], ends[:, 1])
+    if spaces.gamma_c is not None:
+        values["lam_n"], values["lam_t"] = spaces.gamma_c.end_values(scene.loads.displacement)
     lift = np.zeros(fes.ndof)
-    if spaces.neumann is None:
-        return lift
-    ends = spaces.neumann.end_points()
-    for comp, formula in zip(("phi1", "phi2"), scene.loads.displacement):
-        values = -Expression(formula).numpy(ends[:, 0], ends[:, 1])
+    for comp, value in values.items():
         rng = fes.Range(names.index(comp))
-        lift[rng.start:rng.stop] = spaces.end_hats[comp] @ values
+        lift[rng.start:rng.stop] = spaces.end_hats[comp] @ value
     return lift

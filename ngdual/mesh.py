@@ -16,6 +16,7 @@ from netgen.geom2d import SplineGeometry
 from netgen.meshing import Element1D, Element2D, FaceDescriptor, MeshPoint, Pnt
 from netgen.meshing import Mesh as NetgenMesh
 
+from . import geometry
 from .scene import Geometry
 
 THESIS_LABELS = ("bottom", "right", "top", "left")
@@ -53,17 +54,39 @@ def thesis_mesh(level: int) -> ngs.Mesh:
     return ngs.Mesh(m)
 
 
-def polygon_mesh(points, labels, maxh: float, level: int = 1) -> ngs.Mesh:
+def polygon_mesh(points, labels, maxh: float, level: int = 1, arcs: dict | None = None
+                 ) -> ngs.Mesh:
     """A netgen mesh of the counter-clockwise polygon ``points`` with side labels.
 
     Side ``i`` (from ``points[i]`` to ``points[i+1]``) gets boundary label
-    ``labels[i]``; ``level`` k applies k-1 uniform refinements.
+    ``labels[i]``; sides whose label is a key of ``arcs`` are circular arcs around
+    ``arcs[label]`` (:mod:`ngdual.geometry`), given to netgen as rational quadratic
+    splines that are the arc exactly. ``level`` k applies k-1 uniform refinements,
+    which put the new boundary vertices on the curves.
+
+    The elements stay affine (straight-sided): the lowest-order PEERS spaces converge
+    at O(h), and vertices on the exact curve leave a geometric error of O(h^2) in
+    position and O(h) in the normal, which does not limit that order; straight edges
+    also keep the normal constant on every fine edge, which the hybridised solver
+    (:mod:`ngdual.solvers.hybrid`) and the friction terms rely on.
     """
     geo = SplineGeometry()
-    ids = [geo.AppendPoint(float(x), float(y)) for x, y in points]
-    for i, label in enumerate(labels):
-        geo.Append(["line", ids[i], ids[(i + 1) % len(ids)]], bc=label, leftdomain=1,
-                   rightdomain=0)
+    ids: dict[tuple, int] = {}
+
+    def point(p) -> int:
+        key = (float(p[0]), float(p[1]))
+        if key not in ids:
+            ids[key] = geo.AppendPoint(*key)
+        return ids[key]
+
+    for side in geometry.sides(points, labels, arcs):
+        if side.is_arc:
+            for a, control, b in side.spline_pieces():
+                geo.Append(["spline3", point(a), point(control), point(b)], bc=side.label,
+                           leftdomain=1, rightdomain=0)
+        else:
+            geo.Append(["line", point(side.start), point(side.end)], bc=side.label,
+                       leftdomain=1, rightdomain=0)
     mesh = ngs.Mesh(geo.GenerateMesh(maxh=maxh))
     refine_uniformly(mesh, level - 1)
     return mesh
@@ -76,12 +99,12 @@ def refine_uniformly(mesh: ngs.Mesh, times: int) -> ngs.Mesh:
     return mesh
 
 
-def build_mesh(geometry: Geometry, level: int | None = None) -> ngs.Mesh:
+def build_mesh(geo: Geometry, level: int | None = None) -> ngs.Mesh:
     """The mesh of a scene geometry on ``level`` (default: the geometry's own level)."""
-    level = geometry.level if level is None else level
-    if geometry.kind == "thesis-3.46":
+    level = geo.level if level is None else level
+    if geo.kind == "thesis-3.46":
         return thesis_mesh(level)
-    return polygon_mesh(geometry.points, geometry.labels, geometry.maxh, level)
+    return polygon_mesh(geo.points, geo.labels, geo.maxh, level, geo.arcs)
 
 
 def mesh_size(mesh: ngs.Mesh) -> float:

@@ -15,7 +15,6 @@ import ngsolve as ngs
 import numpy as np
 
 from . import __version__, peers
-from .expr import Expression
 from .solvers.result import Solution
 
 CONTACT_TOL = 1e-8
@@ -121,13 +120,15 @@ def contact_traces(solution: Solution) -> ContactTraces:
     sigma = f.sigma
     lam_n_c, lam_t_c = solution.part("lam_n"), solution.part("lam_t")
     in_contact = _in_contact(lam_n_c, lam_t_c)
-    gap = Expression(pb.scene.contact.gap)
-    # fine nodal values of the coarse P1 multipliers
-    p = pb.spaces.prolongations["lam_n"]
-    fine_n, fine_t = p @ lam_n_c, p @ lam_t_c
+    # fine nodal values of the coarse P1 multipliers, with the prescribed end values
+    fine = pb.to_fine(solution.x)
+    rng_n = pb.fes.Range(pb.names.index("lam_n"))
+    rng_t = pb.fes.Range(pb.names.index("lam_t"))
+    fine_n, fine_t = fine[rng_n.start:rng_n.stop], fine[rng_t.start:rng_t.stop]
     space = pb.spaces.components["lam_n"]
+    gamma_c = pb.spaces.gamma_c
 
-    edge_xy, edge_len, s_n, s_t, active, node_xy, ln, lt = ([] for _ in range(8))
+    s_n, s_t, active, node_xy, ln, lt = ([] for _ in range(6))
     offset = 0
     for c, chain in enumerate(contact.chains):
         interior = contact.dof_positions(c)
@@ -135,35 +136,25 @@ def contact_traces(solution: Solution) -> ContactTraces:
         contact_pos = {int(q) for q, flag in zip(interior, flags) if flag}
         offset += len(interior)
         nodes = contact.nodes[c]
-        verts, pts = chain.path_vertices, chain.path_points
-        for k in range(len(verts) - 1):
-            a, b = pts[k], pts[k + 1]
-            mid = 0.5 * (a + b)
-            tangent = (b - a) / np.linalg.norm(b - a)
-            # outward normal: rotate the tangent; fix its sign by a probe into the domain
-            normal = np.array([tangent[1], -tangent[0]])
-            probe = mid - 1e-6 * np.linalg.norm(b - a) * normal
-            if not mesh.Contains(*probe):
-                normal = -normal
-            tvec = np.array([normal[1], -normal[0]])
-            st = np.array(sigma(mesh(*(mid - 1e-9 * normal)))).reshape(2, 2)
-            traction = st @ normal
-            edge_xy.append(mid)
-            edge_len.append(np.linalg.norm(b - a))
-            s_n.append(normal @ traction)
-            s_t.append(tvec @ traction)
+        for k in range(chain.n_edges):
             e = np.searchsorted(nodes, k, side="right") - 1
             active.append(int(nodes[e]) in contact_pos or int(nodes[e + 1]) in contact_pos)
-        for v, xy in zip(verts, pts):
+        for v, xy in zip(chain.path_vertices, chain.path_points):
             dof = space.GetDofNrs(ngs.NodeId(ngs.VERTEX, int(v)))[0]
             node_xy.append(xy)
             ln.append(fine_n[dof])
             lt.append(fine_t[dof])
+    # sigma n on every fine edge, evaluated just inside the body at the edge midpoint
+    for mid, normal, length in zip(gamma_c.midpoints, gamma_c.normals, gamma_c.lengths):
+        st = np.array(sigma(mesh(*(mid - 1e-9 * length * normal)))).reshape(2, 2)
+        traction = st @ normal
+        s_n.append(normal @ traction)
+        s_t.append(np.array([normal[1], -normal[0]]) @ traction)
     node_xy = np.array(node_xy)
     coarse_xy = contact.node_points()
-    return ContactTraces(np.array(edge_xy), np.array(edge_len), np.array(s_n), np.array(s_t),
+    return ContactTraces(gamma_c.midpoints, gamma_c.lengths, np.array(s_n), np.array(s_t),
                          np.array(active, dtype=bool), node_xy, np.array(ln), np.array(lt),
-                         gap.numpy(node_xy[:, 0], node_xy[:, 1]), coarse_xy, lam_n_c, lam_t_c,
+                         pb.spaces.gamma_c.gap_at_vertices(), coarse_xy, lam_n_c, lam_t_c,
                          in_contact)
 
 
@@ -181,6 +172,10 @@ def contact_summary(solution: Solution) -> dict:
     f_abs = np.sum(tr.edge_length * (np.abs(tr.sigma_n) + np.abs(tr.sigma_t)) * tr.edge_active)
     summary = {"nodes_in_contact": int(tr.coarse_in_contact.sum()), "stick_nodes": 0,
                "slip_nodes": int(tr.coarse_in_contact.sum()), "F_abs": float(f_abs)}
+    balance = force_balance(solution)
+    summary.update(resultant=[float(v) for v in balance.resultant],
+                   multiplier_force=[float(v) for v in balance.multiplier_force],
+                   force_mismatch=balance.mismatch, tension=balance.tension)
     if solution.nu is not None:
         diag = friction_diagnostics(solution)
         summary.update(stick_nodes=int(np.sum(diag.node_status == "stick")),
@@ -190,6 +185,50 @@ def contact_summary(solution: Solution) -> dict:
                        max_traction_ratio=float(np.max(diag.traction_ratio[
                            diag.node_status != "separation"], initial=0.0)))
     return summary
+
+
+@dataclass
+class ForceBalance:
+    """The resultant of sigma n on Gamma_C against the force the multipliers carry.
+
+    ``resultant`` = int_{Gamma_C} sigma n ds (exact: sigma n is constant on every fine
+    edge for RT_0, the Curl bubbles have no normal trace). ``multiplier_force`` =
+    sum_i int_{Gamma_C} sigma n mu_i ds over the h~ hats mu_i with a dof: the contact
+    force the discrete contact conditions see (the hat moments d_C(mu_i, sigma) of
+    (3.62)). Where every end of Gamma_C is free the hats sum to one and the two agree on
+    every mesh; at a fixed end they differ by the force in the end h~ edge, which is a
+    discretisation error only if the end values are the right ones. ``tension`` =
+    int (sigma_n)_+ ds / int |sigma_n| ds.
+    """
+
+    resultant: np.ndarray
+    multiplier_force: np.ndarray
+    tension: float
+
+    @property
+    def mismatch(self) -> float:
+        """|resultant - multiplier_force| / |multiplier_force|."""
+        scale = np.linalg.norm(self.multiplier_force) or 1.0
+        return float(np.linalg.norm(self.resultant - self.multiplier_force) / scale)
+
+
+def force_balance(solution: Solution) -> ForceBalance:
+    """:class:`ForceBalance` of a contact solution."""
+    pb = solution.problem
+    tr = contact_traces(solution)
+    gamma_c = pb.spaces.gamma_c
+    space = pb.spaces.components["lam_n"]
+
+    def dof(v: int) -> int:
+        return space.GetDofNrs(ngs.NodeId(ngs.VERTEX, v))[0]
+
+    weight = np.asarray(gamma_c.hat_means(pb.spaces.prolongations["lam_n"], dof).sum(axis=1))
+    force = tr.edge_length[:, None] * (tr.sigma_n[:, None] * gamma_c.normals
+                                       + tr.sigma_t[:, None] * gamma_c.tangents)
+    tension = np.sum(tr.edge_length * np.maximum(tr.sigma_n, 0.0))
+    total = np.sum(tr.edge_length * np.abs(tr.sigma_n)) or 1.0
+    return ForceBalance(force.sum(axis=0), (weight.reshape(-1, 1) * force).sum(axis=0),
+                        float(tension / total))
 
 
 def versions() -> dict:

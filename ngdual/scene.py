@@ -8,11 +8,12 @@ error is detected here, by :func:`validate`, and reported as one
 The schema (all tables optional except ``geometry`` and ``boundary``)::
 
     name = "thesis-3.46-frictionless"
-    [geometry]   kind = "thesis-3.46" | "polygon", level, points, labels, maxh
+    [geometry]   kind = "thesis-3.46" | "polygon", level, points, labels, maxh, arcs
     [boundary]   dirichlet = [labels], neumann = [labels], contact = [labels]
     [material]   E, nu                                   (plane strain)
     [loads]      body_force = [fx, fy], traction = [tx, ty], displacement = [ux, uy]
-    [contact]    gap, htilde_factor (h~/h), hhat_factor (h^/h~: 1 or 2)
+    [contact]    gap | foundation = {point, normal}, htilde_factor (h~/h),
+                 hhat_factor (h^/h~: 1 or 2), ends = "consistent" | "thesis"
     [friction]   law = "none" | "tresca" | "coulomb", mu, bound (Tresca F),
                  normal_stress = "hat-projection" | "fine-edges" (the |sigma_n| of F)
     [solver]     method, metric, rho, eps, max_iter, rho1, rho2, eps1, eps2, loop_order,
@@ -31,6 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
+from . import geometry
 from .expr import Expression, ExpressionError
 
 try:
@@ -63,7 +65,10 @@ class Geometry:
     with the structured mesh of Table 3.1 (sides ``bottom``, ``right``,
     ``top``, ``left``); ``kind = "polygon"`` is meshed by netgen with ``maxh``.
     Side ``i`` runs from ``points[i]`` to ``points[i+1]`` (cyclically).
-    ``level`` k means k-1 uniform refinements of the initial mesh.
+    ``level`` k means k-1 uniform refinements of the initial mesh (new boundary
+    vertices lie on the curves). ``arcs`` maps a side label to a centre [x, y]: those
+    sides are the shorter circular arcs around it between their end points
+    (:mod:`ngdual.geometry`).
     """
 
     kind: str = "thesis-3.46"
@@ -71,16 +76,18 @@ class Geometry:
     points: list = field(default_factory=list)
     labels: list = field(default_factory=list)
     maxh: float = 0.5
+    arcs: dict = field(default_factory=dict)
+
+    def curves(self) -> list[geometry.Side]:
+        """Every side as a segment or a circular arc (``arcs``: label -> centre), in order."""
+        if self.kind == "thesis-3.46":
+            return geometry.sides([(-4.0, -1.0), (4.0, -1.0), (4.0, 1.0), (-4.0, 1.0)],
+                                  ["bottom", "right", "top", "left"])
+        return geometry.sides(self.points, self.labels, self.arcs)
 
     def sides(self) -> list[tuple[str, np.ndarray, np.ndarray]]:
         """``(label, start, end)`` of every side, counter-clockwise."""
-        if self.kind == "thesis-3.46":
-            pts = [(-4.0, -1.0), (4.0, -1.0), (4.0, 1.0), (-4.0, 1.0)]
-            labels = ["bottom", "right", "top", "left"]
-        else:
-            pts, labels = self.points, self.labels
-        arr = np.asarray(pts, dtype=float)
-        return [(labels[i], arr[i], arr[(i + 1) % len(arr)]) for i in range(len(arr))]
+        return [(c.label, c.start, c.end) for c in self.curves()]
 
 
 @dataclass
@@ -111,13 +118,40 @@ class Loads:
     displacement: list = field(default_factory=lambda: ["0", "0"])
 
 
+CONTACT_ENDS = ("consistent", "thesis")
+
+
 @dataclass
 class Contact:
-    """Rigid foundation at gap g >= 0; coarse multiplier meshes h~ and h^."""
+    """Rigid foundation at gap g >= 0; coarse multiplier meshes h~ and h^; end conditions.
 
-    gap: str = "0"
+    The foundation is given either by a ``gap`` formula g(x, y) (the distance to it along
+    the outward normal n of Gamma_C), or as a straight line, ``foundation = {point = [x,
+    y], normal = [nx, ny]}`` with ``normal`` pointing from the foundation towards the
+    body; then g(x) = d(x) / (-n . n_F), d(x) = (x - point) . n_F the distance from the
+    line, which is the distance from x to the line along the body's normal (the u_n of
+    the Signorini condition u_n <= g). Without either, g = 0.
+
+    ``ends`` says what the contact multipliers lambda_n = g - u_n, lambda_t = -u_t do at
+    the ends of Gamma_C. ``"consistent"`` (default): where Gamma_C meets Gamma_D they take
+    the values the data prescribe, g - u_D.n and -u_D.t; where it meets Gamma_N, or
+    another contact side at a kink, they are free. ``"thesis"``: zero at every end
+    (C_h~ of (3.61)), as in the thesis; it is consistent only where g = u_D.n at the
+    ends (with g(+-4) = 0.01 and u_D = 0 in Example 3.46 it is not: the solution is
+    forced to u_n = g at the clamped corners, so that the thesis scenes, which set it,
+    reproduce the thesis tables, tension included).
+    """
+
+    gap: str | None = None
     htilde_factor: int = 2
     hhat_factor: int = 2
+    ends: str = "consistent"
+    foundation: dict | None = None
+
+    @property
+    def gap_formula(self) -> str:
+        """The gap formula (``"0"`` when neither a gap nor a foundation is given)."""
+        return "0" if self.gap is None else self.gap
 
 
 @dataclass
@@ -317,23 +351,51 @@ def _pair(values, field_name: str) -> list[Expression]:
     return [_expression(v, f"{field_name}[{i}]") for i, v in enumerate(values)]
 
 
+KINK_ANGLE = 1e-6  # radians: two contact sides meeting at a larger angle form a kink
+CUSP_ANGLE = np.pi * (1 - 1e-3)
+
+
 def _validate_geometry(geo: Geometry) -> None:
     if geo.kind not in GEOMETRY_KINDS:
         raise SceneError("geometry.kind", f"unknown kind {geo.kind!r}; use one of "
                                           + ", ".join(GEOMETRY_KINDS))
     _positive(geo.level, "geometry.level", integer=True)
-    if geo.kind == "polygon":
-        pts = np.asarray(geo.points, dtype=float) if len(geo.points) else np.zeros((0, 2))
-        if pts.ndim != 2 or pts.shape[1] != 2 or len(pts) < 3:
-            raise SceneError("geometry.points", "need at least three [x, y] points")
-        if len(geo.labels) != len(pts):
-            raise SceneError("geometry.labels", f"need one label per side ({len(pts)}), "
-                                                f"got {len(geo.labels)}")
-        area = 0.5 * np.sum(pts[:, 0] * np.roll(pts[:, 1], -1) - np.roll(pts[:, 0], -1) * pts[:, 1])
-        if area <= 0:
-            raise SceneError("geometry.points", "the polygon must be listed counter-clockwise "
-                                                "and have positive area")
-        _positive(geo.maxh, "geometry.maxh")
+    if geo.kind != "polygon":
+        if geo.arcs:
+            raise SceneError("geometry.arcs", f"arcs need kind = \"polygon\" (the "
+                                              f"{geo.kind!r} geometry is fixed)")
+        return
+    pts = np.asarray(geo.points, dtype=float) if len(geo.points) else np.zeros((0, 2))
+    if pts.ndim != 2 or pts.shape[1] != 2 or len(pts) < 3:
+        raise SceneError("geometry.points", "need at least three [x, y] points")
+    if len(geo.labels) != len(pts):
+        raise SceneError("geometry.labels", f"need one label per side ({len(pts)}), "
+                                            f"got {len(geo.labels)}")
+    if not isinstance(geo.arcs, dict):
+        raise SceneError("geometry.arcs", "must be a table label = [x, y] (the arc's centre)")
+    for label, centre in geo.arcs.items():
+        if label not in geo.labels:
+            raise SceneError(f"geometry.arcs.{label}", f"unknown side label {label!r}; the "
+                                                       f"sides are {', '.join(geo.labels)}")
+        c = np.asarray(centre, dtype=float) if isinstance(centre, (list, tuple)) else None
+        if c is None or c.shape != (2,) or not np.all(np.isfinite(c)):
+            raise SceneError(f"geometry.arcs.{label}", f"the centre must be [x, y], got "
+                                                       f"{centre!r}")
+    curves = geo.curves()
+    for curve in curves:
+        problem = curve.arc_error()
+        if problem:
+            raise SceneError(f"geometry.arcs.{curve.label}", problem)
+    poly = geometry.outline(curves)
+    if geometry.signed_area(poly) <= 0:
+        raise SceneError("geometry.points", "the polygon must be listed counter-clockwise "
+                                            "and have positive area")
+    hit = geometry.self_intersection(poly)
+    if hit is not None:
+        field_name = "geometry.arcs" if geo.arcs else "geometry.points"
+        raise SceneError(field_name, f"the boundary intersects itself at ({hit[0]:.4g}, "
+                                     f"{hit[1]:.4g})")
+    _positive(geo.maxh, "geometry.maxh")
 
 
 def _validate_boundary(scene: Scene) -> None:
@@ -356,33 +418,147 @@ def _validate_boundary(scene: Scene) -> None:
     if not scene.labels("dirichlet"):
         raise SceneError("boundary.dirichlet", "at least one Dirichlet side is needed "
                                                "(rigid body motions are not excluded otherwise)")
-    ends = {role: {tuple(p) for label, a, b in sides if seen[label] == role for p in (a, b)}
-            for role in _ROLES}
-    touch = ends["neumann"] & ends["contact"]
-    if touch:
-        point = tuple(float(c) for c in sorted(touch)[0])
-        raise SceneError("boundary", f"Gamma_N touches Gamma_C at {point}; separate them by a "
-                                     "Dirichlet side (the formulation assumes they do not touch)")
 
 
-def _contact_points(scene: Scene, per_side: int = 401) -> tuple[np.ndarray, np.ndarray]:
-    pts = [a + np.linspace(0, 1, per_side)[:, None] * (b - a)
-           for label, a, b in scene.geometry.sides() if label in scene.labels("contact")]
-    xy = np.vstack(pts)
-    return xy[:, 0], xy[:, 1]
+def role_of(scene: Scene, label: str) -> str:
+    """dirichlet, neumann or contact: the condition on the sides labelled ``label``."""
+    return next(role for role in _ROLES if label in scene.labels(role))
 
 
-def _validate_contact_ends(scene: Scene, u_d: list[Expression]) -> None:
-    """lambda_t, lambda_n vanish at the ends of Gamma_C (C_h~ of (3.61)), so must u_D there."""
-    ends = np.array([p for label, a, b in scene.geometry.sides()
-                     if label in scene.labels("contact") for p in (a, b)])
+def contact_junctions(scene: Scene) -> list[tuple[np.ndarray, str]]:
+    """The end points of the contact sides and what meets Gamma_C there.
+
+    Returns ``(point, kind)`` for every corner of the boundary with a contact side on at
+    least one side of it: kind ``"dirichlet"`` or ``"neumann"`` where Gamma_C meets that
+    part, ``"kink"`` where two contact sides meet at an angle (the multipliers, which are
+    normal and tangential components, are discontinuous there), ``"smooth"`` where they
+    meet tangentially (one multiplier runs through).
+    """
+    curves = scene.geometry.curves()
+    out = []
+    for i, before in enumerate(curves):
+        after = curves[(i + 1) % len(curves)]
+        roles = (role_of(scene, before.label), role_of(scene, after.label))
+        if "contact" not in roles:
+            continue
+        if roles == ("contact", "contact"):
+            angle = abs(geometry.turning_angle(before, after))
+            out.append((before.end, "kink" if angle > KINK_ANGLE else "smooth"))
+        else:
+            out.append((before.end, roles[1] if roles[0] == "contact" else roles[0]))
+    return out
+
+
+def contact_samples(scene: Scene, per_side: int = 401) -> tuple[np.ndarray, np.ndarray]:
+    """Points on Gamma_C and the outward normals there (``per_side`` per contact side)."""
+    pts, normals = [], []
+    for curve in scene.geometry.curves():
+        if curve.label in scene.labels("contact"):
+            xy, n = curve.sample(per_side)
+            pts.append(xy)
+            normals.append(n)
+    return np.vstack(pts), np.vstack(normals)
+
+
+def foundation_line(contact: Contact) -> tuple[np.ndarray, np.ndarray]:
+    """Point and unit normal (towards the body) of the foundation line."""
+    f = contact.foundation
+    normal = np.asarray(f["normal"], dtype=float)
+    return np.asarray(f["point"], dtype=float), normal / np.linalg.norm(normal)
+
+
+def gap_at(contact: Contact, xy: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """The gap g at points of Gamma_C with outward normals ``normals`` (see :class:`Contact`)."""
+    if contact.foundation is None:
+        return Expression(contact.gap_formula).numpy(xy[:, 0], xy[:, 1])
+    point, n_f = foundation_line(contact)
+    return ((xy - point) @ n_f) / (-(normals @ n_f))
+
+
+def _validate_foundation(scene: Scene) -> None:
+    f = scene.contact.foundation
+    if not isinstance(f, dict) or set(f) != {"point", "normal"}:
+        raise SceneError("contact.foundation", "must be a table {point = [x, y], normal = "
+                                               f"[nx, ny]}}, got {f!r}")
+    for key in ("point", "normal"):
+        v = f[key]
+        ok = isinstance(v, (list, tuple)) and len(v) == 2 and all(
+            isinstance(c, (int, float)) and not isinstance(c, bool) and np.isfinite(c) for c in v)
+        if not ok:
+            raise SceneError(f"contact.foundation.{key}", f"must be a pair of numbers, got {v!r}")
+    if np.linalg.norm(np.asarray(f["normal"], dtype=float)) == 0:
+        raise SceneError("contact.foundation.normal", "must not be zero")
+    if scene.contact.gap is not None:
+        raise SceneError("contact.gap", "give either a gap formula or a foundation line, "
+                                        "not both (the foundation determines the gap)")
+    point, n_f = foundation_line(scene.contact)
+    body = geometry.outline(scene.geometry.curves(), per_arc=401)
+    depth = (body - point) @ n_f
+    size = float(np.ptp(body, axis=0).max())
+    if depth.min() < -1e-9 * size:
+        i = int(np.argmin(depth))
+        raise SceneError("contact.foundation", f"the foundation cuts the body: the point "
+                                               f"({body[i, 0]:.4g}, {body[i, 1]:.4g}) lies "
+                                               f"{-depth[i]:.3g} behind the line")
+    xy, normals = contact_samples(scene)
+    facing = -(normals @ n_f)
+    if facing.min() <= np.cos(np.radians(89)):
+        i = int(np.argmin(facing))
+        raise SceneError("contact.foundation", f"Gamma_C does not face the foundation at "
+                                               f"({xy[i, 0]:.4g}, {xy[i, 1]:.4g}) (its normal "
+                                               "is at 89 degrees or more from the line's); "
+                                               "make that part a Neumann side")
+
+
+def _validate_contact(scene: Scene, u_d: list[Expression]) -> None:
+    """Foundation or gap, ends, kinks: what Gamma_C needs to be posed (see :class:`Contact`)."""
+    con = scene.contact
+    if con.ends not in CONTACT_ENDS:
+        raise SceneError("contact.ends", f"unknown choice {con.ends!r}; use one of "
+                                         + ", ".join(CONTACT_ENDS))
+    if not scene.has_contact:
+        if con.foundation is not None:
+            raise SceneError("contact.foundation", "a foundation needs a contact boundary "
+                                                   "(boundary.contact is empty)")
+        return
+    if con.foundation is not None:
+        _validate_foundation(scene)
+    junctions = contact_junctions(scene)
+    for point, kind in junctions:
+        where = f"({point[0]:.4g}, {point[1]:.4g})"
+        if con.ends == "thesis" and kind == "neumann":
+            raise SceneError("contact.ends", f"Gamma_N touches Gamma_C at {where}: the "
+                                             "thesis' zero ends assume they do not touch; "
+                                             "use contact.ends = \"consistent\"")
+        if kind == "kink":
+            curves = scene.geometry.curves()
+            i = next(k for k, c in enumerate(curves) if np.array_equal(c.end, point)
+                     and role_of(scene, c.label) == "contact")
+            angle = geometry.turning_angle(curves[i], curves[(i + 1) % len(curves)])
+            if angle < 0 or angle > CUSP_ANGLE:
+                raise SceneError("boundary.contact", f"Gamma_C has a "
+                                 f"{'re-entrant' if angle < 0 else 'cusp'} kink at {where} "
+                                 "where no normal cone is defined; make one of the two "
+                                 "sides a Neumann or Dirichlet side")
+    ends = np.array([p for p, kind in junctions if kind == "dirichlet"])
     if not len(ends):
         return
-    values = np.abs(np.concatenate([e.numpy(ends[:, 0], ends[:, 1]) for e in u_d]))
-    if values.max() > 1e-12:
-        raise SceneError("loads.displacement", "the prescribed displacement must vanish where "
-                                               "Gamma_D meets Gamma_C (the contact multipliers "
-                                               "are zero at the ends of Gamma_C)")
+    values = np.column_stack([e.numpy(ends[:, 0], ends[:, 1]) for e in u_d])
+    if con.ends == "thesis":
+        if np.abs(values).max() > 1e-12:
+            raise SceneError("loads.displacement", "the prescribed displacement must vanish "
+                                                   "where Gamma_D meets Gamma_C (the thesis' "
+                                                   "contact multipliers are zero there)")
+        return
+    xy, normals = contact_samples(scene)
+    for p, u in zip(ends, values):
+        k = int(np.argmin(np.linalg.norm(xy - p, axis=1)))
+        g = float(gap_at(con, xy[k:k + 1], normals[k:k + 1])[0])
+        if g < u @ normals[k] - 1e-12 * max(1.0, abs(g)):
+            raise SceneError("contact.gap", f"where Gamma_D meets Gamma_C at ({p[0]:.4g}, "
+                                            f"{p[1]:.4g}) the clamp pushes the body "
+                                            f"{u @ normals[k]:.3g} into the foundation but "
+                                            f"the gap is {g:.3g}: need g >= u_D.n there")
 
 
 def validate(scene: Scene) -> None:
@@ -396,10 +572,9 @@ def validate(scene: Scene) -> None:
     _pair(scene.loads.body_force, "loads.body_force")
     _pair(scene.loads.traction, "loads.traction")
     u_d = _pair(scene.loads.displacement, "loads.displacement")
-    _validate_contact_ends(scene, u_d)
-
     con, fr, sol = scene.contact, scene.friction, scene.solver
-    gap = _expression(con.gap, "contact.gap")
+    _expression(con.gap_formula, "contact.gap")
+    _validate_contact(scene, u_d)
     _positive(con.htilde_factor, "contact.htilde_factor", integer=True)
     if con.hhat_factor not in (1, 2) or isinstance(con.hhat_factor, bool):
         raise SceneError("contact.hhat_factor", f"must be 1 (h^ = h~) or 2 (h^ = 2h~), "
@@ -414,12 +589,13 @@ def validate(scene: Scene) -> None:
                                                    "one of " + ", ".join(NORMAL_STRESSES))
     bound = _expression(fr.bound, "friction.bound")
     if scene.has_contact:
-        x, y = _contact_points(scene)
+        xy, normals = contact_samples(scene)
+        x, y = xy[:, 0], xy[:, 1]
         with np.errstate(invalid="ignore", divide="ignore"):
-            g = gap.numpy(x, y)
+            g = gap_at(con, xy, normals)
             b = bound.numpy(x, y)
         if not np.all(np.isfinite(g)):
-            raise SceneError("contact.gap", f"{con.gap!r} is not finite on Gamma_C")
+            raise SceneError("contact.gap", f"{con.gap_formula!r} is not finite on Gamma_C")
         if g.min() < 0:
             i = int(np.argmin(g))
             raise SceneError("contact.gap", f"negative gap {g[i]:.3g} at ({x[i]:.3g}, {y[i]:.3g}); "

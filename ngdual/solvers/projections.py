@@ -42,7 +42,12 @@ def metric_matrix(contact: CoarseMesh, modulus: float, kind: str) -> np.ndarray:
         mass, stiff = contact.p1_mass_stiffness()
         vals, vecs = sla.eigh(stiff, mass)
         mv = mass @ vecs
-        return modulus / 2 * (mv * np.sqrt(np.maximum(vals, 0))) @ mv.T
+        # with a free end the constants (or, between two free ends, also the linears
+        # at low frequency) make L singular: the spectrum is floored at (pi / 2 l)^2,
+        # the lowest eigenvalue of a chain of length l fixed at one end only, which
+        # leaves the metric unchanged where every end is fixed (the thesis' C_h~)
+        floor = (np.pi / (2 * contact.edge_lengths().sum())) ** 2
+        return modulus / 2 * (mv * np.sqrt(np.maximum(vals, floor))) @ mv.T
     raise ValueError(f"unknown metric {kind!r}")
 
 

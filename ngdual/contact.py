@@ -1,0 +1,132 @@
+"""Gamma_C in one place: its fine edges, coarse meshes, normals, gap and end values.
+
+:class:`ContactBoundary` is built once per discrete problem (:class:`ngdual.forms.Spaces`)
+from the scene and the mesh. Friction terms, the solvers, post-processing and the
+estimator read Gamma_C from it instead of deriving it again:
+
+* the fine edges of T_h on Gamma_C chain by chain in arc-length order (vertex pairs,
+  lengths, midpoints, outward normals n and tangents t = (n_2, -n_1) of (3.24));
+* the h~ mesh of lambda_n, lambda_t and the h^ mesh of nu (:mod:`ngdual.boundary`), the
+  h~ and h^ edge of every fine edge and the mean of every h~ hat on every fine edge;
+* the gap g (a formula, or from a foundation line, :class:`ngdual.scene.Contact`) as an
+  NGSolve coefficient and at points;
+* the prescribed end values of lambda_n = g - u_n and lambda_t = -u_t where Gamma_C meets
+  Gamma_D (``contact.ends = "consistent"``): g - u_D.n and -u_D.t; zero for ``"thesis"``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import ngsolve as ngs
+import numpy as np
+import scipy.sparse as sp
+
+from .boundary import CoarseMesh, edge_normals
+from .expr import Expression
+from .scene import Scene, foundation_line, gap_at
+
+
+def gap_coefficient(scene: Scene) -> ngs.CoefficientFunction:
+    """g on Gamma_C as an NGSolve coefficient (boundary integrals only: it may use n)."""
+    contact = scene.contact
+    if contact.foundation is None:
+        return Expression(contact.gap_formula).coefficient()
+    point, n_f = foundation_line(contact)
+    n = ngs.specialcf.normal(2)
+    distance = (ngs.x - point[0]) * n_f[0] + (ngs.y - point[1]) * n_f[1]
+    return distance / (-(n[0] * n_f[0] + n[1] * n_f[1]))
+
+
+@dataclass(frozen=True)
+class ContactBoundary:
+    """Gamma_C of one mesh (see the module docstring).
+
+    Attributes
+    ----------
+    coarse, friction : CoarseMesh
+        The h~ mesh of the contact multipliers and the h^ mesh of nu (None without friction).
+    vertices : numpy.ndarray
+        (n, 2) fine vertex numbers of every fine edge, chain by chain along the chains.
+    lengths, midpoints, normals : numpy.ndarray
+        |e|, midpoints and outward unit normals of the fine edges.
+    htilde_edge, hhat_edge : numpy.ndarray
+        The h~ (and h^) edge holding every fine edge.
+    """
+
+    scene: Scene
+    coarse: CoarseMesh
+    friction: CoarseMesh | None
+    vertices: np.ndarray
+    lengths: np.ndarray
+    midpoints: np.ndarray
+    normals: np.ndarray
+    htilde_edge: np.ndarray
+    hhat_edge: np.ndarray | None
+
+    @classmethod
+    def build(cls, scene: Scene, coarse: CoarseMesh, friction: CoarseMesh | None
+              ) -> ContactBoundary:
+        vertices, htilde_edge = coarse.fine_edges()
+        pts = [ch.path_points for ch in coarse.chains]
+        starts = np.vstack([p[:-1] for p in pts])
+        ends = np.vstack([p[1:] for p in pts])
+        normals = np.vstack([edge_normals(ch) for ch in coarse.chains])
+        hhat_edge = friction.fine_edges()[1] if friction is not None else None
+        return cls(scene, coarse, friction, vertices, np.linalg.norm(ends - starts, axis=1),
+                   0.5 * (starts + ends), normals, htilde_edge, hhat_edge)
+
+    def __len__(self) -> int:
+        return len(self.lengths)
+
+    @property
+    def tangents(self) -> np.ndarray:
+        """t = (n_2, -n_1), the tangent of (3.24)."""
+        return np.column_stack([self.normals[:, 1], -self.normals[:, 0]])
+
+    def hat_means(self, prolongation: sp.csr_matrix, vertex_dof) -> sp.csr_matrix:
+        """M (n_edges x N_C): the mean of every h~ hat on every fine edge.
+
+        ``prolongation`` maps the coarse dofs to the fine P1 trace space, ``vertex_dof``
+        a fine vertex number to its dof there.
+        """
+        P = prolongation.tocsr()
+        a = np.array([vertex_dof(int(v)) for v in self.vertices[:, 0]], dtype=int)
+        b = np.array([vertex_dof(int(v)) for v in self.vertices[:, 1]], dtype=int)
+        return (0.5 * (P[a] + P[b])).tocsr()
+
+    def gap_at_edges(self) -> np.ndarray:
+        """g at the fine edge midpoints."""
+        return gap_at(self.scene.contact, self.midpoints, self.normals)
+
+    def vertex_normals(self) -> np.ndarray:
+        """Outward normals at the fine vertices of every chain (``path_points`` order): the
+        mean of the two edge normals inside a chain, the end edge's at a chain end."""
+        out = []
+        for chain in self.coarse.chains:
+            n = edge_normals(chain)
+            mean = np.vstack([n[:1], n[:-1] + n[1:], n[-1:]])
+            if chain.closed:
+                mean[0] = mean[-1] = n[0] + n[-1]
+            out.append(mean / np.linalg.norm(mean, axis=1)[:, None])
+        return np.vstack(out)
+
+    def gap_at_vertices(self) -> np.ndarray:
+        """g at the fine vertices of every chain (``path_points`` order)."""
+        pts = np.vstack([ch.path_points for ch in self.coarse.chains])
+        return gap_at(self.scene.contact, pts, self.vertex_normals())
+
+    def end_values(self, u_d: tuple[str, str]) -> tuple[np.ndarray, np.ndarray]:
+        """(lambda_n, lambda_t) at the fixed ends (``coarse.end_points()``).
+
+        ``"consistent"``: g - u_D.n and -u_D.t with the normal of the end edge;
+        ``"thesis"``: zero (C_h~ of (3.61)).
+        """
+        points = self.coarse.end_points()
+        if self.scene.contact.ends == "thesis" or not len(points):
+            return np.zeros(len(points)), np.zeros(len(points))
+        normals = self.coarse.end_normals()
+        tangents = np.column_stack([normals[:, 1], -normals[:, 0]])
+        u = np.column_stack([Expression(e).numpy(points[:, 0], points[:, 1]) for e in u_d])
+        g = gap_at(self.scene.contact, points, normals)
+        return g - np.sum(u * normals, axis=1), -np.sum(u * tangents, axis=1)

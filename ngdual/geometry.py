@@ -1,0 +1,156 @@
+"""The boundary of a scene's domain as curves: straight sides and circular arcs.
+
+A polygon side ``i`` runs from ``points[i]`` to ``points[i+1]`` (counter-clockwise, the
+body on its left). A side whose label is listed in ``geometry.arcs`` with a centre c is
+the minor circular arc around c between its end points instead of the segment. The
+outward unit normal n and the tangent t = (n_2, -n_1) of (3.24) are those of the curve.
+
+This module holds the geometric facts that validation, meshing and the contact boundary
+need from the scene (sampled curves, normals, the turning angle where two sides meet,
+simplicity of the boundary), so none of them derives them on its own.
+
+>>> s = Side("arc", np.array([-1.0, 0.0]), np.array([1.0, 0.0]), np.array([0.0, 1.0]))
+>>> bool(np.allclose(s.sample(3)[0][1], [0.0, 1 - np.sqrt(2)]))
+True
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+MAX_ARC_PIECE = np.pi / 4  # netgen gets an arc as rational quadratic splines of <= 45 degrees
+
+
+@dataclass(frozen=True)
+class Side:
+    """One side of the boundary: a segment, or a circular arc around ``center``."""
+
+    label: str
+    start: np.ndarray
+    end: np.ndarray
+    center: np.ndarray | None = None
+
+    @property
+    def is_arc(self) -> bool:
+        return self.center is not None
+
+    def _angles(self) -> tuple[float, float, float]:
+        """Radius, start angle and signed sweep of the minor arc from start to end."""
+        a, b = self.start - self.center, self.end - self.center
+        sweep = float(np.arctan2(a[0] * b[1] - a[1] * b[0], a @ b))
+        return float(np.linalg.norm(a)), float(np.arctan2(a[1], a[0])), sweep
+
+    def sample(self, n: int) -> tuple[np.ndarray, np.ndarray]:
+        """``n`` >= 2 points from start to end (equal parameter steps) and the outward normals."""
+        s = np.linspace(0.0, 1.0, n)
+        if not self.is_arc:
+            d = self.end - self.start
+            normal = np.array([d[1], -d[0]]) / np.linalg.norm(d)
+            return self.start + s[:, None] * d, np.tile(normal, (n, 1))
+        r, phi0, sweep = self._angles()
+        phi = phi0 + s * sweep
+        radial = np.column_stack([np.cos(phi), np.sin(phi)])
+        # counter-clockwise sweep: the body lies to the left, i.e. inside the circle
+        normal = radial if sweep > 0 else -radial
+        return self.center + r * radial, normal
+
+    def tangent(self, at_end: bool) -> np.ndarray:
+        """Unit tangent in the direction of travel at the start or the end of the side."""
+        _, normals = self.sample(2)
+        n = normals[-1 if at_end else 0]
+        return np.array([-n[1], n[0]])
+
+    def spline_pieces(self) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+        """(start, control point, end) of rational quadratic splines that are the arc exactly."""
+        r, phi0, sweep = self._angles()
+        m = max(1, int(np.ceil(abs(sweep) / MAX_ARC_PIECE - 1e-9)))
+        phi = phi0 + np.linspace(0.0, sweep, m + 1)
+        pts = self.center + r * np.column_stack([np.cos(phi), np.sin(phi)])
+        pieces = []
+        for k in range(m):
+            mid = 0.5 * (phi[k] + phi[k + 1])
+            half = 0.5 * (phi[k + 1] - phi[k])
+            # the tangents at both ends meet on the bisector at distance r / cos(half)
+            control = self.center + r / np.cos(half) * np.array([np.cos(mid), np.sin(mid)])
+            pieces.append((pts[k], control, pts[k + 1]))
+        return pieces
+
+    def arc_error(self) -> str | None:
+        """Why this arc is not a valid minor arc (None when it is)."""
+        if not self.is_arc:
+            return None
+        ra, rb = np.linalg.norm(self.start - self.center), np.linalg.norm(self.end - self.center)
+        if min(ra, rb) <= 0 or abs(ra - rb) > 1e-6 * max(ra, rb):
+            return (f"the end points of side {self.label!r} are at distances {ra:.6g} and "
+                    f"{rb:.6g} from the centre; an arc needs equal distances")
+        _, _, sweep = self._angles()
+        if abs(sweep) >= np.pi * (1 - 1e-9):
+            return (f"side {self.label!r} spans 180 degrees or more; split it into two sides "
+                    "(an arc is the shorter arc between its end points)")
+        return None
+
+
+def sides(points, labels, arcs: dict | None = None) -> list[Side]:
+    """The sides of the boundary, counter-clockwise."""
+    arr = np.asarray(points, dtype=float)
+    arcs = arcs or {}
+    out = []
+    for i, label in enumerate(labels):
+        center = arcs.get(label)
+        out.append(Side(label, arr[i], arr[(i + 1) % len(arr)],
+                        None if center is None else np.asarray(center, dtype=float)))
+    return out
+
+
+def outline(boundary: list[Side], per_arc: int = 64) -> np.ndarray:
+    """The closed boundary as a polygon (arcs sampled), without repeating the first point."""
+    pts = []
+    for side in boundary:
+        xy = side.sample(per_arc)[0] if side.is_arc else side.start[None, :]
+        pts.append(xy[:-1] if side.is_arc else xy)
+    return np.vstack(pts)
+
+
+def signed_area(poly: np.ndarray) -> float:
+    x, y = poly[:, 0], poly[:, 1]
+    return 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
+
+
+def self_intersection(poly: np.ndarray) -> np.ndarray | None:
+    """A point where two non-adjacent edges of the closed polygon meet (None if it is simple)."""
+    a, b = poly, np.roll(poly, -1, axis=0)
+    n = len(poly)
+    for i in range(n):
+        for j in range(i + 2, n):
+            if i == 0 and j == n - 1:
+                continue
+            hit = _segments_meet(a[i], b[i], a[j], b[j])
+            if hit is not None:
+                return hit
+    return None
+
+
+def _segments_meet(p, q, r, s) -> np.ndarray | None:
+    d1, d2 = q - p, s - r
+    denom = d1[0] * d2[1] - d1[1] * d2[0]
+    scale = max(np.linalg.norm(d1), np.linalg.norm(d2)) ** 2
+    if abs(denom) <= 1e-14 * scale:
+        # parallel: they meet only if collinear and overlapping
+        if abs((r - p)[0] * d1[1] - (r - p)[1] * d1[0]) > 1e-12 * scale:
+            return None
+        t = [(x - p) @ d1 / (d1 @ d1) for x in (r, s)]
+        return p + max(0.0, min(t)) * d1 if max(t) >= 0 and min(t) <= 1 else None
+    t = ((r - p)[0] * d2[1] - (r - p)[1] * d2[0]) / denom
+    u = ((r - p)[0] * d1[1] - (r - p)[1] * d1[0]) / denom
+    if -1e-12 <= t <= 1 + 1e-12 and -1e-12 <= u <= 1 + 1e-12:
+        return p + t * d1
+    return None
+
+
+def turning_angle(before: Side, after: Side) -> float:
+    """Signed angle (radians) by which the boundary turns where ``before`` ends and ``after``
+    starts: > 0 at a convex corner, < 0 at a re-entrant one, 0 where they join smoothly."""
+    t0, t1 = before.tangent(at_end=True), after.tangent(at_end=False)
+    return float(np.arctan2(t0[0] * t1[1] - t0[1] * t1[0], t0 @ t1))
