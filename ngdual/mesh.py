@@ -54,15 +54,16 @@ def thesis_mesh(level: int) -> ngs.Mesh:
     return ngs.Mesh(m)
 
 
-def polygon_mesh(points, labels, maxh: float, level: int = 1, arcs: dict | None = None
-                 ) -> ngs.Mesh:
+def polygon_mesh(points, labels, maxh: float, level: int = 1, arcs: dict | None = None,
+                 side_maxh: dict | None = None) -> ngs.Mesh:
     """A netgen mesh of the counter-clockwise polygon ``points`` with side labels.
 
     Side ``i`` (from ``points[i]`` to ``points[i+1]``) gets boundary label
     ``labels[i]``; sides whose label is a key of ``arcs`` are circular arcs around
     ``arcs[label]`` (:mod:`ngdual.geometry`), given to netgen as rational quadratic
-    splines that are the arc exactly. ``level`` k applies k-1 uniform refinements,
-    which put the new boundary vertices on the curves.
+    splines that are the arc exactly; ``side_maxh[label]`` is a mesh size on those sides.
+    ``level`` k applies k-1 uniform refinements, which put the new boundary vertices on
+    the curves.
 
     The elements stay affine (straight-sided): the lowest-order PEERS spaces converge
     at O(h), and vertices on the exact curve leave a geometric error of O(h^2) in
@@ -79,14 +80,16 @@ def polygon_mesh(points, labels, maxh: float, level: int = 1, arcs: dict | None 
             ids[key] = geo.AppendPoint(*key)
         return ids[key]
 
+    side_maxh = side_maxh or {}
     for side in geometry.sides(points, labels, arcs):
+        options = {"bc": side.label, "leftdomain": 1, "rightdomain": 0}
+        if side.label in side_maxh:
+            options["maxh"] = float(side_maxh[side.label])
         if side.is_arc:
             for a, control, b in side.spline_pieces():
-                geo.Append(["spline3", point(a), point(control), point(b)], bc=side.label,
-                           leftdomain=1, rightdomain=0)
+                geo.Append(["spline3", point(a), point(control), point(b)], **options)
         else:
-            geo.Append(["line", point(side.start), point(side.end)], bc=side.label,
-                       leftdomain=1, rightdomain=0)
+            geo.Append(["line", point(side.start), point(side.end)], **options)
     mesh = ngs.Mesh(geo.GenerateMesh(maxh=maxh))
     refine_uniformly(mesh, level - 1)
     return mesh
@@ -104,7 +107,7 @@ def build_mesh(geo: Geometry, level: int | None = None) -> ngs.Mesh:
     level = geo.level if level is None else level
     if geo.kind == "thesis-3.46":
         return thesis_mesh(level)
-    return polygon_mesh(geo.points, geo.labels, geo.maxh, level, geo.arcs)
+    return polygon_mesh(geo.points, geo.labels, geo.maxh, level, geo.arcs, geo.side_maxh)
 
 
 def mesh_size(mesh: ngs.Mesh) -> float:

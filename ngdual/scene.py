@@ -68,7 +68,8 @@ class Geometry:
     ``level`` k means k-1 uniform refinements of the initial mesh (new boundary
     vertices lie on the curves). ``arcs`` maps a side label to a centre [x, y]: those
     sides are the shorter circular arcs around it between their end points
-    (:mod:`ngdual.geometry`).
+    (:mod:`ngdual.geometry`). ``side_maxh`` maps a side label to a smaller mesh size
+    on those sides (netgen grades the mesh from there to ``maxh``).
     """
 
     kind: str = "thesis-3.46"
@@ -77,6 +78,7 @@ class Geometry:
     labels: list = field(default_factory=list)
     maxh: float = 0.5
     arcs: dict = field(default_factory=dict)
+    side_maxh: dict = field(default_factory=dict)
 
     def curves(self) -> list[geometry.Side]:
         """Every side as a segment or a circular arc (``arcs``: label -> centre), in order."""
@@ -361,9 +363,10 @@ def _validate_geometry(geo: Geometry) -> None:
                                           + ", ".join(GEOMETRY_KINDS))
     _positive(geo.level, "geometry.level", integer=True)
     if geo.kind != "polygon":
-        if geo.arcs:
-            raise SceneError("geometry.arcs", f"arcs need kind = \"polygon\" (the "
-                                              f"{geo.kind!r} geometry is fixed)")
+        for key in ("arcs", "side_maxh"):
+            if getattr(geo, key):
+                raise SceneError(f"geometry.{key}", f"{key} needs kind = \"polygon\" (the "
+                                                    f"{geo.kind!r} geometry is fixed)")
         return
     pts = np.asarray(geo.points, dtype=float) if len(geo.points) else np.zeros((0, 2))
     if pts.ndim != 2 or pts.shape[1] != 2 or len(pts) < 3:
@@ -381,20 +384,28 @@ def _validate_geometry(geo: Geometry) -> None:
         if c is None or c.shape != (2,) or not np.all(np.isfinite(c)):
             raise SceneError(f"geometry.arcs.{label}", f"the centre must be [x, y], got "
                                                        f"{centre!r}")
+    if not isinstance(geo.side_maxh, dict):
+        raise SceneError("geometry.side_maxh", "must be a table label = mesh size")
+    for label, h in geo.side_maxh.items():
+        if label not in geo.labels:
+            raise SceneError(f"geometry.side_maxh.{label}", f"unknown side label {label!r}; "
+                                                            f"the sides are "
+                                                            f"{', '.join(geo.labels)}")
+        _positive(h, f"geometry.side_maxh.{label}")
     curves = geo.curves()
     for curve in curves:
         problem = curve.arc_error()
         if problem:
             raise SceneError(f"geometry.arcs.{curve.label}", problem)
     poly = geometry.outline(curves)
-    if geometry.signed_area(poly) <= 0:
-        raise SceneError("geometry.points", "the polygon must be listed counter-clockwise "
-                                            "and have positive area")
     hit = geometry.self_intersection(poly)
     if hit is not None:
         field_name = "geometry.arcs" if geo.arcs else "geometry.points"
         raise SceneError(field_name, f"the boundary intersects itself at ({hit[0]:.4g}, "
                                      f"{hit[1]:.4g})")
+    if geometry.signed_area(poly) <= 0:
+        raise SceneError("geometry.points", "the polygon must be listed counter-clockwise "
+                                            "and have positive area")
     _positive(geo.maxh, "geometry.maxh")
 
 

@@ -8,8 +8,13 @@ from ngdual.scene import SceneError, load_scene, shipped_scenes
 BAD = [
     (["boundary.contact=['floor']"], "boundary.contact", "unknown boundary label"),
     (["boundary.dirichlet=['left']"], "boundary", "'right' has no condition"),
-    (["boundary.neumann=['top', 'right']", "boundary.dirichlet=['left']"], "boundary",
+    (["boundary.neumann=['top', 'right']", "boundary.dirichlet=['left']"], "contact.ends",
      "touches"),
+    (["contact.ends='both'"], "contact.ends", "unknown choice"),
+    (["contact.ends='consistent'", "loads.displacement=['0', '-0.02']"], "contact.gap",
+     "need g >= u_D.n"),
+    (["contact.foundation={point = [0, -1], normal = [0, 1]}"], "contact.gap", "not both"),
+    (["geometry.arcs={bottom = [0, 3]}"], "geometry.arcs", "kind"),
     (["material.E=0"], "material.E", "positive"),
     (["material.E=-2e5"], "material.E", "positive"),
     (["material.nu=0.5"], "material.nu", "(-1, 0.5)"),
@@ -101,3 +106,56 @@ def test_formulas_with_transcendental_functions_assemble():
 def test_nonzero_displacement_at_the_ends_of_gamma_c_is_rejected():
     with pytest.raises(SceneError, match="loads.displacement"):
         load_scene("thesis-3.46-frictionless", ["loads.displacement=['0.001', '0']"])
+
+
+BLOCK = {"kind": "polygon", "points": [[-1.0, 0.0], [1.0, 0.0], [1.0, 1.0], [-1.0, 1.0]],
+         "labels": ["bottom", "right", "top", "left"], "maxh": 0.5}
+BAD_GEOMETRY = [
+    # an arc whose end points are not equidistant from its centre
+    ({"arcs": {"bottom": [0.0, 3.0]}, "points": [[-1.0, 0.0], [1.0, 0.1], [1.0, 1.0],
+                                                [-1.0, 1.0]]}, {}, "geometry.arcs.bottom",
+     "equal distances"),
+    # an arc bulging so far that it crosses the top side
+    ({"arcs": {"bottom": [0.0, 0.0]}}, {}, "geometry.arcs.bottom", "180 degrees"),
+    ({"arcs": {"bottom": [0.0, -0.05]},
+      "points": [[-1.0, 0.0], [1.0, 0.0], [1.0, 0.5], [-1.0, 0.5]]}, {}, "geometry.arcs",
+     "intersects itself"),
+    ({"arcs": {"floor": [0.0, 3.0]}}, {}, "geometry.arcs.floor", "unknown side label"),
+    ({}, {"foundation": {"point": [0.0, 0.2], "normal": [0.0, 1.0]}}, "contact.foundation",
+     "cuts the body"),
+    ({}, {"foundation": {"point": [0.0, -1.0], "normal": [1.0, 0.0]}}, "contact.foundation",
+     "cuts the body"),
+    ({}, {"foundation": {"point": [0.0, 0.0], "normal": [0.0, 0.0]}},
+     "contact.foundation.normal", "zero"),
+    # a V-shaped notch in the contact side: re-entrant kink
+    ({"points": [[-1.0, 0.0], [0.0, 0.5], [1.0, 0.0], [1.0, 1.0], [-1.0, 1.0]],
+      "labels": ["c1", "c2", "right", "top", "left"]}, {}, "boundary.contact", "re-entrant"),
+]
+
+
+@pytest.mark.parametrize("geometry, contact, field, words", BAD_GEOMETRY)
+def test_bad_geometry_and_foundation_are_refused_naming_the_field(geometry, contact, field,
+                                                                   words):
+    from ngdual.scene import Scene, Geometry, Contact, validate
+    geo = Geometry(**{**BLOCK, **geometry})
+    contact_labels = [lab for lab in geo.labels if lab.startswith("c")] or ["bottom"]
+    boundary = {"contact": contact_labels, "dirichlet": ["top"],
+                "neumann": [lab for lab in geo.labels if lab in ("left", "right")]}
+    scene = Scene("bad", geo, boundary, contact=Contact(**contact))
+    with pytest.raises(SceneError) as info:
+        validate(scene)
+    assert info.value.field == field, str(info.value)
+    assert words in str(info.value)
+
+
+def test_contact_sides_meeting_each_other_need_no_end_condition():
+    """Gamma_C split where the load changes: the end checks apply only where Gamma_C meets
+    Gamma_D or Gamma_N, not where two contact sides meet."""
+    from ngdual.scene import Scene, Geometry, validate
+    geo = Geometry(kind="polygon", points=[[-1.0, 0.0], [0.0, 0.0], [1.0, 0.0], [1.0, 1.0],
+                                           [-1.0, 1.0]],
+                   labels=["c1", "c2", "right", "top", "left"], maxh=0.5)
+    scene = Scene("split", geo, {"contact": ["c1", "c2"], "dirichlet": ["left", "right"],
+                                 "neumann": ["top"]})
+    scene.loads.displacement = ["0", "y"]  # vanishes at the corners (+-1, 0) only
+    validate(scene)

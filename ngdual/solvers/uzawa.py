@@ -15,9 +15,12 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
+import scipy.linalg as sla
 import scipy.sparse as sp
+import scipy.sparse.linalg as sla_sparse
 
 from ..forms import DiscreteProblem
 from .condensed import CondensedResponse
@@ -130,6 +133,36 @@ class ContactLoop:
         self.condense_seconds = time.perf_counter() - start
         self._split = np.cumsum([n_c, n_t])
 
+    @cached_property
+    def stability_bound(self) -> float:
+        """lambda_max(W^{-1} S), S the Steklov-Poincare map lambda_n -> -C_n^T sigma.
+
+        Step 4 contracts for rho < 2 / lambda_max. The metric W carries the half-plane
+        scaling of S, so lambda_max is about 1 where the ends of Gamma_C are fixed (0.82
+        to 0.96 on Example 3.46, levels 2-3); where Gamma_C has free ends, its lowest
+        modes feel the stiffness of the whole body (a block of height H pressed as a
+        whole: S ~ E*/H per length, far above the metric's E*/2 |k| at small k), and
+        lambda_max can exceed 2 (2.76 on hertz-cylinder, level 1). Computed by Lanczos
+        (scipy ``eigsh``, about 20 responses: cheap beside the iteration).
+        """
+        n = self.n_c
+        if n == 0:
+            return 0.0
+        tau = np.zeros(self.E_t.shape[1])
+        t0 = self.respond(np.zeros(n), tau).traction
+        chol = sla.cholesky(np.diag(self.projection.W) if self.projection.diagonal
+                            else self.projection.W)  # W = R^T R
+
+        def apply(v):
+            w = sla.solve_triangular(chol, v)
+            return sla.solve_triangular(chol, -(self.respond(w, tau).traction - t0), trans="T")
+        if n <= 3:
+            matrix = np.column_stack([apply(e) for e in np.eye(n)])
+            return float(np.linalg.eigvalsh(0.5 * (matrix + matrix.T)).max())
+        op = sla_sparse.LinearOperator((n, n), matvec=apply, dtype=float)
+        return float(sla_sparse.eigsh(op, k=1, which="LA", tol=1e-3,
+                                      v0=np.ones(n))[0][0])
+
     def respond(self, lam: np.ndarray, tau: np.ndarray) -> LoopState:
         """Step 3 for lambda_n = ``lam`` and the lambda_t-row load ``tau``."""
         z = np.concatenate([lam, tau])
@@ -159,9 +192,17 @@ class ContactLoop:
             progress: Callable[[int, float], None] | None = None):
         """Iterate until the relative increment is <= eps (step 5).
 
+        ``rho`` is the dimensionless step. In the H^{1/2} metric, where the metric
+        underestimates the body's stiffness (:attr:`stability_bound` > 1), it is taken
+        relative to that bound, rho / lambda_max, so that rho in (0, 2) always contracts
+        (where the bound is <= 1, e.g. on Example 3.46, the step is rho itself, as in the
+        thesis). In the Euclidean metric the bound grows like 1/h and rho is the plain
+        step of the thesis, to be chosen by the user.
         Returns ``(state, iterations, history, converged)``; the state's y solves
         the linear system with the state's lambda_n exactly.
         """
+        if not self.projection.diagonal:
+            rho = rho / max(1.0, self.stability_bound)
         tau = np.zeros(self.E_t.shape[1]) if tau is None else tau
         prev, history, converged = None, [], False
         for it in range(1, max_iter + 1):
