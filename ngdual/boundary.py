@@ -423,6 +423,36 @@ class CoarseMesh:
                             vals.append(w)
         return sp.csr_matrix((vals, (rows, cols)), shape=(n_fine, offset))
 
+    def p1_edge_prolongation(self, edge_dofs: np.ndarray, n_fine: int, ends: bool = False
+                             ) -> sp.csr_matrix:
+        """The coarse P1 hats at both ends of every fine edge, for a fine space that is
+        discontinuous from edge to edge (needed at the kinks of Gamma_C).
+
+        ``edge_dofs`` (n_fine_edges, 2): the fine dofs at the start and the end of every
+        fine edge, in the chain order of :meth:`fine_edges`. ``ends`` as in
+        :meth:`p1_prolongation`. Returns a csr_matrix of shape (n_fine, n_dofs).
+        """
+        rows, cols, vals = [], [], []
+        offset, edge = 0, 0
+        for c, chain in enumerate(self.chains):
+            s, nodes = chain.arclength, self.nodes[c]
+            carriers = self._ends(c) if ends else self.dof_positions(c)
+            dof_of_pos = {int(p): offset + k for k, p in enumerate(carriers)}
+            offset += len(carriers)
+            for k in range(chain.n_edges):
+                e = np.searchsorted(nodes, k, side="right") - 1
+                a, b = int(nodes[e]), int(nodes[e + 1])
+                for end, p in enumerate((k, k + 1)):
+                    t = (s[p] - s[a]) / (s[b] - s[a])
+                    for pos, w in ((a, 1 - t), (b, t)):
+                        key = pos % chain.n_edges if chain.closed else pos
+                        if key in dof_of_pos and w > 0:
+                            rows.append(edge_dofs[edge + k, end])
+                            cols.append(dof_of_pos[key])
+                            vals.append(w)
+            edge += chain.n_edges
+        return sp.csr_matrix((vals, (rows, cols)), shape=(n_fine, offset))
+
     def p1_mass_stiffness(self) -> tuple[np.ndarray, np.ndarray]:
         """Dense P1 mass M and arc-length stiffness L on the coarse dofs."""
         n = self.n_p1_dofs

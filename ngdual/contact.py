@@ -27,6 +27,19 @@ from .expr import Expression
 from .scene import Scene, foundation_line, gap_at
 
 
+def trace_space(mesh: ngs.Mesh, labels: list[str]) -> ngs.FESpace:
+    """The fine trace space of lambda_n, lambda_t: P1 on every fine edge of Gamma_C,
+    discontinuous between edges (see :class:`ContactBoundary`)."""
+    h1 = ngs.H1(mesh, order=1, definedon=mesh.Boundaries("|".join(labels)))
+    # BND=True (discontinuous across boundary elements) works but is missing from the
+    # flag list NGSolve checks keywords against, which would print a warning
+    level, ngs.ngsglobals.msg_level = ngs.ngsglobals.msg_level, 0
+    try:
+        return ngs.Compress(ngs.Discontinuous(h1, BND=True))
+    finally:
+        ngs.ngsglobals.msg_level = level
+
+
 def gap_coefficient(scene: Scene) -> ngs.CoefficientFunction:
     """g on Gamma_C as an NGSolve coefficient (boundary integrals only: it may use n)."""
     contact = scene.contact
@@ -52,6 +65,11 @@ class ContactBoundary:
         |e|, midpoints and outward unit normals of the fine edges.
     htilde_edge, hhat_edge : numpy.ndarray
         The h~ (and h^) edge holding every fine edge.
+    edge_dofs : numpy.ndarray
+        (n, 2) dofs of the fine trace space of lambda at the start and end of every
+        fine edge. That space is P1 on every fine edge and discontinuous from edge to
+        edge (``Discontinuous(H1, BND=True)``): the coarse multipliers are continuous
+        along a chain but not across a kink, where two chains share a vertex.
     """
 
     scene: Scene
@@ -63,18 +81,29 @@ class ContactBoundary:
     normals: np.ndarray
     htilde_edge: np.ndarray
     hhat_edge: np.ndarray | None
+    edge_dofs: np.ndarray
 
     @classmethod
-    def build(cls, scene: Scene, coarse: CoarseMesh, friction: CoarseMesh | None
-              ) -> ContactBoundary:
+    def build(cls, scene: Scene, coarse: CoarseMesh, friction: CoarseMesh | None,
+              space: ngs.FESpace) -> ContactBoundary:
+        """Gamma_C from its coarse meshes and the fine trace space (:func:`trace_space`)."""
         vertices, htilde_edge = coarse.fine_edges()
+        mesh, labels = space.mesh, set(scene.labels("contact"))
+        dofs_of = {}
+        for el in mesh.Elements(ngs.BND):
+            if el.mat in labels:
+                a, b = (v.nr for v in el.vertices)
+                da, db = space.GetDofNrs(el)
+                dofs_of[(a, b)], dofs_of[(b, a)] = (da, db), (db, da)
+        edge_dofs = np.array([dofs_of[(int(a), int(b))] for a, b in vertices],
+                             dtype=int).reshape(-1, 2)
         pts = [ch.path_points for ch in coarse.chains]
         starts = np.vstack([p[:-1] for p in pts])
         ends = np.vstack([p[1:] for p in pts])
         normals = np.vstack([edge_normals(ch) for ch in coarse.chains])
         hhat_edge = friction.fine_edges()[1] if friction is not None else None
         return cls(scene, coarse, friction, vertices, np.linalg.norm(ends - starts, axis=1),
-                   0.5 * (starts + ends), normals, htilde_edge, hhat_edge)
+                   0.5 * (starts + ends), normals, htilde_edge, hhat_edge, edge_dofs)
 
     def __len__(self) -> int:
         return len(self.lengths)
@@ -84,16 +113,23 @@ class ContactBoundary:
         """t = (n_2, -n_1), the tangent of (3.24)."""
         return np.column_stack([self.normals[:, 1], -self.normals[:, 0]])
 
-    def hat_means(self, prolongation: sp.csr_matrix, vertex_dof) -> sp.csr_matrix:
-        """M (n_edges x N_C): the mean of every h~ hat on every fine edge.
+    def prolongation(self, n_fine: int, ends: bool = False) -> sp.csr_matrix:
+        """Coarse h~ P1 dofs (or the fixed-end hats, ``ends=True``) -> fine trace dofs."""
+        return self.coarse.p1_edge_prolongation(self.edge_dofs, n_fine, ends)
 
-        ``prolongation`` maps the coarse dofs to the fine P1 trace space, ``vertex_dof``
-        a fine vertex number to its dof there.
-        """
+    def hat_means(self, prolongation: sp.csr_matrix) -> sp.csr_matrix:
+        """M (n_edges x N_C): the mean of every coarse function on every fine edge."""
         P = prolongation.tocsr()
-        a = np.array([vertex_dof(int(v)) for v in self.vertices[:, 0]], dtype=int)
-        b = np.array([vertex_dof(int(v)) for v in self.vertices[:, 1]], dtype=int)
-        return (0.5 * (P[a] + P[b])).tocsr()
+        return (0.5 * (P[self.edge_dofs[:, 0]] + P[self.edge_dofs[:, 1]])).tocsr()
+
+    def vertex_values(self, fine: np.ndarray) -> np.ndarray:
+        """Fine trace values at the vertices of every chain (``path_points`` order)."""
+        out, edge = [], 0
+        for chain in self.coarse.chains:
+            d = self.edge_dofs[edge:edge + chain.n_edges]
+            out.append(np.concatenate([fine[d[:, 0]], fine[d[-1:, 1]]]))
+            edge += chain.n_edges
+        return np.concatenate(out)
 
     def gap_at_edges(self) -> np.ndarray:
         """g at the fine edge midpoints."""

@@ -23,7 +23,7 @@ import scipy.sparse as sp
 
 from . import peers
 from .boundary import BoundaryMeshes, CoarseMesh
-from .contact import ContactBoundary, gap_coefficient
+from .contact import ContactBoundary, gap_coefficient, trace_space
 from .expr import Expression
 from .scene import Scene
 
@@ -79,15 +79,13 @@ class Spaces:
         gamma_c = None
         if scene.has_contact:
             contact = coarse.contact
-            space = _trace_space(mesh, scene.labels("contact"))
+            space = trace_space(mesh, scene.labels("contact"))
             comps["lam_t"] = comps["lam_n"] = space
-            prolong["lam_t"] = prolong["lam_n"] = contact.p1_prolongation(_vertex_dof(space),
-                                                                          space.ndof)
-            end_hats["lam_t"] = end_hats["lam_n"] = contact.p1_prolongation(
-                _vertex_dof(space), space.ndof, ends=True)
             if scene.has_friction:
                 friction = coarse.friction
-            gamma_c = ContactBoundary.build(scene, contact, friction)
+            gamma_c = ContactBoundary.build(scene, contact, friction, space)
+            prolong["lam_t"] = prolong["lam_n"] = gamma_c.prolongation(space.ndof)
+            end_hats["lam_t"] = end_hats["lam_n"] = gamma_c.prolongation(space.ndof, ends=True)
         return cls(mesh, comps, neumann, contact, friction, prolong, end_hats, gamma_c)
 
     def coarse_ndof(self, name: str) -> int:

@@ -138,32 +138,15 @@ def _edge_functionals(problem: DiscreteProblem):
 def build_friction_forms(problem: DiscreteProblem) -> FrictionForms:
     """Fine-edge traces, hat means and the h^ edge map for the contact boundary."""
     spaces = problem.spaces
-    contact, hat = spaces.contact, spaces.friction
+    gamma_c = spaces.gamma_c
     (int_n, int_t), dof_of_edge = _edge_functionals(problem)
-    space = spaces.components["lam_n"]
-    P = spaces.prolongations["lam_n"]
-    order, lengths, mids, edge_of, hat_rows = [], [], [], [], []
-    hat_offset = 0
-    for c, chain in enumerate(contact.chains):
-        verts, pts = chain.path_vertices, chain.path_points
-        for k in range(len(verts) - 1):
-            order.append(dof_of_edge[frozenset((int(verts[k]), int(verts[k + 1])))])
-            lengths.append(np.linalg.norm(pts[k + 1] - pts[k]))
-            mids.append(0.5 * (pts[k] + pts[k + 1]))
-            edge_of.append(hat_offset + np.searchsorted(hat.nodes[c], k, side="right") - 1)
-            a = space.GetDofNrs(ngs.NodeId(ngs.VERTEX, int(verts[k])))[0]
-            b = space.GetDofNrs(ngs.NodeId(ngs.VERTEX, int(verts[k + 1])))[0]
-            hat_rows.append((a, b))
-        hat_offset += len(hat.nodes[c]) - 1
-    lengths = np.array(lengths)
-    order = np.array(order)
-    rows = np.array(hat_rows)
-    midpoint_hats = (0.5 * (P[rows[:, 0]] + P[rows[:, 1]])).tocsr()
-    scale = sp.diags(1.0 / lengths)
+    order = np.array([dof_of_edge[frozenset((int(a), int(b)))] for a, b in gamma_c.vertices])
+    scale = sp.diags(1.0 / gamma_c.lengths)
     return FrictionForms(T_n=(scale @ int_n[order]).tocsr(), T_t=(scale @ int_t[order]).tocsr(),
-                         lengths=lengths, midpoint_hats=midpoint_hats,
-                         edge_of=np.array(edge_of), hat_lengths=hat.edge_lengths(),
-                         midpoints=np.array(mids),
+                         lengths=gamma_c.lengths,
+                         midpoint_hats=gamma_c.hat_means(spaces.prolongations["lam_n"]),
+                         edge_of=gamma_c.hhat_edge, hat_lengths=spaces.friction.edge_lengths(),
+                         midpoints=gamma_c.midpoints,
                          normal_stress=problem.scene.friction.normal_stress)
 
 

@@ -125,10 +125,9 @@ def contact_traces(solution: Solution) -> ContactTraces:
     rng_n = pb.fes.Range(pb.names.index("lam_n"))
     rng_t = pb.fes.Range(pb.names.index("lam_t"))
     fine_n, fine_t = fine[rng_n.start:rng_n.stop], fine[rng_t.start:rng_t.stop]
-    space = pb.spaces.components["lam_n"]
     gamma_c = pb.spaces.gamma_c
 
-    s_n, s_t, active, node_xy, ln, lt = ([] for _ in range(6))
+    s_n, s_t, active = [], [], []
     offset = 0
     for c, chain in enumerate(contact.chains):
         interior = contact.dof_positions(c)
@@ -139,21 +138,17 @@ def contact_traces(solution: Solution) -> ContactTraces:
         for k in range(chain.n_edges):
             e = np.searchsorted(nodes, k, side="right") - 1
             active.append(int(nodes[e]) in contact_pos or int(nodes[e + 1]) in contact_pos)
-        for v, xy in zip(chain.path_vertices, chain.path_points):
-            dof = space.GetDofNrs(ngs.NodeId(ngs.VERTEX, int(v)))[0]
-            node_xy.append(xy)
-            ln.append(fine_n[dof])
-            lt.append(fine_t[dof])
     # sigma n on every fine edge, evaluated just inside the body at the edge midpoint
     for mid, normal, length in zip(gamma_c.midpoints, gamma_c.normals, gamma_c.lengths):
         st = np.array(sigma(mesh(*(mid - 1e-9 * length * normal)))).reshape(2, 2)
         traction = st @ normal
         s_n.append(normal @ traction)
         s_t.append(np.array([normal[1], -normal[0]]) @ traction)
-    node_xy = np.array(node_xy)
+    node_xy = np.vstack([chain.path_points for chain in contact.chains])
     coarse_xy = contact.node_points()
     return ContactTraces(gamma_c.midpoints, gamma_c.lengths, np.array(s_n), np.array(s_t),
-                         np.array(active, dtype=bool), node_xy, np.array(ln), np.array(lt),
+                         np.array(active, dtype=bool), node_xy,
+                         gamma_c.vertex_values(fine_n), gamma_c.vertex_values(fine_t),
                          pb.spaces.gamma_c.gap_at_vertices(), coarse_xy, lam_n_c, lam_t_c,
                          in_contact)
 
@@ -217,12 +212,7 @@ def force_balance(solution: Solution) -> ForceBalance:
     pb = solution.problem
     tr = contact_traces(solution)
     gamma_c = pb.spaces.gamma_c
-    space = pb.spaces.components["lam_n"]
-
-    def dof(v: int) -> int:
-        return space.GetDofNrs(ngs.NodeId(ngs.VERTEX, v))[0]
-
-    weight = np.asarray(gamma_c.hat_means(pb.spaces.prolongations["lam_n"], dof).sum(axis=1))
+    weight = np.asarray(gamma_c.hat_means(pb.spaces.prolongations["lam_n"]).sum(axis=1))
     force = tr.edge_length[:, None] * (tr.sigma_n[:, None] * gamma_c.normals
                                        + tr.sigma_t[:, None] * gamma_c.tangents)
     tension = np.sum(tr.edge_length * np.maximum(tr.sigma_n, 0.0))

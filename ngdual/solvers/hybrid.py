@@ -269,15 +269,9 @@ class HybridSystem:
         for lab in scene.labels("contact"):
             for row in labelled.get(lab, []):
                 edge_of[frozenset(int(v) for v in row[2:])] = row[:2]
-        space = pb.spaces.components["lam_n"]
-        P = pb.spaces.prolongations["lam_n"].tocsr()
-        edges, ends = [], []
-        for chain in contact.chains:
-            verts = chain.path_vertices
-            for a, b in zip(verts[:-1], verts[1:]):
-                edges.append(edge_of[frozenset((int(a), int(b)))])
-                ends.append([space.GetDofNrs(ngs.NodeId(ngs.VERTEX, int(v)))[0] for v in (a, b)])
-        edges, ends = np.array(edges).reshape(-1, 2), np.array(ends)
+        gamma_c = pb.spaces.gamma_c
+        edges = np.array([edge_of[frozenset((int(a), int(b)))] for a, b in gamma_c.vertices]
+                         ).reshape(-1, 2)
         rt = edges[:, 1]
         flux = fluxes[0][rt]
         normals = np.column_stack([fluxes[1][rt], fluxes[2][rt]]) / flux[:, None]
@@ -285,9 +279,8 @@ class HybridSystem:
         # the sigma rows of F hold int_e (g - lift_n) tau_n - int_e lift_t tau_t on e
         gap = (normals[:, 0] * F1[rt] + normals[:, 1] * F2[rt]) / flux
         offset_t = (normals[:, 1] * F1[rt] - normals[:, 0] * F2[rt]) / flux
-        lengths = np.concatenate([np.diff(chain.arclength) for chain in contact.chains])
-        return ContactEdges(edges[:, 0], lengths, normals,
-                            (0.5 * (P[ends[:, 0]] + P[ends[:, 1]])).tocsr(), gap, offset_t)
+        return ContactEdges(edges[:, 0], gamma_c.lengths, normals,
+                            gamma_c.hat_means(pb.spaces.prolongations["lam_n"]), gap, offset_t)
 
     def unknowns(self, w: np.ndarray, lam_t: np.ndarray | None = None,
                  lam_n: np.ndarray | None = None) -> np.ndarray:
