@@ -565,6 +565,13 @@ def _validate_contact(scene: Scene, u_d: list[Expression]) -> None:
     for p, u in zip(ends, values):
         k = int(np.argmin(np.linalg.norm(xy - p, axis=1)))
         g = float(gap_at(con, xy[k:k + 1], normals[k:k + 1])[0])
+        slide = abs(u @ np.array([normals[k, 1], -normals[k, 0]]))
+        if scene.friction.law != "none" and slide > 1e-12:
+            # the friction functional q(nu, lambda_t) is posed on the lambda_t dofs only
+            raise SceneError("loads.displacement", f"with friction the prescribed "
+                                                   f"displacement must not slide along "
+                                                   f"Gamma_C where Gamma_D meets it (u_D.t = "
+                                                   f"{slide:.3g} at ({p[0]:.4g}, {p[1]:.4g}))")
         if g < u @ normals[k] - 1e-12 * max(1.0, abs(g)):
             raise SceneError("contact.gap", f"where Gamma_D meets Gamma_C at ({p[0]:.4g}, "
                                             f"{p[1]:.4g}) the clamp pushes the body "

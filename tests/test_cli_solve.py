@@ -20,7 +20,9 @@ def test_solve_writes_the_result_record(tmp_path, capsys):
     assert record["dofs"]["X"] == 680
     assert set(record["norms"]) == {"sigma_X", "u", "eta", "phi", "lam_t", "lam_n", "nu"}
     assert record["norms"]["nu"] is None
-    assert set(record["contact"]) == {"nodes_in_contact", "stick_nodes", "slip_nodes", "F_abs"}
+    assert set(record["contact"]) == {"nodes_in_contact", "stick_nodes", "slip_nodes", "F_abs",
+                                      "resultant", "multiplier_force", "force_mismatch",
+                                      "tension"}
     assert set(record["timings_s"]) == {"assemble", "factorize", "solve", "total"}
     assert record["versions"]["ngsolve"] and record["versions"]["ngdual"]
     assert record["contact"]["nodes_in_contact"] > 0
