@@ -136,7 +136,7 @@ BAD_GEOMETRY = [
 @pytest.mark.parametrize("geometry, contact, field, words", BAD_GEOMETRY)
 def test_bad_geometry_and_foundation_are_refused_naming_the_field(geometry, contact, field,
                                                                    words):
-    from ngdual.scene import Scene, Geometry, Contact, validate
+    from ngdual.scene import Contact, Geometry, Scene, validate
     geo = Geometry(**{**BLOCK, **geometry})
     contact_labels = [lab for lab in geo.labels if lab.startswith("c")] or ["bottom"]
     boundary = {"contact": contact_labels, "dirichlet": ["top"],
@@ -151,7 +151,7 @@ def test_bad_geometry_and_foundation_are_refused_naming_the_field(geometry, cont
 def test_contact_sides_meeting_each_other_need_no_end_condition():
     """Gamma_C split where the load changes: the end checks apply only where Gamma_C meets
     Gamma_D or Gamma_N, not where two contact sides meet."""
-    from ngdual.scene import Scene, Geometry, validate
+    from ngdual.scene import Geometry, Scene, validate
     geo = Geometry(kind="polygon", points=[[-1.0, 0.0], [0.0, 0.0], [1.0, 0.0], [1.0, 1.0],
                                            [-1.0, 1.0]],
                    labels=["c1", "c2", "right", "top", "left"], maxh=0.5)
