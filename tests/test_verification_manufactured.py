@@ -218,3 +218,12 @@ def test_uzawa_reaches_the_same_discrete_solution_as_the_active_set_solver(name)
     assert uzawa.method != fast.method
     assert np.abs(uzawa.x - fast.x).max() <= 1e-5 * np.abs(fast.x).max()
     assert discrete_sets(uzawa) == discrete_sets(fast)
+
+
+def test_both_end_treatments_pose_the_same_problem():
+    """The exact lambda_n, lambda_t vanish at the clamped ends of Gamma_C, so the data's end
+    values (contact.ends = "consistent") and the thesis' zeros give the same solution."""
+    case = manufactured_case("tresca")
+    consistent = solve_scene(case.scene(ends="consistent"), 3)
+    thesis = solve_scene(case.scene(ends="thesis"), 3)
+    assert np.abs(consistent.x - thesis.x).max() <= 1e-10 * np.abs(thesis.x).max()

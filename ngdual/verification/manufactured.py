@@ -183,8 +183,12 @@ class ManufacturedCase:
         return ExactSolution(u, sigma, div_sigma, eta, self.u_n + self.lam_n, self.lam_n,
                              self.lam_t, self.sigma_n, self.sigma_t, bound)
 
-    def scene(self, method: str = "auto", level: int = 1) -> Scene:
-        """The validated scene: f = -div sigma, t0 = sigma n on the top, u_D = u on the sides."""
+    def scene(self, method: str = "auto", level: int = 1, ends: str = "consistent") -> Scene:
+        """The validated scene: f = -div sigma, t0 = sigma n on the top, u_D = u on the sides.
+
+        ``method``: ``solver.method``; ``ends``: ``contact.ends`` (the exact multipliers
+        vanish at the ends of Gamma_C, so "consistent" and "thesis" pose the same problem).
+        """
         ex = self.exact
         traction = [ex.sigma[0][1].text(), ex.sigma[1][1].text()]   # n = (0, 1) on the top
         sc = Scene(name=f"manufactured-{self.name}",
@@ -197,7 +201,7 @@ class ManufacturedCase:
                                displacement=[c.text() for c in ex.u]),
                    # max(0, .): the expanded polynomial is zero at the clamped ends only up
                    # to round-off, and the scene's gap must be >= 0
-                   contact=Contact(gap=f"max(0, {ex.gap.text()})"),
+                   contact=Contact(gap=f"max(0, {ex.gap.text()})", ends=ends),
                    friction=Friction(law=self.law, mu=self.mu_f,
                                      bound=self.tresca_bound.text()),
                    solver=Solver(method=method))
@@ -328,27 +332,22 @@ def _boundary_l2(x_nodes: np.ndarray, values: np.ndarray, exact: Piecewise) -> f
     return math.sqrt(total)
 
 
-def _coarse_nodes(solution: Solution, interior: np.ndarray, ends: np.ndarray | None = None
-                  ) -> list[tuple[np.ndarray, np.ndarray]]:
-    """(x of the h~ nodes with the chain ends, per-node flag) for every chain of Gamma_C.
+def _coarse_nodes(solution: Solution, flags: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+    """(x of the h~ nodes, per-node flag) for every chain of Gamma_C, ends included.
 
-    ``interior`` holds one flag per coarse dof (dof order); ``ends`` one per chain end
-    (default: True, the multipliers are fixed at the ends of Gamma_C).
+    ``flags`` holds one flag per coarse dof (dof order); nodes without a dof (the ends of
+    Gamma_C, where lambda_n^h is prescribed: zero in every manufactured case) count as true.
     """
     contact = solution.problem.spaces.contact
     out, offset = [], 0
     for c, chain in enumerate(contact.chains):
         nodes = contact.nodes[c]
-        inner = interior[offset:offset + len(nodes) - 2]
-        offset += len(nodes) - 2
-        first, last = (True, True) if ends is None else (ends[2 * c], ends[2 * c + 1])
-        flags = np.concatenate([[first], inner, [last]]).astype(bool)
-        out.append((chain.path_points[nodes][:, 0], flags))
+        node_flags = np.ones(len(nodes), dtype=bool)
+        for k, position in enumerate(contact.dof_positions(c)):
+            node_flags[np.flatnonzero(nodes == position)] = flags[offset + k]
+        offset += len(contact.dof_positions(c))
+        out.append((chain.path_points[nodes][:, 0], node_flags))
     return out
-
-
-def _measure(intervals) -> float:
-    return float(sum(b - a for a, b in intervals))
 
 
 def _edges_of(chains) -> list[tuple[float, float]]:
