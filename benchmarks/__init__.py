@@ -1,0 +1,1 @@
+"""Benchmarks and peer methods (run as scripts or ``python -m benchmarks.NAME``)."""
