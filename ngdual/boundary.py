@@ -200,12 +200,15 @@ def end_rule(scene, mesh: ngs.Mesh, role: str) -> EndRule:
     meets Gamma_D, and all ends for ``"thesis"``) is fixed (see :class:`ngdual.scene.Contact`).
     """
     junctions = contact_junctions(scene) if scene.has_contact else []
-    kinks = [p for p, kind in junctions if kind == "kink"]
-    touching = [p for p, kind in junctions if kind == "neumann"]
+    kinks = [p for p, kind, _ in junctions if kind == "kink"]
+    touching = [p for p, kind, _ in junctions if kind == "neumann"]
     consistent = scene.contact.ends == "consistent"
     if role == "contact":
-        coords = {v.nr: np.array(v.point) for v in mesh.vertices}
-        breaks = frozenset(nr for nr, xy in coords.items()
+        labels = set(scene.labels("contact"))
+        # only the vertices of Gamma_C can be kinks (a full vertex scan costs seconds at L8)
+        candidates = {v.nr: np.array(mesh[v].point) for el in mesh.Elements(ngs.BND)
+                      if el.mat in labels for v in el.vertices} if kinks else {}
+        breaks = frozenset(nr for nr, xy in candidates.items()
                            if any(np.linalg.norm(xy - k) <= 1e-9 * (1 + np.linalg.norm(k))
                                   for k in kinks))
         return EndRule(breaks, tuple(kinks) + (tuple(touching) if consistent else ()))

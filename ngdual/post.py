@@ -167,7 +167,7 @@ def contact_summary(solution: Solution) -> dict:
     f_abs = np.sum(tr.edge_length * (np.abs(tr.sigma_n) + np.abs(tr.sigma_t)) * tr.edge_active)
     summary = {"nodes_in_contact": int(tr.coarse_in_contact.sum()), "stick_nodes": 0,
                "slip_nodes": int(tr.coarse_in_contact.sum()), "F_abs": float(f_abs)}
-    balance = force_balance(solution)
+    balance = force_balance(solution, tr)
     summary.update(resultant=[float(v) for v in balance.resultant],
                    multiplier_force=[float(v) for v in balance.multiplier_force],
                    force_mismatch=balance.mismatch, tension=balance.tension)
@@ -207,10 +207,10 @@ class ForceBalance:
         return float(np.linalg.norm(self.resultant - self.multiplier_force) / scale)
 
 
-def force_balance(solution: Solution) -> ForceBalance:
-    """:class:`ForceBalance` of a contact solution."""
+def force_balance(solution: Solution, traces: ContactTraces | None = None) -> ForceBalance:
+    """:class:`ForceBalance` of a contact solution (``traces``: its :func:`contact_traces`)."""
     pb = solution.problem
-    tr = contact_traces(solution)
+    tr = traces if traces is not None else contact_traces(solution)
     gamma_c = pb.spaces.gamma_c
     weight = np.asarray(gamma_c.hat_means(pb.spaces.prolongations["lam_n"]).sum(axis=1))
     force = tr.edge_length[:, None] * (tr.sigma_n[:, None] * gamma_c.normals

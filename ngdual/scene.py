@@ -357,6 +357,18 @@ KINK_ANGLE = 1e-6  # radians: two contact sides meeting at a larger angle form a
 CUSP_ANGLE = np.pi * (1 - 1e-3)
 
 
+def _side_table(geo: Geometry, key: str, value: str) -> list[tuple[str, object]]:
+    """The entries of ``geometry.<key>``, a table side label -> ``value``, labels checked."""
+    table = getattr(geo, key)
+    if not isinstance(table, dict):
+        raise SceneError(f"geometry.{key}", f"must be a table label = {value}")
+    for label in table:
+        if label not in geo.labels:
+            raise SceneError(f"geometry.{key}.{label}", f"unknown side label {label!r}; the "
+                                                        f"sides are {', '.join(geo.labels)}")
+    return list(table.items())
+
+
 def _validate_geometry(geo: Geometry) -> None:
     if geo.kind not in GEOMETRY_KINDS:
         raise SceneError("geometry.kind", f"unknown kind {geo.kind!r}; use one of "
@@ -374,23 +386,12 @@ def _validate_geometry(geo: Geometry) -> None:
     if len(geo.labels) != len(pts):
         raise SceneError("geometry.labels", f"need one label per side ({len(pts)}), "
                                             f"got {len(geo.labels)}")
-    if not isinstance(geo.arcs, dict):
-        raise SceneError("geometry.arcs", "must be a table label = [x, y] (the arc's centre)")
-    for label, centre in geo.arcs.items():
-        if label not in geo.labels:
-            raise SceneError(f"geometry.arcs.{label}", f"unknown side label {label!r}; the "
-                                                       f"sides are {', '.join(geo.labels)}")
+    for label, centre in _side_table(geo, "arcs", "[x, y] (the arc's centre)"):
         c = np.asarray(centre, dtype=float) if isinstance(centre, (list, tuple)) else None
         if c is None or c.shape != (2,) or not np.all(np.isfinite(c)):
             raise SceneError(f"geometry.arcs.{label}", f"the centre must be [x, y], got "
                                                        f"{centre!r}")
-    if not isinstance(geo.side_maxh, dict):
-        raise SceneError("geometry.side_maxh", "must be a table label = mesh size")
-    for label, h in geo.side_maxh.items():
-        if label not in geo.labels:
-            raise SceneError(f"geometry.side_maxh.{label}", f"unknown side label {label!r}; "
-                                                            f"the sides are "
-                                                            f"{', '.join(geo.labels)}")
+    for label, h in _side_table(geo, "side_maxh", "mesh size"):
         _positive(h, f"geometry.side_maxh.{label}")
     curves = geo.curves()
     for curve in curves:
@@ -436,14 +437,15 @@ def role_of(scene: Scene, label: str) -> str:
     return next(role for role in _ROLES if label in scene.labels(role))
 
 
-def contact_junctions(scene: Scene) -> list[tuple[np.ndarray, str]]:
+def contact_junctions(scene: Scene) -> list[tuple[np.ndarray, str, float]]:
     """The end points of the contact sides and what meets Gamma_C there.
 
-    Returns ``(point, kind)`` for every corner of the boundary with a contact side on at
-    least one side of it: kind ``"dirichlet"`` or ``"neumann"`` where Gamma_C meets that
-    part, ``"kink"`` where two contact sides meet at an angle (the multipliers, which are
-    normal and tangential components, are discontinuous there), ``"smooth"`` where they
-    meet tangentially (one multiplier runs through).
+    Returns ``(point, kind, angle)`` for every corner of the boundary with a contact side
+    on at least one side of it: kind ``"dirichlet"`` or ``"neumann"`` where Gamma_C meets
+    that part, ``"kink"`` where two contact sides meet at an angle (the multipliers, which
+    are normal and tangential components, are discontinuous there), ``"smooth"`` where
+    they meet tangentially (one multiplier runs through); ``angle`` is the boundary's
+    turning angle there (:func:`ngdual.geometry.turning_angle`).
     """
     curves = scene.geometry.curves()
     out = []
@@ -452,11 +454,12 @@ def contact_junctions(scene: Scene) -> list[tuple[np.ndarray, str]]:
         roles = (role_of(scene, before.label), role_of(scene, after.label))
         if "contact" not in roles:
             continue
+        angle = geometry.turning_angle(before, after)
         if roles == ("contact", "contact"):
-            angle = abs(geometry.turning_angle(before, after))
-            out.append((before.end, "kink" if angle > KINK_ANGLE else "smooth"))
+            kind = "kink" if abs(angle) > KINK_ANGLE else "smooth"
         else:
-            out.append((before.end, roles[1] if roles[0] == "contact" else roles[0]))
+            kind = roles[1] if roles[0] == "contact" else roles[0]
+        out.append((before.end, kind, angle))
     return out
 
 
@@ -535,23 +538,19 @@ def _validate_contact(scene: Scene, u_d: list[Expression]) -> None:
     if con.foundation is not None:
         _validate_foundation(scene)
     junctions = contact_junctions(scene)
-    for point, kind in junctions:
+    for point, kind, angle in junctions:
         where = f"({point[0]:.4g}, {point[1]:.4g})"
         if con.ends == "thesis" and kind == "neumann":
             raise SceneError("contact.ends", f"Gamma_N touches Gamma_C at {where}: the "
                                              "thesis' zero ends assume they do not touch; "
                                              "use contact.ends = \"consistent\"")
         if kind == "kink":
-            curves = scene.geometry.curves()
-            i = next(k for k, c in enumerate(curves) if np.array_equal(c.end, point)
-                     and role_of(scene, c.label) == "contact")
-            angle = geometry.turning_angle(curves[i], curves[(i + 1) % len(curves)])
             if angle < 0 or angle > CUSP_ANGLE:
                 raise SceneError("boundary.contact", f"Gamma_C has a "
                                  f"{'re-entrant' if angle < 0 else 'cusp'} kink at {where} "
                                  "where no normal cone is defined; make one of the two "
                                  "sides a Neumann or Dirichlet side")
-    ends = np.array([p for p, kind in junctions if kind == "dirichlet"])
+    ends = np.array([p for p, kind, _ in junctions if kind == "dirichlet"])
     if not len(ends):
         return
     values = np.column_stack([e.numpy(ends[:, 0], ends[:, 1]) for e in u_d])
