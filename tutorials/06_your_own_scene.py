@@ -49,7 +49,9 @@ print(f"quick mode: {QUICK}; levels {LEVELS}; output in {OUT}")
 # point i to point i+1 and gets label i. Every label must get exactly one role:
 # `dirichlet` (u = u_D, here 0), `neumann` (traction t₀) or `contact`. Loads, the gap
 # and friction bounds are formulas in `x` and `y`. The thesis assumes that Γ_N and Γ_C
-# do not touch, which is why the clamped sides separate the loaded top from the base.
+# do not touch (its multipliers vanish at the ends of Γ_C, `contact.ends = "thesis"`),
+# which is why the clamped sides separate the loaded top from the base here. With the
+# default `contact.ends = "consistent"` they may touch: the multipliers are free there.
 
 # %%
 SCENE = """
@@ -103,8 +105,8 @@ clockwise = SCENE.replace(
 MISTAKES = [
     ("a typo in a boundary label", scene_file, ["boundary.contact=['bsae']"]),
     ("a side without a condition", scene_file, ["boundary.dirichlet=['left_clamp']"]),
-    ("the loaded part touches the contact part", scene_file,
-     ["boundary.dirichlet=['left_clamp']",
+    ("the loaded part touches the contact part, with the thesis' ends", scene_file,
+     ["contact.ends='thesis'", "boundary.dirichlet=['left_clamp']",
       "boundary.neumann=['right_clamp', 'right_shoulder', 'top', 'left_shoulder']"]),
     ("an incompressible material", scene_file, ["material.nu=0.5"]),
     ("a foundation that cuts into the body", scene_file, ["contact.gap='0.05*x'"]),
@@ -194,7 +196,7 @@ print(f"exit status {status}; result.json: converged {cli_record['converged']}, 
 
 # %%
 results = {"quick": QUICK, "caught": caught,
-           "expected_fields": ["boundary.contact", "boundary", "boundary", "material.nu",
+           "expected_fields": ["boundary.contact", "boundary", "contact.ends", "material.nu",
                                "contact.gap", "material.youngs_modulus", "geometry.points"],
            "cli_bad_input_status": bad_status,
            "cli_bad_input_wrote": (OUT / "never-written").exists(),

@@ -72,8 +72,9 @@ print(f"first contact at s* = {s_star:.4f}; nodes in contact at 0.95 s*: {touchi
 #
 # A half annulus (radii 1 and 1.5) as a polygon with 8 segments per arc. Its feet (the
 # two short bottom sides) rest on the foundation. If all the curved sides were loaded
-# (Neumann), Γ_N would touch Γ_C at the feet; so the lowest segment of each arc is
-# clamped (an abutment). First two mistakes, then the fixed scene.
+# (Neumann), Γ_N would touch Γ_C at the feet, which the thesis' multipliers (zero at the
+# ends of Γ_C, `contact.ends = "thesis"`) do not allow; so the lowest segment of each arc
+# is clamped (an abutment). First two mistakes, then the fixed scene.
 
 # %%
 N = 8
@@ -86,7 +87,7 @@ labels = (["right_foot"] + ["outer_clamp"] + ["outer"] * (N - 2) + ["outer_clamp
 assert len(points) == len(labels)
 
 
-def arch_toml(points, dirichlet, neumann) -> str:
+def arch_toml(points, dirichlet, neumann, ends="consistent") -> str:
     coords = ", ".join(f"[{x:.6f}, {y:.6f}]" for x, y in points)
     return f"""
 name = "arch"
@@ -103,12 +104,13 @@ contact = ["right_foot", "left_foot"]
 traction = ["0", "-300"]
 [contact]
 gap = "0.0005"
+ends = "{ends}"
 """
 
 
 mistakes = {
     "everything loaded": arch_toml(points, ["outer_clamp"],
-                                   ["inner_clamp", "outer", "inner"]),
+                                   ["inner_clamp", "outer", "inner"], ends="thesis"),
     "clockwise corners": arch_toml(points[::-1], ["outer_clamp", "inner_clamp"],
                                    ["outer", "inner"]),
 }
