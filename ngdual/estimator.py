@@ -173,18 +173,16 @@ class _BoundaryEdges:
     def to_elements(self, values: np.ndarray) -> np.ndarray:
         return np.bincount(self.element, values, self.mesh.ne)
 
-    def per_edge(self, coarse, values: np.ndarray) -> np.ndarray:
-        """Scatter values given per fine edge of a coarse mesh's chains onto edge dofs."""
+    def scatter(self, pairs: np.ndarray, values: np.ndarray) -> np.ndarray:
+        """Values given per fine edge (vertex ``pairs``) onto the edge dofs, zero elsewhere."""
         out = np.zeros(self.space.ndof)
-        pairs, _ = coarse.fine_edges()
-        dofs = [self.dof_of_edge[frozenset(map(int, p))] for p in pairs]
-        out[dofs] = values
+        out[[self.dof_of_edge[frozenset(map(int, p))] for p in pairs]] = values
         return out
 
     def coarse_lengths(self, coarse) -> np.ndarray:
-        """h~_e: the length of the coarse edge holding every fine edge of ``coarse``."""
-        _, owner = coarse.fine_edges()
-        return self.per_edge(coarse, coarse.edge_lengths()[owner])
+        """The length of the coarse edge holding every fine edge of ``coarse``'s chains."""
+        pairs, owner = coarse.fine_edges()
+        return self.scatter(pairs, coarse.edge_lengths()[owner])
 
 
 def _interior_edge_lengths(mesh: ngs.Mesh) -> ngs.GridFunction:
@@ -318,15 +316,14 @@ def neighbour_ratio(coarse) -> float:
 def _friction_term(solution: Solution, edges: _BoundaryEdges, sigma_t, labels) -> np.ndarray:
     """h~_e ||sigma_t - F nu||_e^2 on the fine Gamma_C edges of A_C = supp F.
 
-    F (``friction_bound``) is given per fine edge and nu per h^ edge, both in
-    the chain order of the contact mesh (see :mod:`ngdual.friction`).
+    F (``friction_bound``) is given per fine edge of Gamma_C and nu per h^ edge, in the
+    order of :class:`ngdual.contact.ContactBoundary`.
     """
-    spaces = solution.problem.spaces
-    _, owner = spaces.friction.fine_edges()
+    gamma_c = solution.problem.spaces.gamma_c
     bound = np.asarray(solution.friction_bound, dtype=float)
-    f_nu = bound * np.asarray(solution.nu, dtype=float)[owner]
+    f_nu = bound * np.asarray(solution.nu, dtype=float)[gamma_c.hhat_edge]
     gf = ngs.GridFunction(edges.space)
-    gf.vec.FV().NumPy()[:] = edges.per_edge(spaces.contact, f_nu)
-    active = edges.per_edge(spaces.contact, (bound > 0).astype(float))
-    return (active * edges.coarse_lengths(spaces.contact)
-            * edges.integrals((sigma_t - gf) * (sigma_t - gf), labels))
+    gf.vec.FV().NumPy()[:] = edges.scatter(gamma_c.vertices, f_nu)
+    htilde = gamma_c.coarse.edge_lengths()[gamma_c.htilde_edge]
+    weight = edges.scatter(gamma_c.vertices, np.where(bound > 0, htilde, 0.0))
+    return weight * edges.integrals((sigma_t - gf) * (sigma_t - gf), labels)
