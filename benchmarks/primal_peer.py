@@ -70,6 +70,7 @@ from netgen.geom2d import SplineGeometry
 from threadpoolctl import threadpool_limits
 
 from ngdual.expr import Expression
+from ngdual.verification import cattaneo_mindlin, hertz, mcewen_approach
 
 __all__ = ["NewtonError", "PrimalResult", "solve_primal", "hertz_mesh", "hertz_case",
            "cattaneo_mindlin_case", "hertz_pressure"]
@@ -463,10 +464,9 @@ def hertz_mesh(level: int, *, L: float = 4.0, H: float = 4.0, b: float = 0.25,
 
 
 def hertz_pressure(x, P: float, R: float, E: float, nu: float):
-    """Hertz: p(x) = 2P/(pi a) sqrt(1 - x^2/a^2), a = sqrt(4 P R / (pi E*)); returns (p, a)."""
-    a = math.sqrt(4 * P * R / (math.pi * E / (1 - nu**2)))
-    x = np.asarray(x, float)
-    return 2 * P / (math.pi * a) * np.sqrt(np.clip(1 - x**2 / a**2, 0, None)), a
+    """The Hertz pressure of :func:`ngdual.verification.hertz` at ``x``; returns (p, a)."""
+    contact = hertz(P, R, E, nu)
+    return contact.pressure(np.asarray(x, float)), contact.a
 
 
 def _ellipse_cf(p0: float, a: float):
@@ -474,19 +474,6 @@ def _ellipse_cf(p0: float, a: float):
     w = 1 - ngs.x**2 / a**2
     # IfPos outside the sqrt, so that the CF is differentiable (see solve_primal)
     return p0 * ngs.IfPos(w, ngs.sqrt(ngs.IfPos(w, w, 1)), 0)
-
-
-def mcewen_approach(d: float, P: float, a: float, E: float, nu: float) -> float:
-    """u_y(0, -d) - u_y(0, 0) below a Hertz contact on the half-plane (plane strain).
-
-    Integrates eps_zz = (1 + nu)/E ((1 - nu) sigma_zz - nu sigma_xx) along the axis with
-    McEwen's stresses sigma_zz = -p0 a / sqrt(a^2 + z^2),
-    sigma_xx = -p0 ((a^2 + 2 z^2) / sqrt(a^2 + z^2) - 2 z) / a (Johnson, Contact Mechanics,
-    Sec. 4.2), p0 = 2P / (pi a).
-    """
-    p0 = 2 * P / (math.pi * a)
-    return (1 + nu) / E * p0 * ((1 - nu) * a * math.asinh(d / a)
-                                - nu * (d * math.sqrt(a * a + d * d) - d * d) / a)
 
 
 @dataclass
@@ -592,9 +579,8 @@ def cattaneo_mindlin_case(order: int, level: int, *, E: float = 1.0, nu: float =
     else:
         res = solve_primal(mesh, **common, law="coulomb", mu_f=mu_f)
     P, Q = res.contact_force, res.tangential_force
-    a = hertz_pressure(0.0, P, R, E, nu)[1]
-    c = a * math.sqrt(max(0.0, 1 - abs(Q) / (mu_f * P)))
-    p0 = 2 * P / (math.pi * a)
+    exact = cattaneo_mindlin(P, Q, R, E, nu, mu_f)
+    a, c, p0 = exact.hertz.a, exact.c, exact.hertz.p0
     q = -math.copysign(mu_f, shift) * (_ellipse_cf(p0, a) - _ellipse_cf(p0 * c / a, c))
     err2, norm2 = _facet_integral([(res.traction_cf - q) ** 2, q**2], mesh, ["contact"],
                                   bonus_intorder=12)

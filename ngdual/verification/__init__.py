@@ -6,6 +6,19 @@ every error per level with observed orders (:func:`manufactured_study`,
 :func:`convergence_orders`, :func:`format_study`).
 """
 
+from .analytic import (
+    CattaneoMindlin,
+    FlatPunch,
+    HertzContact,
+    TractionProfile,
+    cattaneo_mindlin,
+    flat_punch,
+    hertz,
+    mcewen_approach,
+    pressure_errors,
+    traction_errors,
+    traction_profile,
+)
 from .manufactured import (
     CASES,
     ExactSolution,
@@ -27,8 +40,10 @@ from .manufactured import (
 )
 from .piecewise import Piecewise
 
-__all__ = ["CASES", "ExactSolution", "ManufacturedCase", "Piecewise", "boundary_errors",
-           "contact_profile", "convergence_orders", "coulomb_case", "discrete_sets",
-           "format_study", "frictionless_case", "intersection", "manufactured_case",
-           "manufactured_study", "print_study", "symmetric_difference", "tresca_case",
-           "volume_errors"]
+__all__ = ["CASES", "CattaneoMindlin", "ExactSolution", "FlatPunch", "HertzContact",
+           "ManufacturedCase", "Piecewise", "TractionProfile", "boundary_errors",
+           "cattaneo_mindlin", "contact_profile", "convergence_orders", "coulomb_case",
+           "discrete_sets", "flat_punch", "format_study", "frictionless_case", "hertz",
+           "intersection", "manufactured_case", "manufactured_study", "mcewen_approach",
+           "pressure_errors", "print_study", "symmetric_difference", "traction_errors",
+           "traction_profile", "tresca_case", "volume_errors"]
