@@ -11,7 +11,8 @@ With that,
 
 exactly, mu_i the h~ hats and kappa_j the indicator of the h^ edge j.
 The normal and tangential stress per fine edge are linear maps of the unknown
-vector, assembled once by NGSolve against piecewise constants on Gamma_C.
+vector, assembled once by NGSolve against the fine trace space of Gamma_C
+(:class:`ngdual.contact.ContactBoundary`, the one home of Gamma_C).
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from . import peers
+from .contact import ContactBoundary
 from .expr import Expression
 from .forms import DiscreteProblem, boundary_regex
 
@@ -35,33 +37,47 @@ GAUSS = (np.array([0.5 - np.sqrt(15) / 10, 0.5, 0.5 + np.sqrt(15) / 10]),
 class FrictionForms:
     """Everything the friction loop needs on Gamma_C.
 
+    Gamma_C itself (fine edges, their h^ edges, the h^ mesh) is read from
+    :class:`ngdual.contact.ContactBoundary`, its one home.
+
     Attributes
     ----------
+    gamma_c : ngdual.contact.ContactBoundary
+        Gamma_C of the mesh: the fine edges in chain order and the h~ / h^ meshes.
     T_n, T_t : scipy.sparse.csr_matrix
         sigma_n and sigma_t on every fine Gamma_C edge: ``T_n @ x``.
-    lengths : numpy.ndarray
-        Fine edge lengths.
     midpoint_hats : scipy.sparse.csr_matrix
         Mean value of every h~ hat on every fine edge.
-    edge_of : numpy.ndarray
-        Index of the h^ edge containing each fine edge.
-    hat_lengths : numpy.ndarray
-        Lengths of the h^ edges: the (diagonal) mass matrix of L_h^.
-    midpoints : numpy.ndarray
-        Fine edge midpoints (for plots).
     normal_stress : str
         The |sigma_n| of the Coulomb bound (3.123): ``"hat-projection"`` or
         ``"fine-edges"`` (see :class:`ngdual.scene.Friction`).
     """
 
+    gamma_c: ContactBoundary
     T_n: sp.csr_matrix
     T_t: sp.csr_matrix
-    lengths: np.ndarray
     midpoint_hats: sp.csr_matrix
-    edge_of: np.ndarray
-    hat_lengths: np.ndarray
-    midpoints: np.ndarray
     normal_stress: str = "hat-projection"
+
+    @property
+    def lengths(self) -> np.ndarray:
+        """Fine edge lengths."""
+        return self.gamma_c.lengths
+
+    @property
+    def midpoints(self) -> np.ndarray:
+        """Fine edge midpoints (for plots)."""
+        return self.gamma_c.midpoints
+
+    @property
+    def edge_of(self) -> np.ndarray:
+        """Index of the h^ edge containing each fine edge."""
+        return self.gamma_c.hhat_edge
+
+    @property
+    def hat_lengths(self) -> np.ndarray:
+        """Lengths of the h^ edges: the (diagonal) mass matrix of L_h^."""
+        return self.gamma_c.friction.edge_lengths()
 
     @property
     def n_nu(self) -> int:
@@ -80,19 +96,12 @@ class FrictionForms:
     def coulomb_bound_of(self, sigma_n: np.ndarray, mu_f: float) -> np.ndarray:
         """F of (3.123) from sigma_n given per fine edge.
 
-        With ``normal_stress = "hat-projection"`` sigma_n is first replaced by
-        its lumped L^2 projection onto the h~ hats, sum_i (t_i / m_i) mu_i with
-        the moments t_i = int sigma_n mu_i ds = d_Cn(mu_i, sigma) and m_i =
-        int mu_i ds (sigma_n is constant on every fine edge, so both are exact
-        sums); it is zero wherever the moments are, i.e. where the body separates.
+        With ``normal_stress = "hat-projection"`` sigma_n is first replaced by the
+        contact pressure p_h of :func:`hat_projection` (zero where the body separates).
         """
         if self.normal_stress == "hat-projection":
-            weights = self.midpoint_hats.T @ self.lengths
-            moments = self.midpoint_hats.T @ (self.lengths * sigma_n)
-            # an iterative contact solve leaves moments of the size of its tolerance
-            # where the body separates: they are zero, and so is F there
-            moments[np.abs(moments) <= NEGLIGIBLE * np.abs(moments).max(initial=0.0)] = 0.0
-            sigma_n = self.midpoint_hats @ (moments / weights)
+            sigma_n = self.midpoint_hats @ hat_projection(self.midpoint_hats, self.lengths,
+                                                          sigma_n)
         return mu_f * self.per_hat_edge(np.abs(sigma_n))[self.edge_of]
 
     def per_hat_edge(self, F_edges: np.ndarray) -> np.ndarray:
@@ -106,60 +115,87 @@ class FrictionForms:
         return float(np.sqrt(np.sum(w * nu**2)))
 
 
-def _edge_functionals(problem: DiscreteProblem):
-    """Matrices of int_e sigma_n ds and int_e sigma_t ds for every fine Gamma_C edge."""
-    mesh, fes, names = problem.fes.mesh, problem.fes, problem.names
-    labels = problem.scene.labels("contact")
-    p0 = ngs.Compress(ngs.SurfaceL2(mesh, order=0,
-                                    definedon=mesh.Boundaries(boundary_regex(labels))))
-    trial = dict(zip(names, fes.TrialFunction()))
-    v0 = p0.TestFunction()
+def hat_projection(midpoint_hats: sp.csr_matrix, lengths: np.ndarray,
+                   sigma_n: np.ndarray) -> np.ndarray:
+    """The contact pressure p_h: nodal values t_i / m_i on the h~ mesh.
+
+    p_h = sum_i (t_i / m_i) mu_i is the lumped L^2 projection of sigma_n onto the h~
+    hats mu_i, with the moments t_i = int sigma_n mu_i ds = d_Cn(mu_i, sigma) of (3.62)
+    -- the normal forces the contact conditions constrain (t_i <= 0, t_i lambda_i = 0)
+    -- and m_i = int mu_i ds (sigma_n is constant on every fine edge, so both are exact
+    sums with ``midpoint_hats``, the hat means per fine edge). p_h vanishes where the body
+    separates; the fine-edge sigma_n does not: with h~ = 2h it carries modes orthogonal to
+    every hat (alternating from fine edge to fine edge), which nothing in (3.62) controls.
+
+    Where the edge of the contact zone lies inside an h~ edge, p_h carries a spike at the
+    last node in contact: lambda_n^h is linear on the partly covered h~ edge while the exact
+    gap opens smoothly, and the elastic response to that corner of the discrete normal
+    displacement is a concentrated compressive force on the node. It is O(theta^2 h~) with
+    theta the uncovered part of the edge: at most first order, O(h^{3/2}) in L^2(Gamma_C),
+    and not removable from the discrete solution while lambda_n is P1 on h~ (see the
+    README, "Contact problems beyond the thesis").
+
+    Moments below ``NEGLIGIBLE`` times the largest are zero: an iterative contact solve
+    leaves moments of the size of its tolerance where the body separates.
+    """
+    weights = midpoint_hats.T @ lengths
+    moments = midpoint_hats.T @ (lengths * sigma_n)
+    moments[np.abs(moments) <= NEGLIGIBLE * np.abs(moments).max(initial=0.0)] = 0.0
+    return moments / weights
+
+
+def _edge_functionals(problem: DiscreteProblem) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+    """Matrices of int_e sigma_n ds and int_e sigma_t ds on every fine Gamma_C edge e.
+
+    Rows in the order of :class:`ngdual.contact.ContactBoundary`. Assembled against the
+    fine trace space of lambda (P1 on every fine edge, discontinuous from edge to edge):
+    the two end functions of e sum to its indicator, so int_e sigma_n ds is the sum of
+    the rows of the two trace dofs of e (``ContactBoundary.edge_dofs``).
+    """
+    fes, gamma_c = problem.fes, problem.spaces.gamma_c
+    space = problem.spaces.components["lam_n"]
+    trial = dict(zip(problem.names, fes.TrialFunction()))
+    test = space.TestFunction()
     traction = peers.stress_traction(trial["r1"], trial["r2"])
     n = ngs.specialcf.normal(2)
     t = ngs.CF((n[1], -n[0]))
-    ds = ngs.ds(definedon=mesh.Boundaries(boundary_regex(labels)))
+    ds = ngs.ds(definedon=fes.mesh.Boundaries(boundary_regex(problem.scene.labels("contact"))))
+    n_edges = len(gamma_c)
+    ends = sp.csr_matrix((np.ones(2 * n_edges), (np.repeat(np.arange(n_edges), 2),
+                                                 gamma_c.edge_dofs.ravel())),
+                         shape=(n_edges, space.ndof))
     mats = []
     for direction in (n, t):
-        form = ngs.BilinearForm(trialspace=fes, testspace=p0)
-        form += (direction * traction) * v0 * ds
+        form = ngs.BilinearForm(trialspace=fes, testspace=space)
+        form += (direction * traction) * test * ds
         form.Assemble()
         rows, cols, vals = form.mat.COO()
         fine = sp.csr_matrix((np.asarray(vals), (np.asarray(rows), np.asarray(cols))),
-                             shape=(p0.ndof, fes.ndof))
-        mats.append((fine @ problem.P).tocsr())
-    dof_of_edge = {}
-    for el in mesh.Elements(ngs.BND):
-        if el.mat in labels:
-            key = frozenset(v.nr for v in el.vertices)
-            dof_of_edge[key] = p0.GetDofNrs(el)[0]
-    return mats, dof_of_edge
+                             shape=(space.ndof, fes.ndof))
+        mats.append((ends @ fine @ problem.P).tocsr())
+    return mats[0], mats[1]
 
 
 def build_friction_forms(problem: DiscreteProblem) -> FrictionForms:
-    """Fine-edge traces, hat means and the h^ edge map for the contact boundary."""
-    spaces = problem.spaces
-    gamma_c = spaces.gamma_c
-    (int_n, int_t), dof_of_edge = _edge_functionals(problem)
-    order = np.array([dof_of_edge[frozenset((int(a), int(b)))] for a, b in gamma_c.vertices])
+    """Fine-edge traces and hat means on Gamma_C (:class:`ngdual.contact.ContactBoundary`)."""
+    gamma_c = problem.spaces.gamma_c
+    int_n, int_t = _edge_functionals(problem)
     scale = sp.diags(1.0 / gamma_c.lengths)
-    return FrictionForms(T_n=(scale @ int_n[order]).tocsr(), T_t=(scale @ int_t[order]).tocsr(),
-                         lengths=gamma_c.lengths,
-                         midpoint_hats=gamma_c.hat_means(spaces.prolongations["lam_n"]),
-                         edge_of=gamma_c.hhat_edge, hat_lengths=spaces.friction.edge_lengths(),
-                         midpoints=gamma_c.midpoints,
+    return FrictionForms(gamma_c, T_n=(scale @ int_n).tocsr(), T_t=(scale @ int_t).tocsr(),
+                         midpoint_hats=gamma_c.hat_means(problem.spaces.prolongations["lam_n"]),
                          normal_stress=problem.scene.friction.normal_stress)
 
 
 def tresca_bound(forms: FrictionForms, problem: DiscreteProblem) -> np.ndarray:
-    """The given Tresca bound F, averaged (3-point Gauss) on every fine edge."""
+    """The given Tresca bound F, averaged (3-point Gauss) on every fine edge.
+
+    The points of the (symmetric) rule run along every fine edge from its midpoint in
+    the direction of its tangent.
+    """
     bound = Expression(problem.scene.friction.bound)
-    contact = problem.spaces.contact
-    values = np.zeros(len(forms.lengths))
-    start = 0
-    for chain in contact.chains:
-        a, b = chain.path_points[:-1], chain.path_points[1:]
-        for s, w in zip(*GAUSS):
-            q = a + s * (b - a)
-            values[start:start + len(a)] += w * bound.numpy(q[:, 0], q[:, 1])
-        start += len(a)
+    gamma_c = forms.gamma_c
+    values = np.zeros(len(gamma_c))
+    for s, w in zip(*GAUSS):
+        q = gamma_c.midpoints + ((s - 0.5) * gamma_c.lengths)[:, None] * gamma_c.tangents
+        values += w * bound.numpy(q[:, 0], q[:, 1])
     return values
