@@ -112,7 +112,10 @@ def field_arrays(solution) -> dict[str, np.ndarray]:
     Gamma_N at the fine vertices: ``phi_x``, ``phi1``, ``phi2``. On Gamma_C
     (:func:`ngdual.post.contact_traces`): per fine edge ``edge_x``,
     ``sigma_n``, ``sigma_t``, ``edge_active``; per fine vertex ``node_x``,
-    ``lam_n``, ``lam_t``, ``gap``; per h~ node ``coarse_x``, ``in_contact``.
+    ``lam_n``, ``lam_t``, ``gap``; per h~ node ``coarse_x``, ``in_contact`` and the
+    pressure and shear traction the contact conditions see, ``hat_x`` (coordinate along the
+    foundation), ``hat_pressure``, ``hat_shear``
+    (:func:`ngdual.verification.analytic.traction_profile`).
     With friction (:func:`ngdual.post.friction_diagnostics`): per h~ node
     ``hat_ratio`` (|int sigma_t mu_i| / |int sigma_n mu_i|), ``bound_ratio``
     (|int sigma_t mu_i| / int F mu_i, at most 1 by (3.62): the discrete Coulomb
@@ -146,6 +149,10 @@ def field_arrays(solution) -> dict[str, np.ndarray]:
                    sigma_t=tr.sigma_t, edge_active=tr.edge_active, node_x=tr.node_xy[:, 0],
                    lam_n=tr.lam_n, lam_t=tr.lam_t, gap=tr.gap, coarse_x=tr.coarse_xy[:, 0],
                    in_contact=tr.coarse_in_contact)
+        from .verification.analytic import traction_profile
+
+        profile = traction_profile(solution)
+        out.update(hat_x=profile.x, hat_pressure=profile.pressure, hat_shear=profile.shear)
     if solution.nu is not None:
         from .friction import build_friction_forms
 
