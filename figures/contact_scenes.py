@@ -105,12 +105,12 @@ def run(ctx):
                              facecolors=arrays["von_mises"], cmap="viridis", vmin=0, vmax=vmax,
                              edgecolors="none", rasterized=True)
         fig.colorbar(art, ax=ax_f, extend="max",
-                     label=rf"$\sigma_0$ (clipped at its {CLIP:g}th percentile)")
+                     label=rf"$\sigma_0$ [stress units], clipped at its {CLIP:g}th percentile")
         ax_f.set_xlim(box[0], box[1])
         ax_f.set_ylim(box[2], box[3])
         ax_f.set_aspect("equal")
-        ax_f.set_xlabel(r"$x_1$")
-        ax_f.set_ylabel(r"$x_2$")
+        ax_f.set_xlabel(r"$x_1$ [length]")
+        ax_f.set_ylabel(r"$x_2$ [length]")
         ax_f.set_title(f"{name}: von Mises stress near $\\Gamma_C$ (level {level})")
         order = np.argsort(x)
         hat = np.argsort(arrays["hat_x"])
@@ -133,8 +133,8 @@ def run(ctx):
         ax_c.set_xlim(box[0], box[1])
         top = max(arrays["hat_pressure"].max(), np.abs(arrays["hat_shear"]).max())
         ax_c.set_ylim(-0.15 * top, 1.5 * top)  # the flat punch's exact p is unbounded
-        ax_c.set_xlabel(r"$x_1$ on $\Gamma_C$")
-        ax_c.set_ylabel("traction")
+        ax_c.set_xlabel(r"$x_1$ on $\Gamma_C$ [length]")
+        ax_c.set_ylabel("traction [stress units]")
         ax_c.grid(alpha=0.3)
         ax_c.legend(loc="upper right", fontsize=8)
         ax_c.set_title(f"P = {P:.4g}" + (f", Q = {Q:.4g}" if abs(Q) > 1e-9 * abs(P) else ""))

@@ -37,7 +37,7 @@ SMOKE = "3"     # the smoke run of every script
 COARSE = "2"    # the sweep that is killed and resumed
 EXPECTED = ([f"Fig. 3.{n}" for n in range(10, 29)] + [f"Table 3.{n}" for n in range(1, 7)]
             + ["Figs. 4.1-4.8", "Figs. 4.9-4.13"] + [f"Table 4.{n}" for n in range(1, 5)]
-            + ["Work-precision (beyond the thesis)"])
+            + ["Work-precision (beyond the thesis)", "Beyond the thesis: contact scenes"])
 UNIT = re.compile(r"\[[^\]]+\]")
 
 
