@@ -56,6 +56,7 @@ import ngsolve as ngs
 import numpy as np
 
 from ..expr import Expression
+from ..friction import hat_projection
 from ..mesh import mesh_size
 from ..post import contact_traces, fields, friction_diagnostics
 from ..scene import Contact, Friction, Geometry, Loads, Material, Scene, Solver, validate
@@ -567,3 +568,84 @@ def contact_profile(case: ManufacturedCase, solution: Solution) -> dict:
             "lam_n_exact": case.exact.lam_n.numpy(xs, 0 * xs),
             "pressure": t / m, "pressure_of_exact": np.array(t_exact) / m,
             "sigma_n": trace.numpy(xs, 0 * xs)}
+
+
+# --- the contact pressure and its error -----------------------------------------------------
+
+def contact_pressure(solution: Solution) -> dict:
+    """The contact pressure p_h and the raw fine-edge sigma_n^h along Gamma_C.
+
+    p_h = sum_i (t_i / m_i) mu_i over the h~ hats (:func:`ngdual.friction.hat_projection`):
+    the discrete contact forces per unit length, zero where the body separates. Returns the
+    fine edge end points ``x0``, ``x1`` (x of the start and end vertex), ``p0``, ``p1``
+    (p_h there: p_h is linear on every fine edge), ``sigma_n`` (the fine-edge value of
+    :func:`ngdual.post.contact_traces`), and per interior h~ node ``node_x``,
+    ``node_pressure`` (t_i / m_i) and ``node_lam_n``.
+    """
+    pb = solution.problem
+    gamma_c, prolong = pb.spaces.gamma_c, pb.spaces.prolongations["lam_n"]
+    sigma_n = contact_traces(solution).sigma_n
+    nodal = hat_projection(gamma_c.hat_means(prolong), gamma_c.lengths, sigma_n)
+    fine = prolong @ nodal
+    points = np.array([v.point for v in pb.fes.mesh.vertices])
+    dof_x = np.concatenate([chain.path_points[pb.spaces.contact.dof_positions(c)][:, 0]
+                            for c, chain in enumerate(pb.spaces.contact.chains)])
+    return {"x0": points[gamma_c.vertices[:, 0], 0], "x1": points[gamma_c.vertices[:, 1], 0],
+            "p0": fine[gamma_c.edge_dofs[:, 0]], "p1": fine[gamma_c.edge_dofs[:, 1]],
+            "sigma_n": sigma_n, "node_x": dof_x, "node_pressure": nodal,
+            "node_lam_n": solution.part("lam_n")}
+
+
+def pressure_errors(case: ManufacturedCase, solution: Solution) -> dict:
+    """Errors of the contact pressure against the exact sigma_n on Gamma_C.
+
+    ``pressure`` / ``pressure_max``: L2(Gamma_C) and maximum error of p_h
+    (:func:`contact_pressure`); ``fine_sigma_n`` / ``fine_sigma_n_max``: the same for the
+    raw fine-edge sigma_n^h. Gauss-Legendre on every fine edge, split at the breakpoints
+    of the exact trace (the maximum over those points and the edge ends).
+    """
+    pr = contact_pressure(solution)
+    trace = case.exact.sigma_n.at_y(Y0)
+    points, weights = np.polynomial.legendre.leggauss(trace.degree // 2 + 4)
+    points = np.concatenate([[-1.0], points, [1.0]])
+    weights = np.concatenate([[0.0], weights, [0.0]])
+    sums = {"pressure": [0.0, 0.0], "fine_sigma_n": [0.0, 0.0]}
+    for x0, x1, p0, p1, s in zip(pr["x0"], pr["x1"], pr["p0"], pr["p1"], pr["sigma_n"]):
+        lo, hi = min(x0, x1), max(x0, x1)
+        cuts = [lo, *(b for b in trace.breaks if lo < b < hi), hi]
+        for a, b in zip(cuts[:-1], cuts[1:]):
+            xq = 0.5 * (a + b) + 0.5 * (b - a) * points
+            exact = trace.numpy(xq, 0.0 * xq)
+            for key, vh in (("pressure", p0 + (p1 - p0) * (xq - x0) / (x1 - x0)),
+                            ("fine_sigma_n", s + 0.0 * xq)):
+                d = vh - exact
+                sums[key][0] += 0.5 * (b - a) * np.sum(weights * d * d)
+                sums[key][1] = max(sums[key][1], float(np.abs(d).max()))
+    return {"pressure": math.sqrt(sums["pressure"][0]), "pressure_max": sums["pressure"][1],
+            "fine_sigma_n": math.sqrt(sums["fine_sigma_n"][0]),
+            "fine_sigma_n_max": sums["fine_sigma_n"][1]}
+
+
+def edge_spikes(case: ManufacturedCase, solution: Solution) -> list[dict]:
+    """The pressure at every last h~ node in contact (a contact node next to a separated one).
+
+    Per such node: ``x``, ``excess`` = p_h - (the same projection of the exact sigma_n, from
+    :func:`contact_profile`; negative = too much compression), ``kink`` = lambda_n^h at the
+    separated neighbour over the h~ edge length (the slope jump of lambda_n^h at the node)
+    and ``uncovered``: the part theta of that h~ edge outside the exact contact set.
+    """
+    prof = contact_profile(case, solution)
+    order = np.argsort(prof["x"])
+    x, lam = prof["x"][order], prof["lam_n"][order]
+    excess = (prof["pressure"] - prof["pressure_of_exact"])[order]
+    touching = lam <= 1e-12 * np.abs(lam).max(initial=0.0)
+    out = []
+    for k in np.flatnonzero(touching):
+        for j in (k - 1, k + 1):
+            if 0 <= j < len(x) and not touching[j]:
+                edge = abs(x[j] - x[k])
+                inside = max(0.0, *(min(max(x[k], x[j]), hi) - max(min(x[k], x[j]), lo)
+                                    for lo, hi in case.contact_set))
+                out.append({"x": float(x[k]), "excess": float(excess[k]),
+                            "kink": float(lam[j] / edge), "uncovered": 1.0 - inside / edge})
+    return out
