@@ -4,7 +4,12 @@ Scenes give loads, gaps and friction bounds as short formulas such as
 ``"-800*ifpos(4 - x*x, (1 - x*x/4)**2, 0)"``. One parsed expression is
 evaluated with two back ends: NumPy (for validation and plotting) and NGSolve
 coefficient functions (for assembly). Only a whitelist of names is accepted,
-so a scene file can never execute arbitrary code.
+so a scene file can never execute arbitrary code, and evaluation is bounded:
+a formula has at most ``MAX_LENGTH`` characters and ``MAX_NODES`` syntax nodes,
+functions take their exact number of arguments, and every constant subexpression
+is folded once in floating point at parse time, so a power tower such as
+``10**10**10`` (which Python's integers would try to compute digit by digit) or
+``1/0`` is refused there instead of hanging or failing during assembly.
 
 >>> Expression("abs(x) + 1").numpy(np.array([-2.0, 3.0]), np.zeros(2))
 array([3., 4.])
@@ -13,12 +18,19 @@ array([3., 4.])
 from __future__ import annotations
 
 import ast
+import math
+import operator
+import sys
 from dataclasses import dataclass, field
 
 import numpy as np
 
-_FUNCTIONS = ("abs", "sqrt", "exp", "log", "sin", "cos", "tan", "atan", "atan2",
-              "ifpos", "min", "max")
+_ARITY = {"abs": 1, "sqrt": 1, "exp": 1, "log": 1, "sin": 1, "cos": 1, "tan": 1, "atan": 1,
+          "atan2": 2, "ifpos": 3, "min": 2, "max": 2}
+_FUNCTIONS = tuple(_ARITY)
+MAX_LENGTH = 20_000   # characters; the longest shipped (manufactured) formulas have ~2 500
+MAX_NODES = 10_000    # syntax nodes
+MAX_DEPTH = 200       # nesting of operations and calls (shipped formulas: <= 24)
 _CONSTANTS = {"pi": np.pi, "e": np.e}
 _OPERATORS = (ast.Add, ast.Sub, ast.Mult, ast.Div, ast.Pow, ast.USub, ast.UAdd)
 
@@ -27,24 +39,105 @@ class ExpressionError(ValueError):
     """Raised for a formula that does not parse or uses unknown names."""
 
 
+def quote(text: str, width: int = 60) -> str:
+    """The formula quoted for a one-line message (long ones shortened)."""
+    return repr(text if len(text) <= width else text[:width - 3] + "...")
+
+
 def _check(node: ast.AST, text: str) -> None:
-    for sub in ast.walk(node):
+    callees = {id(sub.func) for sub in ast.walk(node) if isinstance(sub, ast.Call)}
+    for count, sub in enumerate(ast.walk(node)):
+        if count > MAX_NODES:
+            raise ExpressionError(f"formula too long: more than {MAX_NODES} terms")
         if isinstance(sub, (ast.Expression, ast.Load, ast.BinOp, ast.UnaryOp) + _OPERATORS):
             continue
-        if isinstance(sub, ast.Constant) and isinstance(sub.value, (int, float)):
-            continue
+        if isinstance(sub, ast.Constant):
+            # bool is an int subclass: True/False would silently mean 1/0
+            if isinstance(sub.value, (int, float)) and not isinstance(sub.value, bool):
+                continue
+            raise ExpressionError(f"{repr(sub.value)[:40]} is not a number, in {quote(text)}")
         if isinstance(sub, ast.Name):
+            if sub.id in _FUNCTIONS and id(sub) not in callees:
+                raise ExpressionError(f"{sub.id!r} is a function: call it, e.g. "
+                                      f"{sub.id}({', '.join('xyx'[:_ARITY[sub.id]])}), "
+                                      f"in {quote(text)}")
             if sub.id in ("x", "y") or sub.id in _CONSTANTS or sub.id in _FUNCTIONS:
                 continue
-            raise ExpressionError(f"unknown name {sub.id!r} in {text!r} "
+            raise ExpressionError(f"unknown name {sub.id!r} in {quote(text)} "
                                   f"(allowed: x, y, pi, e, {', '.join(_FUNCTIONS)})")
         if isinstance(sub, ast.Call):
-            if isinstance(sub.func, ast.Name) and sub.func.id in _FUNCTIONS and not sub.keywords:
-                continue
-            name = sub.func.id if isinstance(sub.func, ast.Name) else ast.unparse(sub.func)
-            raise ExpressionError(f"unknown name {name!r} in {text!r} "
-                                  f"(functions: {', '.join(_FUNCTIONS)})")
-        raise ExpressionError(f"unsupported syntax {type(sub).__name__} in {text!r}")
+            if not (isinstance(sub.func, ast.Name) and sub.func.id in _FUNCTIONS):
+                name = sub.func.id if isinstance(sub.func, ast.Name) else ast.unparse(sub.func)
+                raise ExpressionError(f"unknown name {name!r} in {quote(text)} "
+                                      f"(functions: {', '.join(_FUNCTIONS)})")
+            if sub.keywords or len(sub.args) != _ARITY[sub.func.id]:
+                raise ExpressionError(f"{sub.func.id} takes {_ARITY[sub.func.id]} "
+                                      f"argument{'s' * (_ARITY[sub.func.id] > 1)}, got "
+                                      f"{len(sub.args) + len(sub.keywords)} in {quote(text)}")
+            continue
+        raise ExpressionError(f"unsupported syntax {type(sub).__name__} in {quote(text)}")
+
+
+_FOLD_FUNCTIONS = {
+    "abs": abs, "sqrt": math.sqrt, "exp": math.exp, "log": math.log, "sin": math.sin,
+    "cos": math.cos, "tan": math.tan, "atan": math.atan, "atan2": math.atan2,
+    "min": min, "max": max, "ifpos": lambda c, a, b: a if c > 0 else b,
+}
+_FOLD_OPERATORS = {ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul,
+                   ast.Div: operator.truediv, ast.Pow: operator.pow,
+                   ast.USub: operator.neg, ast.UAdd: operator.pos}
+
+
+def _fold(node: ast.AST, text: str, depth: int = 0) -> float | None:
+    """The value of a constant subtree in floating point, None where it depends on x, y.
+
+    Every constant operation is done once, in floats, so its size is bounded (an
+    overflow, a division by zero or a complex power is refused here); the NumPy and
+    NGSolve back ends then only ever see operations on floats of bounded size.
+    """
+    if depth > MAX_DEPTH:
+        raise ExpressionError(f"formula nested too deeply (more than {MAX_DEPTH} levels) in "
+                              f"{quote(text)}")
+    if isinstance(node, ast.Expression):
+        return _fold(node.body, text, depth)
+    if isinstance(node, ast.Constant):
+        try:
+            return _finite(float(node.value), text)
+        except OverflowError:
+            return _finite(math.inf, text)
+    if isinstance(node, ast.Name):
+        return _CONSTANTS.get(node.id)
+    if isinstance(node, ast.UnaryOp):
+        value = _fold(node.operand, text, depth + 1)
+        return None if value is None else _FOLD_OPERATORS[type(node.op)](value)
+    if isinstance(node, ast.BinOp):
+        args = [_fold(node.left, text, depth + 1), _fold(node.right, text, depth + 1)]
+        operation = _FOLD_OPERATORS[type(node.op)]
+    else:  # a call (the only other node _check lets through)
+        args = [_fold(a, text, depth + 1) for a in node.args]
+        operation = _FOLD_FUNCTIONS[node.func.id]
+    if any(a is None for a in args):
+        return None
+    try:
+        value = operation(*args)
+    except ZeroDivisionError:
+        raise ExpressionError(f"division by zero in {quote(text)}") from None
+    except OverflowError:
+        raise ExpressionError(f"a constant overflows (exceeds {sys.float_info.max:.3g}) in "
+                              f"{quote(text)}") from None
+    except ValueError:
+        raise ExpressionError(f"{quote(ast.unparse(node))} is not defined (not a real number) in "
+                              f"{quote(text)}") from None
+    if isinstance(value, complex):
+        raise ExpressionError(f"{quote(ast.unparse(node))} is not a real number in {quote(text)}")
+    return _finite(float(value), text)
+
+
+def _finite(value: float, text: str) -> float:
+    if not math.isfinite(value):
+        raise ExpressionError(f"a constant overflows (exceeds {sys.float_info.max:.3g}) in "
+                              f"{quote(text)}")
+    return value
 
 
 def _numpy_namespace(x, y) -> dict:
@@ -83,21 +176,37 @@ class Expression:
 
     text: str
     _code: object = field(init=False, repr=False, compare=False)
+    constant: float | None = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
+        if isinstance(self.text, bool) or not isinstance(self.text, (str, int, float)):
+            raise ExpressionError(f"a formula must be a string or a number, got "
+                                  f"{repr(self.text)[:60]}")
         text = str(self.text).strip()
+        if len(text) > MAX_LENGTH:
+            raise ExpressionError(f"formula too long ({len(text)} characters, at most "
+                                  f"{MAX_LENGTH})")
         try:
             tree = ast.parse(text, mode="eval")
         except SyntaxError as err:
-            raise ExpressionError(f"cannot parse {text!r}: {err.msg}") from None
+            raise ExpressionError(f"cannot parse {quote(text)}: {err.msg}") from None
+        except (RecursionError, MemoryError, ValueError):
+            raise ExpressionError(f"formula too large to parse: {quote(text)}") from None
         _check(tree, text)
+        object.__setattr__(self, "constant", _fold(tree, text))
         object.__setattr__(self, "text", text)
         object.__setattr__(self, "_code", compile(tree, "<scene expression>", "eval"))
 
     def numpy(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
-        """Evaluate at the points ``(x, y)``; returns an array of ``x``'s shape."""
+        """Evaluate at the points ``(x, y)``; returns an array of ``x``'s shape.
+
+        Where the formula is not defined (``sqrt(-1)``, ``log(0)``, overflow) the value
+        is inf or nan, without a warning: callers check finiteness where it matters.
+        """
         x = np.asarray(x, dtype=float)
-        value = eval(self._code, {"__builtins__": {}}, _numpy_namespace(x, np.asarray(y, float)))
+        with np.errstate(all="ignore"):
+            value = eval(self._code, {"__builtins__": {}},
+                         _numpy_namespace(x, np.asarray(y, float)))
         return np.broadcast_to(np.asarray(value, dtype=float), x.shape).copy()
 
     def coefficient(self):

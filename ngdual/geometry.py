@@ -44,17 +44,26 @@ class Side:
 
     def sample(self, n: int) -> tuple[np.ndarray, np.ndarray]:
         """``n`` >= 2 points from start to end (equal parameter steps) and the outward normals."""
-        s = np.linspace(0.0, 1.0, n)
+        return self.at(np.linspace(0.0, 1.0, n), normals=True)
+
+    def at(self, s: np.ndarray, normals: bool = False):
+        """The points at parameters ``s`` in [0, 1] (proportional to arc length), and with
+        ``normals`` the outward unit normals there."""
+        s = np.asarray(s, dtype=float)
         if not self.is_arc:
             d = self.end - self.start
+            points = self.start + s[:, None] * d
+            if not normals:
+                return points
             normal = np.array([d[1], -d[0]]) / np.linalg.norm(d)
-            return self.start + s[:, None] * d, np.tile(normal, (n, 1))
+            return points, np.tile(normal, (len(s), 1))
         r, phi0, sweep = self._angles()
         phi = phi0 + s * sweep
         radial = np.column_stack([np.cos(phi), np.sin(phi)])
+        if not normals:
+            return self.center + r * radial
         # counter-clockwise sweep: the body lies to the left, i.e. inside the circle
-        normal = radial if sweep > 0 else -radial
-        return self.center + r * radial, normal
+        return self.center + r * radial, (radial if sweep > 0 else -radial)
 
     def tangent(self, at_end: bool) -> np.ndarray:
         """Unit tangent in the direction of travel at the start or the end of the side."""

@@ -26,6 +26,8 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import math
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
@@ -33,7 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from . import geometry
-from .expr import Expression, ExpressionError
+from .expr import Expression, ExpressionError, quote
 
 try:
     import tomllib
@@ -50,11 +52,60 @@ GEOMETRY_KINDS = ("thesis-3.46", "polygon")
 
 
 class SceneError(ValueError):
-    """A scene that cannot be solved; ``field`` names the offending entry."""
+    """A scene that cannot be solved; ``field`` names the offending entry.
 
-    def __init__(self, field_name: str, message: str):
-        super().__init__(f"{field_name}: {message}")
-        self.field = field_name
+    Several problems found together are one error: ``problems`` lists every
+    ``(field, message)`` pair, ``field`` is the first of them and the message has one
+    line per problem.
+    """
+
+    def __init__(self, field_name: str, message: str,
+                 problems: list[tuple[str, str]] | None = None):
+        self.problems = list(problems or [(field_name, message)])
+        self.field = self.problems[0][0]
+        if len(self.problems) == 1:
+            text = f"{self.field}: {self.problems[0][1]}"
+        else:
+            text = (f"{len(self.problems)} problems in the scene:\n"
+                    + "\n".join(f"  {f}: {m}" for f, m in self.problems))
+        super().__init__(text)
+
+    @property
+    def fields(self) -> list[str]:
+        """The fields of every problem, in the order found."""
+        return [f for f, _ in self.problems]
+
+
+class _Problems:
+    """Collects the :class:`SceneError` s of independent checks, to report them together."""
+
+    def __init__(self):
+        self.found: list[tuple[str, str]] = []
+
+    @contextmanager
+    def check(self):
+        """Run the checks in the ``with`` block; a SceneError there is recorded, not raised."""
+        try:
+            yield
+        except SceneError as err:
+            self.found.extend(err.problems)
+
+    def add(self, field_name: str, message: str) -> None:
+        self.found.append((field_name, message))
+
+    def run(self, check, *args, value: bool = False, **kwargs):
+        """Call ``check``; on a SceneError record it and return False (None with ``value``),
+        else return True (the result with ``value``)."""
+        try:
+            result = check(*args, **kwargs)
+        except SceneError as err:
+            self.found.extend(err.problems)
+            return None if value else False
+        return result if value else True
+
+    def raise_any(self) -> None:
+        if self.found:
+            raise SceneError("", "", self.found)
 
 
 @dataclass
@@ -252,11 +303,21 @@ def shipped_scenes() -> list[str]:
 
 
 def _read_toml(source: str | Path) -> tuple[str, dict]:
+    if isinstance(source, bool) or not isinstance(source, (str, Path)):
+        raise SceneError("scene", f"must be a path or a shipped scene name, got "
+                                  f"{type(source).__name__}")
     path = Path(source)
+    if path.is_dir():
+        raise SceneError("scene", f"{str(path)!r} is a directory; give a TOML scene file "
+                                  "inside it or the name of a shipped scene")
     if path.suffix == ".toml" or path.exists():
         if not path.is_file():
             raise SceneError("scene", f"no such scene file {str(path)!r}")
-        text, default_name = path.read_text(), path.stem
+        try:
+            text, default_name = path.read_text(encoding="utf-8"), path.stem
+        except (OSError, UnicodeDecodeError) as err:
+            raise SceneError("scene", f"cannot read {str(path)!r}: "
+                                      f"{getattr(err, 'strerror', None) or err}") from None
     else:
         name = str(source)
         if name not in shipped_scenes():
@@ -280,6 +341,10 @@ def _parse_value(text: str):
 
 def apply_overrides(data: dict, overrides: list[str] | None) -> dict:
     """Apply ``--set section.key=value`` overrides (values parsed as TOML, else strings)."""
+    if overrides is not None and (isinstance(overrides, str)
+                                  or not all(isinstance(o, str) for o in overrides)):
+        raise SceneError("overrides", "must be a list of 'section.key=value' strings, got "
+                                      f"{overrides!r}")
     data = copy.deepcopy(data)
     for item in overrides or []:
         if "=" not in item:
@@ -292,31 +357,55 @@ def apply_overrides(data: dict, overrides: list[str] | None) -> dict:
         if len(parts) != 2 or (parts[0] not in _SECTIONS and parts[0] != "boundary"):
             raise SceneError(key, "unknown key; use section.key with section in "
                                   + ", ".join(["boundary", *_SECTIONS]))
-        data.setdefault(parts[0], {})[parts[1]] = _parse_value(value)
+        section = data.setdefault(parts[0], {})
+        if not isinstance(section, dict):
+            raise SceneError(parts[0], f"must be a table, got {section!r}")
+        section[parts[1]] = _parse_value(value)
     return data
 
 
+GEOMETRY_REQUIRED = ('give kind = "thesis-3.46" (the rectangle [-4,4]x[-1,1] of Example 3.46) '
+                     'or kind = "polygon" with points and labels')
+
+
 def _build(name: str, data: dict) -> Scene:
-    unknown = set(data) - {"name", "description", "boundary", *_SECTIONS}
-    if unknown:
-        raise SceneError(sorted(unknown)[0], "unknown section")
+    """The :class:`Scene` of a TOML document; every structural problem is reported at once."""
+    problems = _Problems()
+    for key in sorted(set(data) - {"name", "description", "boundary", *_SECTIONS}):
+        problems.add(key, "unknown section; sections are "
+                          + ", ".join(["name", "description", "boundary", *_SECTIONS]))
+    for key in ("name", "description"):
+        if key in data and not isinstance(data[key], str):
+            problems.add(key, f"must be a string, got {data[key]!r}")
+    # a scene states its domain: no table silently becoming the thesis rectangle
+    if "geometry" not in data:
+        problems.add("geometry", "missing table: " + GEOMETRY_REQUIRED)
+    elif isinstance(data["geometry"], dict) and "kind" not in data["geometry"]:
+        problems.add("geometry.kind", "missing: " + GEOMETRY_REQUIRED)
     kwargs = {}
     for section, cls in _SECTIONS.items():
-        values = dict(data.get(section, {}))
+        values = data.get(section, {})
+        if not isinstance(values, dict):
+            problems.add(section, f"must be a table [{section}], got {values!r}")
+            values = {}
         names = {f.name for f in dataclasses.fields(cls)}
         for key in values:
             if key not in names:
-                raise SceneError(f"{section}.{key}", "unknown key; known keys: "
-                                 + ", ".join(sorted(names)))
-        kwargs[section] = cls(**values)
-    if "boundary" not in data:
-        raise SceneError("boundary", "missing table: assign dirichlet/neumann/contact labels")
+                problems.add(f"{section}.{key}", "unknown key; known keys: "
+                             + ", ".join(sorted(names)))
+        kwargs[section] = cls(**{k: v for k, v in values.items() if k in names})
     boundary = {}
-    for role, labels in data["boundary"].items():
-        if role not in _ROLES:
-            raise SceneError(f"boundary.{role}", f"unknown role; use one of {', '.join(_ROLES)}")
-        labels = [labels] if isinstance(labels, str) else list(labels)
-        boundary[role] = labels
+    if "boundary" not in data:
+        problems.add("boundary", "missing table: assign dirichlet/neumann/contact labels")
+    elif not isinstance(data["boundary"], dict):
+        problems.add("boundary", f"must be a table [boundary], got {data['boundary']!r}")
+    else:
+        for role, labels in data["boundary"].items():
+            if role not in _ROLES:
+                problems.add(f"boundary.{role}", f"unknown role; use one of {', '.join(_ROLES)}")
+                continue
+            boundary[role] = [labels] if isinstance(labels, str) else labels
+    problems.raise_any()
     return Scene(name=str(data.get("name", name)), boundary=boundary, **kwargs)
 
 
@@ -330,6 +419,10 @@ def load_scene(source: str | Path, overrides: list[str] | None = None) -> Scene:
     scene = _build(name, apply_overrides(data, overrides))
     validate(scene)
     return scene
+
+
+def _is_number(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
 
 
 def _positive(value, field_name: str, integer: bool = False) -> None:
@@ -350,11 +443,59 @@ def _expression(text, field_name: str) -> Expression:
 def _pair(values, field_name: str) -> list[Expression]:
     if not isinstance(values, (list, tuple)) or len(values) != 2:
         raise SceneError(field_name, f"must be a pair [x-component, y-component], got {values!r}")
-    return [_expression(v, f"{field_name}[{i}]") for i, v in enumerate(values)]
+    problems = _Problems()
+    out = []
+    for i, v in enumerate(values):
+        with problems.check():
+            out.append(_expression(v, f"{field_name}[{i}]"))
+    problems.raise_any()
+    return out
+
+
+# What each setting must be; the formulas (loads, contact.gap, friction.bound) are checked
+# by parsing them, the tables of geometry (points, labels, arcs, side_maxh) entry by entry.
+_TYPES = {"str": (str,), "int": (int,), "float": (int, float), "list": (list, tuple),
+          "dict": (dict,)}
+_TYPE_NAMES = {"str": "a string", "int": "an integer", "float": "a number",
+               "list": "a list", "dict": "a table"}
+_FORMULAS = {"contact.gap", "friction.bound", "loads.body_force", "loads.traction",
+             "loads.displacement"}
+
+
+def _type_problems(scene: Scene) -> list[tuple[str, str]]:
+    """``(field, message)`` for every setting of ``scene`` whose type is wrong."""
+    found = []
+    if not isinstance(scene.name, str):
+        found.append(("name", f"must be a string, got {scene.name!r}"))
+    for section, cls in _SECTIONS.items():
+        obj = getattr(scene, section)
+        if not isinstance(obj, cls):
+            found.append((section, f"must be a {cls.__module__}.{cls.__name__}, got "
+                                   f"{type(obj).__name__}"))
+            continue
+        for f in dataclasses.fields(cls):
+            key, value = f"{section}.{f.name}", getattr(obj, f.name)
+            kinds = [k.strip() for k in str(f.type).split("|")]
+            if key in _FORMULAS or (value is None and "None" in kinds):
+                continue
+            ok = _TYPES[kinds[0]]
+            if isinstance(value, bool) or not isinstance(value, ok):
+                found.append((key, f"must be {_TYPE_NAMES[kinds[0]]}, got {value!r}"))
+    if not isinstance(scene.boundary, dict):
+        found.append(("boundary", f"must be a table role -> labels, got {scene.boundary!r}"))
+        return found
+    for role, labels in scene.boundary.items():
+        if role not in _ROLES:
+            found.append((f"boundary.{role}", f"unknown role; use one of {', '.join(_ROLES)}"))
+        elif not isinstance(labels, (list, tuple)) or not all(isinstance(lab, str)
+                                                              for lab in labels):
+            found.append((f"boundary.{role}", f"must be a list of side labels, got {labels!r}"))
+    return found
 
 
 KINK_ANGLE = 1e-6  # radians: two contact sides meeting at a larger angle form a kink
 CUSP_ANGLE = np.pi * (1 - 1e-3)
+SHORT_SIDE = 1e-9  # relative to the diameter: shorter sides are degenerate (netgen crashes)
 
 
 def _side_table(geo: Geometry, key: str, value: str) -> list[tuple[str, object]]:
@@ -369,26 +510,64 @@ def _side_table(geo: Geometry, key: str, value: str) -> list[tuple[str, object]]
     return list(table.items())
 
 
+def _validate_points(geo: Geometry) -> np.ndarray:
+    """The polygon's vertices as an array; refuses non-numbers and degenerate polygons."""
+    if not isinstance(geo.points, (list, tuple)) or len(geo.points) < 3:
+        raise SceneError("geometry.points", f"need at least three [x, y] points, got "
+                                            f"{geo.points!r}")
+    problems = _Problems()
+    for i, p in enumerate(geo.points):
+        if not (isinstance(p, (list, tuple)) and len(p) == 2 and all(_is_number(c) and
+                                                                      math.isfinite(c)
+                                                                      for c in p)):
+            problems.add(f"geometry.points[{i}]", f"must be a pair of finite numbers [x, y], "
+                                                  f"got {p!r}")
+    if not isinstance(geo.labels, (list, tuple)) or not all(
+            isinstance(lab, str) and lab for lab in geo.labels):
+        problems.add("geometry.labels", f"must be a list of non-empty strings, got "
+                                        f"{geo.labels!r}")
+    elif len(geo.labels) != len(geo.points):
+        problems.add("geometry.labels", f"need one label per side ({len(geo.points)}), "
+                                        f"got {len(geo.labels)}")
+    problems.raise_any()
+    pts = np.asarray(geo.points, dtype=float)
+    size = float(np.ptp(pts, axis=0).max())
+    if size > 1e100 or size < 1e-100:
+        raise SceneError("geometry.points", f"the polygon's size {size:.3g} is outside "
+                                            "[1e-100, 1e100]; rescale the units")
+    # coincident vertices give zero-length sides or touching boundaries, which netgen
+    # cannot mesh (a zero-length side crashes it), so they are refused before meshing
+    for i in range(len(pts)):
+        for j in range(i + 1, len(pts)):
+            if np.linalg.norm(pts[i] - pts[j]) <= SHORT_SIDE * size:
+                where = f"({pts[i, 0]:.4g}, {pts[i, 1]:.4g})"
+                if j == i + 1 or (i == 0 and j == len(pts) - 1):
+                    side = i if j == i + 1 else j
+                    raise SceneError("geometry.points", f"points[{i}] and points[{j}] "
+                                     f"coincide at {where}: side {side} "
+                                     f"({geo.labels[side]!r}) has zero length; remove the "
+                                     "repeated point")
+                raise SceneError("geometry.points", f"points[{i}] and points[{j}] coincide "
+                                                    f"at {where}: the boundary touches itself")
+    return pts
+
+
 def _validate_geometry(geo: Geometry) -> None:
     if geo.kind not in GEOMETRY_KINDS:
         raise SceneError("geometry.kind", f"unknown kind {geo.kind!r}; use one of "
                                           + ", ".join(GEOMETRY_KINDS))
     _positive(geo.level, "geometry.level", integer=True)
     if geo.kind != "polygon":
-        for key in ("arcs", "side_maxh"):
+        for key in ("arcs", "side_maxh", "points", "labels"):
             if getattr(geo, key):
                 raise SceneError(f"geometry.{key}", f"{key} needs kind = \"polygon\" (the "
                                                     f"{geo.kind!r} geometry is fixed)")
         return
-    pts = np.asarray(geo.points, dtype=float) if len(geo.points) else np.zeros((0, 2))
-    if pts.ndim != 2 or pts.shape[1] != 2 or len(pts) < 3:
-        raise SceneError("geometry.points", "need at least three [x, y] points")
-    if len(geo.labels) != len(pts):
-        raise SceneError("geometry.labels", f"need one label per side ({len(pts)}), "
-                                            f"got {len(geo.labels)}")
+    _validate_points(geo)
     for label, centre in _side_table(geo, "arcs", "[x, y] (the arc's centre)"):
-        c = np.asarray(centre, dtype=float) if isinstance(centre, (list, tuple)) else None
-        if c is None or c.shape != (2,) or not np.all(np.isfinite(c)):
+        ok = isinstance(centre, (list, tuple)) and len(centre) == 2 and all(
+            _is_number(c) and math.isfinite(c) for c in centre)
+        if not ok:
             raise SceneError(f"geometry.arcs.{label}", f"the centre must be [x, y], got "
                                                        f"{centre!r}")
     for label, h in _side_table(geo, "side_maxh", "mesh size"):
@@ -578,67 +757,233 @@ def _validate_contact(scene: Scene, u_d: list[Expression]) -> None:
                                             f"the gap is {g:.3g}: need g >= u_D.n there")
 
 
+class SceneTypeError(SceneError, TypeError):
+    """An argument of the Python API of the wrong type (a :class:`SceneError` and a TypeError)."""
+
+
+E_RANGE = (1e-30, 1e30)  # beyond, C^-1 ~ 1/E and sigma ~ E reach the ends of double precision
+
+
 def validate(scene: Scene) -> None:
-    """Raise :class:`SceneError` for the first problem found in ``scene``."""
-    _validate_geometry(scene.geometry)
-    _validate_boundary(scene)
-    mat = scene.material
-    _positive(mat.E, "material.E")
-    if isinstance(mat.nu, bool) or not isinstance(mat.nu, (int, float)) or not -1 < mat.nu < 0.5:
-        raise SceneError("material.nu", f"Poisson's ratio must lie in (-1, 0.5), got {mat.nu!r}")
-    _pair(scene.loads.body_force, "loads.body_force")
-    _pair(scene.loads.traction, "loads.traction")
-    u_d = _pair(scene.loads.displacement, "loads.displacement")
-    con, fr, sol = scene.contact, scene.friction, scene.solver
-    _expression(con.gap_formula, "contact.gap")
-    _validate_contact(scene, u_d)
-    _positive(con.htilde_factor, "contact.htilde_factor", integer=True)
-    if con.hhat_factor not in (1, 2) or isinstance(con.hhat_factor, bool):
-        raise SceneError("contact.hhat_factor", f"must be 1 (h^ = h~) or 2 (h^ = 2h~), "
-                                                f"got {con.hhat_factor!r}")
+    """Raise one :class:`SceneError` listing every problem found in ``scene``.
+
+    Independent settings are checked independently, so a scene with several mistakes
+    gets them all reported at once, each naming its field; checks that need a sound
+    geometry and boundary (sampling the formulas on Gamma_N, Gamma_D, Gamma_C) run only
+    when those are sound.
+    """
+    if not isinstance(scene, Scene):
+        raise SceneTypeError("scene", f"must be an ngdual.scene.Scene (see load_scene), got "
+                                      f"{type(scene).__name__}")
+    problems = _Problems()
+    for f, m in _type_problems(scene):
+        problems.add(f, m)
+    wrong = {f.split(".")[0] for f in (p[0] for p in problems.found)}
+    ok = {section: section not in wrong for section in ("geometry", "boundary", *_SECTIONS)}
+    if ok["geometry"]:
+        ok["geometry"] = problems.run(_validate_geometry, scene.geometry)
+    if ok["geometry"] and ok["boundary"]:
+        ok["boundary"] = problems.run(_validate_boundary, scene)
+    if ok["material"]:
+        problems.run(_validate_material, scene.material)
+    loads = {}
+    if ok["loads"]:
+        for key in ("body_force", "traction", "displacement"):
+            loads[key] = problems.run(_pair, getattr(scene.loads, key), f"loads.{key}",
+                                      value=True)
+        ok["loads"] = all(v is not None for v in loads.values())
+    if ok["contact"]:
+        ok["contact"] = problems.run(_validate_contact_settings, scene.contact)
+    if ok["friction"]:
+        ok["friction"] = problems.run(_validate_friction_settings, scene)
+    if ok["solver"]:
+        _validate_solver(scene.solver, problems)
+    if all(ok[k] for k in ("geometry", "boundary", "loads", "contact", "friction")):
+        if problems.run(_validate_contact, scene, loads["displacement"]):
+            problems.run(_validate_data_on_sides, scene, loads)
+    problems.raise_any()
+
+
+def _validate_material(mat: Material) -> None:
+    problems = _Problems()
+    with problems.check():
+        _positive(mat.E, "material.E")
+        if not E_RANGE[0] <= mat.E <= E_RANGE[1]:
+            raise SceneError("material.E", f"{mat.E:g} is outside [{E_RANGE[0]:g}, "
+                                           f"{E_RANGE[1]:g}], where the compliance 1/E and "
+                                           "the stresses stay within double precision; "
+                                           "rescale the units")
+    if not -1 < mat.nu < 0.5:
+        problems.add("material.nu", f"Poisson's ratio must lie in (-1, 0.5), got {mat.nu!r}")
+    problems.raise_any()
+
+
+def _validate_contact_settings(con: Contact) -> None:
+    problems = _Problems()
+    with problems.check():
+        _expression(con.gap_formula, "contact.gap")
+    if con.ends not in CONTACT_ENDS:
+        problems.add("contact.ends", f"unknown choice {con.ends!r}; use one of "
+                                     + ", ".join(CONTACT_ENDS))
+    with problems.check():
+        _positive(con.htilde_factor, "contact.htilde_factor", integer=True)
+    if con.hhat_factor not in (1, 2):
+        problems.add("contact.hhat_factor", f"must be 1 (h^ = h~) or 2 (h^ = 2h~), "
+                                            f"got {con.hhat_factor!r}")
+    problems.raise_any()
+
+
+def _validate_friction_settings(scene: Scene) -> None:
+    fr = scene.friction
+    problems = _Problems()
     if fr.law not in FRICTION_LAWS:
-        raise SceneError("friction.law", f"unknown friction law {fr.law!r}; use one of "
-                                         + ", ".join(FRICTION_LAWS))
-    if isinstance(fr.mu, bool) or not isinstance(fr.mu, (int, float)) or not fr.mu >= 0:
-        raise SceneError("friction.mu", f"friction coefficient must be >= 0, got {fr.mu!r}")
+        problems.add("friction.law", f"unknown friction law {fr.law!r}; use one of "
+                                     + ", ".join(FRICTION_LAWS))
+    elif fr.law != "none" and not scene.has_contact:
+        problems.add("friction.law", f"{fr.law!r} friction needs a contact boundary "
+                                     "(boundary.contact is empty)")
+    if not (math.isfinite(fr.mu) and fr.mu >= 0):
+        problems.add("friction.mu", f"friction coefficient must be >= 0, got {fr.mu!r}")
+    elif fr.law == "coulomb" and fr.mu == 0:
+        problems.add("friction.mu", "Coulomb friction needs a coefficient mu > 0 (mu = 0 is "
+                                    "frictionless: use friction.law = \"none\")")
     if fr.normal_stress not in NORMAL_STRESSES:
-        raise SceneError("friction.normal_stress", f"unknown choice {fr.normal_stress!r}; use "
-                                                   "one of " + ", ".join(NORMAL_STRESSES))
-    bound = _expression(fr.bound, "friction.bound")
-    if scene.has_contact:
-        xy, normals = contact_samples(scene)
-        x, y = xy[:, 0], xy[:, 1]
-        with np.errstate(invalid="ignore", divide="ignore"):
-            g = gap_at(con, xy, normals)
-            b = bound.numpy(x, y)
-        if not np.all(np.isfinite(g)):
-            raise SceneError("contact.gap", f"{con.gap_formula!r} is not finite on Gamma_C")
-        if g.min() < 0:
-            i = int(np.argmin(g))
-            raise SceneError("contact.gap", f"negative gap {g[i]:.3g} at ({x[i]:.3g}, {y[i]:.3g}); "
-                                            "the gap must be >= 0")
-        if fr.law == "tresca" and (not np.all(np.isfinite(b)) or b.min() < 0):
-            raise SceneError("friction.bound", "the Tresca bound F must be finite and >= 0 "
-                                               "on Gamma_C")
-    elif fr.law != "none":
-        raise SceneError("friction.law", f"{fr.law!r} friction needs a contact boundary "
-                                         "(boundary.contact is empty)")
-    if sol.method not in SOLVER_METHODS:
-        raise SceneError("solver.method", f"unknown solver method {sol.method!r}; use one of "
-                                          + ", ".join(SOLVER_METHODS))
-    if sol.metric not in METRICS:
-        raise SceneError("solver.metric", f"unknown metric {sol.metric!r}; use one of "
-                                          + ", ".join(METRICS))
-    if sol.loop_order not in LOOP_ORDERS:
-        raise SceneError("solver.loop_order", f"unknown loop order {sol.loop_order!r}; use one "
-                                              "of " + ", ".join(LOOP_ORDERS))
-    if sol.friction_metric not in FRICTION_METRICS:
-        raise SceneError("solver.friction_metric", f"unknown metric {sol.friction_metric!r}; "
-                                                   "use one of " + ", ".join(FRICTION_METRICS))
-    if not 0 < sol.rho2 < 2:
-        raise SceneError("solver.rho2", f"rho2 = {sol.rho2} is outside (0, 2), where the nu "
+        problems.add("friction.normal_stress", f"unknown choice {fr.normal_stress!r}; use "
+                                               "one of " + ", ".join(NORMAL_STRESSES))
+    with problems.check():
+        _expression(fr.bound, "friction.bound")
+    problems.raise_any()
+
+
+def _validate_solver(sol: Solver, problems: _Problems) -> None:
+    choices = {"method": SOLVER_METHODS, "metric": METRICS, "loop_order": LOOP_ORDERS,
+               "friction_metric": FRICTION_METRICS}
+    for key, allowed in choices.items():
+        value = getattr(sol, key)
+        if value not in allowed:
+            problems.add(f"solver.{key}", f"unknown {key.replace('_', ' ')} {value!r}; use "
+                                          "one of " + ", ".join(allowed))
+    for key in ("rho", "eps", "rho1", "rho2", "eps1", "eps2"):
+        if problems.run(_positive, getattr(sol, key), f"solver.{key}") and key == "rho2" \
+                and not sol.rho2 < 2:
+            problems.add("solver.rho2", f"rho2 = {sol.rho2} is outside (0, 2), where the nu "
                                         "iteration converges (it is relative to the stability "
                                         "bound)")
-    for key in ("rho", "eps", "rho1", "rho2", "eps1", "eps2"):
-        _positive(getattr(sol, key), f"solver.{key}")
-    _positive(sol.max_iter, "solver.max_iter", integer=True)
+    problems.run(_positive, sol.max_iter, "solver.max_iter", integer=True)
+
+
+def _validate_data_on_sides(scene: Scene, loads: dict[str, list[Expression]]) -> None:
+    """Gap, Tresca bound, traction and boundary displacement where they act.
+
+    Each formula must be finite on its closed sides (their end points are mesh vertices)
+    and integrable there (:func:`_integral_diverges_near`); the gap must be >= 0 and a
+    Tresca bound >= 0 and not zero everywhere. The body force and the quadrature points
+    of the actual mesh are checked before assembly (:mod:`ngdual.quadrature_check`).
+    """
+    problems = _Problems()
+    curves = scene.geometry.curves()
+    where = {"neumann": "Gamma_N", "dirichlet": "Gamma_D", "contact": "Gamma_C"}
+    fields = [(f"loads.traction[{i}]", e, "neumann") for i, e in enumerate(loads["traction"])]
+    fields += [(f"loads.displacement[{i}]", e, "dirichlet")
+               for i, e in enumerate(loads["displacement"])]
+    con, fr = scene.contact, scene.friction
+    if scene.has_contact and con.foundation is None:
+        fields.append(("contact.gap", Expression(con.gap_formula), "contact"))
+    if fr.law == "tresca":
+        fields.append(("friction.bound", Expression(fr.bound), "contact"))
+    for name, expr, role in fields:
+        with problems.check():
+            _formula_on_sides(expr, name, [c for c in curves if c.label in scene.labels(role)],
+                              where[role])
+    if problems.found:
+        problems.raise_any()
+    if not scene.has_contact:
+        return
+    xy, normals = contact_samples(scene)
+    x, y = xy[:, 0], xy[:, 1]
+    g = gap_at(con, xy, normals)
+    if not np.all(np.isfinite(g)):
+        i = int(np.argmin(np.isfinite(g)))
+        problems.add("contact.gap", f"not finite on Gamma_C at ({x[i]:.4g}, {y[i]:.4g})")
+    elif g.min() < 0:
+        i = int(np.argmin(g))
+        problems.add("contact.gap", f"negative gap {g[i]:.3g} at ({x[i]:.3g}, {y[i]:.3g}); "
+                                    "the gap must be >= 0")
+    if fr.law == "tresca":
+        b = Expression(fr.bound).numpy(x, y)
+        if b.min() < 0:
+            i = int(np.argmin(b))
+            problems.add("friction.bound", f"the Tresca bound F must be >= 0 on Gamma_C, got "
+                                           f"{b[i]:.3g} at ({x[i]:.4g}, {y[i]:.4g})")
+        elif b.max() == 0:
+            problems.add("friction.bound", "Tresca friction needs a bound F > 0 on part of "
+                                           "Gamma_C (F = 0 everywhere is frictionless: use "
+                                           "friction.law = \"none\")")
+    problems.raise_any()
+
+
+PROBE_POINTS = 8192   # samples per side in which the largest values of a formula are sought
+POLE_ORDER = 0.99     # |f| ~ |s - a|^-p near a with p >= 1 is not integrable
+
+
+def _formula_on_sides(expr: Expression, field_name: str, curves: list, where: str) -> None:
+    """Refuse a formula that is not finite, or not integrable, on the closed ``curves``."""
+    if expr.constant is not None:  # folded and checked finite at parse time
+        return
+    for curve in curves:
+        s = np.concatenate([[0.0, 1.0], (np.arange(PROBE_POINTS) + 0.5) / PROBE_POINTS])
+        xy = curve.at(s)
+        values = expr.numpy(xy[:, 0], xy[:, 1])
+        bad = ~np.isfinite(values)
+        if bad.any():
+            i = int(np.argmax(bad))
+            raise SceneError(field_name, f"{quote(expr.text)} is not finite on {where} at "
+                                         f"({xy[i, 0]:.4g}, {xy[i, 1]:.4g}) "
+                                         f"(value {values[i]})")
+        pole = _pole(expr, curve, s, np.abs(values))
+        if pole is not None:
+            point, order, value = pole
+            raise SceneError(field_name, f"{quote(expr.text)} is not integrable on {where}: "
+                             f"|f| grows like 1/distance^{order:.2g} towards ({point[0]:.6g}, "
+                             f"{point[1]:.6g})" + (f" (value {value})" if not
+                                                   np.isfinite(value) else ""))
+
+
+def _pole(expr: Expression, curve, s: np.ndarray, values: np.ndarray):
+    """``(point, order, value)`` of a non-integrable singularity of ``expr`` on ``curve``.
+
+    The (up to) three largest sampled values of |f| are zoomed in on together (the
+    largest value in a window shrinking 20x per step locates a maximum to round-off),
+    and the growth of |f| towards each measured between the distances 1e-7 and 1e-10
+    (in the side's parameter): a pole |s - a|^-p gives the order p, a bounded or merely
+    steep function about 0, a logarithm about 0.1. None when every order is below 1.
+    """
+    def f(t):
+        q = curve.at(np.clip(t, 0.0, 1.0).ravel())
+        return np.abs(expr.numpy(q[:, 0], q[:, 1])).reshape(np.shape(t))
+
+    width = 1.0 / PROBE_POINTS
+    starts: list[float] = []
+    for i in np.argsort(values)[::-1][:64]:
+        if len(starts) < 3 and all(abs(s[i] - t) >= 4 * width for t in starts):
+            starts.append(float(s[i]))
+    a, w = np.array(starts), width
+    offsets = np.linspace(-1.0, 1.0, 41)
+    for _ in range(8):
+        t = a[:, None] + w * offsets[None, :]
+        v = f(t)
+        # a non-finite value is the singular point itself
+        v = np.where(np.isfinite(v), v, np.inf)
+        a, w = t[np.arange(len(a)), np.argmax(v, axis=1)], w / 20
+    probes = a[:, None] + np.array([-1e-10, -1e-7, 1e-10, 1e-7])[None, :]
+    v = f(probes)
+    peaks = f(a)
+    inside = (probes >= 0) & (probes <= 1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        orders = np.log10(v[:, [0, 2]] / v[:, [1, 3]]) / 3
+    orders = np.where(inside[:, [0, 2]] & inside[:, [1, 3]] & (v[:, [1, 3]] > 0),
+                      np.nan_to_num(orders, nan=0.0, posinf=np.inf), 0.0).max(axis=1)
+    for k in range(len(a)):
+        if orders[k] >= POLE_ORDER:
+            return curve.at(a[k:k + 1])[0], float(orders[k]), float(peaks[k])
+    return None
