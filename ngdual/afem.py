@@ -21,14 +21,16 @@ from collections.abc import Callable
 import ngsolve as ngs
 import numpy as np
 
+from . import budget
 from .boundary import BoundaryMeshes
 from .estimator import Estimate, estimate
 from .forms import assemble
 from .marking import mark
 from .mesh import build_mesh
 from .post import aitken_extrapolate, norms, total_error
-from .scene import Scene
-from .solve import solve_problem, solve_scene
+from .quadrature_check import check_formulas
+from .scene import Scene, SceneError, SceneTypeError, check_level, ensure_valid
+from .solve import check_unknowns, solve_problem, solve_scene
 from .solvers.result import Solution
 
 StepCallback = Callable[[dict, Solution, Estimate, np.ndarray | None], None]
@@ -67,7 +69,7 @@ def refine_towards(scene: Scene, mesh: ngs.Mesh, point, times: int
 
 def adapt(scene: Scene, marking: str = "dorfler", theta: float = 0.5, steps: int = 5,
           level: int | None = None, asymmetry: str = "l2", reference: dict | None = None,
-          on_step: StepCallback | None = None) -> list[dict]:
+          on_step: StepCallback | None = None, allow_large: bool = False) -> list[dict]:
     """Run ``steps`` adaptive steps on ``scene`` from its mesh on ``level``.
 
     Parameters
@@ -87,20 +89,26 @@ def adapt(scene: Scene, marking: str = "dorfler", theta: float = 0.5, steps: int
     on_step : callable, optional
         ``on_step(record, solution, estimate, marked)`` after MARK (``marked`` is
         None on the last step), before the mesh is refined: for output files.
+    allow_large : bool
+        Refine even when the next mesh's estimated memory exceeds what the machine has
+        available (:mod:`ngdual.budget`; refused with a SceneError otherwise).
 
     Returns
     -------
     list of dict
         One record per step (see :func:`step_record`).
     """
-    if steps < 1:
-        raise ValueError(f"steps must be >= 1, got {steps}")
+    _check_adapt_arguments(scene, marking, theta, steps, level, asymmetry, reference, on_step,
+                           allow_large)
+    budget.check(scene.geometry, level, "level", allow_large, method=scene.solver.method)
     mesh = build_mesh(scene.geometry, level)
+    check_formulas(scene, mesh)
     coarse = BoundaryMeshes.for_scene(scene, mesh)
     history = []
     for step in range(steps):
         # SOLVE
         problem = assemble(scene, mesh, coarse)
+        check_unknowns(problem)
         solution = solve_problem(problem)
         # ESTIMATE
         indicators = estimate(solution, asymmetry)
@@ -118,11 +126,58 @@ def adapt(scene: Scene, marking: str = "dorfler", theta: float = 0.5, steps: int
         if marked is None:
             break
         # REFINE
+        _check_refinement_size(scene, mesh, marked, allow_large)
         start = time.perf_counter()
         mesh = refine(mesh, marked)
         coarse = coarse.follow(scene, mesh)
         record["timings_s"]["refine"] = time.perf_counter() - start
     return history
+
+
+MARKINGS = ("max", "fraction", "dorfler")
+ASYMMETRY_NORMS = ("hdiv", "l2")
+
+
+def _check_adapt_arguments(scene, marking, theta, steps, level, asymmetry, reference, on_step,
+                           allow_large) -> None:
+    """A SceneError (SceneTypeError for a wrong type) naming the first bad argument."""
+    ensure_valid(scene)
+    check_level(level, "level", optional=True)
+    if marking not in MARKINGS:
+        raise SceneError("marking", f"unknown marking {marking!r}; use one of "
+                                    + ", ".join(MARKINGS))
+    if isinstance(theta, bool) or not isinstance(theta, (int, float)):
+        raise SceneTypeError("theta", f"must be a number in [0, 1], got {theta!r}")
+    if not 0 <= theta <= 1:
+        raise SceneError("theta", f"must lie in [0, 1], got {theta!r}")
+    if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)):
+        raise SceneTypeError("steps", f"must be an integer >= 1, got {steps!r}")
+    if steps < 1:
+        raise SceneError("steps", f"must be >= 1, got {steps}")
+    if asymmetry not in ASYMMETRY_NORMS:
+        raise SceneError("asymmetry", f"unknown norm {asymmetry!r}; use one of "
+                                      + ", ".join(ASYMMETRY_NORMS))
+    if reference is not None and not isinstance(reference, dict):
+        raise SceneTypeError("reference", f"must be a dict of norms, got "
+                                          f"{type(reference).__name__}")
+    if on_step is not None and not callable(on_step):
+        raise SceneTypeError("on_step", f"must be callable, got {type(on_step).__name__}")
+    if not isinstance(allow_large, bool):
+        raise SceneTypeError("allow_large", f"must be True or False, got {allow_large!r}")
+
+
+def _check_refinement_size(scene: Scene, mesh: ngs.Mesh, marked: np.ndarray,
+                           allow_large: bool) -> None:
+    """Refuse a refinement whose mesh would not fit in memory (bisection of the marked
+    triangles and their closure: at most about 4 new triangles per marked one)."""
+    elements = mesh.ne + 4.0 * int(np.sum(marked))
+    need = budget.solve_memory(elements, scene.solver.method)
+    have = budget.available_memory()
+    if need > have and not allow_large:
+        raise SceneError("steps", f"the next refinement would have about {elements:.3g} "
+                                  f"triangles and need about {need / 2**30:.3g} GiB, more than "
+                                  f"the {have / 2**30:.3g} GiB available; use fewer steps or "
+                                  "pass --allow-large (allow_large=True)")
 
 
 def step_record(step: int, solution: Solution, indicators: Estimate,
@@ -170,8 +225,14 @@ def reference_norms(scene: Scene, levels: list[int]) -> dict:
     Uses the last three of ``levels`` (at least three, consecutive uniform
     refinements); see :func:`ngdual.post.aitken_extrapolate` for its safeguard.
     """
+    ensure_valid(scene)
+    if not isinstance(levels, (list, tuple)):
+        raise SceneTypeError("levels", f"must be a list of levels, got {levels!r}")
+    for level in levels:
+        check_level(level, "levels")
     if len(levels) < 3:
-        raise ValueError("Aitken extrapolation needs at least three levels")
+        raise SceneError("levels", f"Aitken extrapolation needs at least three levels, got "
+                                   f"{list(levels)}")
     sequence = [norms(solve_scene(scene, level)) for level in levels[-3:]]
     return {q: (aitken_extrapolate([s[q] for s in sequence])
                 if all(s[q] is not None for s in sequence) else None)

@@ -10,7 +10,10 @@ runs the adaptive loop and writes ``DIR/history.json`` plus a mesh (.vol, .png) 
 writes them as Jupyter notebooks.
 ``ngdual bench [--levels ...] [--json FILE]`` times the contact solvers against one
 linear solve of the same matrix (the limit ratio, :mod:`ngdual.bench`).
-Exit status: 0 solved and converged, 1 not converged, 2 bad input.
+Exit status: 0 solved and converged, 1 not converged, 2 bad input (one message naming
+every field or flag at fault; nothing is written), 3 an internal error (a bug: the message
+says so; ``ngdual --debug ...`` shows the traceback). Runs whose estimated size exceeds the
+memory available are refused before meshing; ``--allow-large`` runs them anyway.
 """
 
 from __future__ import annotations
@@ -19,9 +22,41 @@ import argparse
 import sys
 from pathlib import Path
 
-from .scene import SceneError, load_scene, shipped_scenes
+from .scene import SceneError, check_level, load_scene, shipped_scenes
 
-EXIT_NOT_CONVERGED, EXIT_BAD_INPUT = 1, 2
+EXIT_NOT_CONVERGED, EXIT_BAD_INPUT, EXIT_INTERNAL = 1, 2, 3
+HISTORY_ROWS = 8  # residuals shown when an iteration fails
+LARGE_MESH = 2e5  # triangles: say so before meshing
+
+
+def _history(err) -> str:
+    """The last residuals of a failed iteration, on one line."""
+    history = list(getattr(err, "history", None) or [])
+    if not history:
+        return ""
+    start = len(history) - min(len(history), HISTORY_ROWS)
+    rows = "  ".join(f"{start + k + 1}: {float(v):.3e}" for k, v in enumerate(history[start:]))
+    return f"\nngdual: residual history, last {len(history) - start} of {len(history)} " \
+           f"steps (step: residual): {rows}"
+
+
+def _not_converged(err) -> int:
+    print(f"ngdual: not converged: {err}{_history(err)}", file=sys.stderr)
+    return EXIT_NOT_CONVERGED
+
+
+def _number(value, flag: str, low: float, high: float, integer: bool = False):
+    """``value`` if it is a (finite) number in [low, high]; a SceneError naming ``flag``."""
+    import math
+
+    kind = "an integer" if integer else "a number"
+    if value is None or not math.isfinite(value) or not low <= value <= high:
+        raise SceneError(flag, f"must be {kind} in [{low:g}, {high:g}], got {value!r}")
+    return value
+
+
+def _levels(levels, flag: str) -> list[int]:
+    return [check_level(level, flag) for level in levels]
 
 
 def _table(record: dict) -> str:
@@ -54,18 +89,22 @@ def _progress():
 
 
 def cmd_solve(args) -> int:
-    from . import plot, post
-    from .io import write_json
+    from . import budget, plot, post
+    from .io import check_output_dir, write_json
     from .solve import solve_scene
     from .solvers.result import ConvergenceError
 
+    level = check_level(args.level, "--level", optional=True)
     scene = load_scene(args.scene, args.set)
-    out = Path(args.out)
+    out = check_output_dir(args.out, "--out")
+    size = budget.check(scene.geometry, level, "--level", args.allow_large,
+                        method=scene.solver.method)
+    if size.elements > LARGE_MESH:
+        print(f"ngdual: {size.describe()}: meshing and solving take a while", file=sys.stderr)
     try:
-        solution = solve_scene(scene, args.level, progress=_progress())
+        solution = solve_scene(scene, level, progress=_progress(), allow_large=args.allow_large)
     except ConvergenceError as err:
-        print(f"ngdual: {err}", file=sys.stderr)
-        return EXIT_NOT_CONVERGED
+        return _not_converged(err)
     record = post.result_record(solution)
     print(_table(record))
     write_json(record, out / "result.json")
@@ -97,12 +136,16 @@ def cmd_scenes(args) -> int:
 
 
 def cmd_dofs(args) -> int:
+    from . import budget
     from .forms import Spaces
     from .mesh import build_mesh
 
+    levels = _levels(args.levels, "--levels")
     scene = load_scene(args.scene, args.set)
+    for level in levels:
+        budget.check(scene.geometry, level, "--levels", args.allow_large, mesh_only=True)
     print("level " + " ".join(f"{k:>9s}" for k in ("X", "M", "S", "N", "C", "L")))
-    for level in args.levels:
+    for level in levels:
         dofs = Spaces.build(scene, build_mesh(scene.geometry, level)).dofs()
         print(f"{level:5d} " + " ".join(f"{v:9d}" for v in dofs.values()))
     return 0
@@ -113,25 +156,36 @@ def cmd_adapt(args) -> int:
     import ngsolve as ngs
     import numpy as np
 
-    from . import plot
+    from . import budget, plot
     from .afem import adapt, reference_norms
-    from .io import write_json
+    from .io import check_output_dir, write_json
     from .post import versions
     from .solvers.result import ConvergenceError
 
+    level = check_level(args.level, "--level", optional=True)
+    _number(args.theta, "--theta", 0, 1)
+    _number(args.steps, "--steps", 1, 10_000, integer=True)
+    if args.reference_levels is not None:
+        _levels(args.reference_levels, "--reference-levels")
+        if len(args.reference_levels) < 3:
+            raise SceneError("--reference-levels", "Aitken extrapolation needs at least three "
+                                                   f"levels, got {args.reference_levels}")
     scene = load_scene(args.scene, args.set)
-    if not 0 <= args.theta <= 1:
-        raise SceneError("--theta", f"must lie in [0, 1], got {args.theta}")
-    if args.steps < 1:
-        raise SceneError("--steps", f"must be >= 1, got {args.steps}")
-    out = Path(args.out)
+    out = check_output_dir(args.out, "--out")
+    budget.check(scene.geometry, level, "--level", args.allow_large, method=scene.solver.method)
+    for reference in args.reference_levels or []:
+        budget.check(scene.geometry, reference, "--reference-levels", args.allow_large,
+                     method=scene.solver.method)
     run = {"scene": scene.name, "marking": args.marking, "theta": args.theta,
-           "steps": args.steps, "level": args.level, "asymmetry": args.asymmetry,
+           "steps": args.steps, "level": level, "asymmetry": args.asymmetry,
            "parameters": scene.to_dict(), "versions": versions(), "history": []}
     if args.reference_levels:
         print(f"reference norms: Aitken extrapolation from levels {args.reference_levels}")
         run["reference_levels"] = args.reference_levels
-        run["reference_norms"] = reference_norms(scene, args.reference_levels)
+        try:
+            run["reference_norms"] = reference_norms(scene, args.reference_levels)
+        except ConvergenceError as err:
+            return _not_converged(err)
 
     def on_step(record, solution, estimate, marked):
         mesh = solution.problem.fes.mesh
@@ -152,11 +206,10 @@ def cmd_adapt(args) -> int:
               + f"  marked {record['marked']}")
 
     try:
-        adapt(scene, args.marking, args.theta, args.steps, args.level, args.asymmetry,
-              run.get("reference_norms"), on_step)
+        adapt(scene, args.marking, args.theta, args.steps, level, args.asymmetry,
+              run.get("reference_norms"), on_step, allow_large=args.allow_large)
     except ConvergenceError as err:
-        print(f"ngdual: {err}", file=sys.stderr)
-        return EXIT_NOT_CONVERGED
+        return _not_converged(err)
     write_json(run, out / "history.json")
     print(f"wrote {out / 'history.json'} and {len(run['history'])} meshes (.vol, .png)")
     return 0 if all(r["converged"] for r in run["history"]) else EXIT_NOT_CONVERGED
@@ -164,10 +217,21 @@ def cmd_adapt(args) -> int:
 
 def cmd_figures(args) -> int:
     """Regenerate the figures and tables of Sections 3.4 and 4.2 into DIR (see figures/)."""
-    from .figures import run_figures
+    from . import budget
+    from .figures import DEFAULT_MAX_LEVEL, THESIS_MAX_LEVEL, run_figures
+    from .io import check_output_dir
+    from .scene import Geometry
 
+    max_level = DEFAULT_MAX_LEVEL if args.max_level is None else args.max_level
+    _number(max_level, "--max-level", 2, THESIS_MAX_LEVEL, integer=True)
+    if args.workers is not None:
+        _number(args.workers, "--workers", 1, 256, integer=True)
+    check_output_dir(args.out, "--out")
+    if args.gallery:
+        check_output_dir(args.gallery, "--gallery")
+    budget.check(Geometry(), max_level, "--max-level", args.allow_large)
     try:
-        summary = run_figures(args.max_level, args.out, args.scheduler, args.workers,
+        summary = run_figures(max_level, args.out, args.scheduler, args.workers,
                               not args.threads, args.only, args.source)
     except (FileNotFoundError, ValueError) as err:
         print(f"ngdual: error: {err}", file=sys.stderr)
@@ -188,14 +252,27 @@ def cmd_figures(args) -> int:
 
 def cmd_bench(args) -> int:
     """Limit ratios of the contact solvers (ngdual.bench): table on stdout, JSON with --json."""
+    from . import budget
     from .bench import CASES, SOLVERS, bench, summary_rows
-    from .io import write_json
+    from .io import check_output_file, write_json
+    from .scene import Geometry
 
-    bad = [c for c in args.cases if c not in CASES] + [s for s in args.solvers if s not in SOLVERS]
-    if bad:
-        print(f"ngdual: error: unknown case or solver {bad[0]!r}; cases: {', '.join(CASES)}; "
-              f"solvers: {', '.join(SOLVERS)}", file=sys.stderr)
-        return EXIT_BAD_INPUT
+    for flag, values, known in (("--cases", args.cases, CASES), ("--solvers", args.solvers,
+                                                                  SOLVERS)):
+        for value in values:
+            if value not in known:
+                raise SceneError(flag, f"unknown {flag[2:-1]} {value!r}; use one of "
+                                       + ", ".join(known))
+    levels = _levels(args.levels, "--levels")
+    if args.timeout is not None:
+        _number(args.timeout, "--timeout", 1e-3, 1e7)
+    _number(args.blas_threads, "--blas-threads", 0, 1024, integer=True)
+    if args.json:
+        check_output_file(args.json, "--json")
+    methods = {"active-set" if s == "active-set" else "uzawa" for s in args.solvers}
+    for level in levels:
+        for method in methods:
+            budget.check(Geometry(), level, "--levels", args.allow_large, method=method)
     header = (f"{'case':20s} {'lvl':>3} {'solver':12s} {'unknowns':>9} {'assemble':>8} "
               f"{'linear':>8} {'contact':>8} {'ratio':>6} {'r_fast':>6} {'outer':>6} "
               f"{'inner':>6} {'RSS MB':>7}")
@@ -215,7 +292,7 @@ def cmd_bench(args) -> int:
               + ("" if row["converged"] else f"  NOT CONVERGED {row['error'] or ''}"),
               flush=True)
 
-    run = bench(args.levels, args.cases, args.solvers, args.isolate, args.timeout, on_record,
+    run = bench(levels, args.cases, args.solvers, args.isolate, args.timeout, on_record,
                 args.blas_threads or None)
     if args.json:
         write_json(run, args.json)
@@ -225,8 +302,11 @@ def cmd_bench(args) -> int:
 
 def cmd_tutorials(args) -> int:
     """List the tutorials; with --notebooks DIR write them (and their solutions) as notebooks."""
+    from .io import check_output_dir
     from .tutorials import list_tutorials, write_notebooks
 
+    if args.notebooks:
+        check_output_dir(args.notebooks, "--notebooks")
     try:
         items = list_tutorials(args.source)
         if args.notebooks:
@@ -247,8 +327,19 @@ def cmd_tutorials(args) -> int:
 
 def parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="ngdual", description=__doc__.splitlines()[0])
+    p.add_argument("--debug", action="store_true",
+                   help="show the Python traceback of any error (for developers)")
+    # --debug after the subcommand too; SUPPRESS keeps a value given before it
+    common = argparse.ArgumentParser(add_help=False)
+    common.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
+                        help=argparse.SUPPRESS)
+    sized = argparse.ArgumentParser(add_help=False, parents=[common])
+    sized.add_argument("--allow-large", action="store_true",
+                       help="run even when the estimated memory exceeds what the machine has "
+                            "available (the estimate is refused otherwise)")
     sub = p.add_subparsers(dest="command", required=True)
-    s = sub.add_parser("solve", help="solve one scene and write DIR/result.json")
+    s = sub.add_parser("solve", help="solve one scene and write DIR/result.json",
+                       parents=[sized])
     s.add_argument("scene", help="path to a TOML scene or the name of a shipped scene")
     s.add_argument("--level", type=int, default=None, help="mesh level (default: the scene's)")
     s.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
@@ -257,14 +348,16 @@ def parser() -> argparse.ArgumentParser:
     s.add_argument("--vtk", action="store_true", help="also write a VTK file for ParaView")
     s.add_argument("--no-plots", action="store_true", help="do not write PNG figures")
     s.set_defaults(func=cmd_solve)
-    sc = sub.add_parser("scenes", help="list the shipped scenes")
+    sc = sub.add_parser("scenes", help="list the shipped scenes", parents=[common])
     sc.set_defaults(func=cmd_scenes)
-    d = sub.add_parser("dofs", help="degrees of freedom per level (Table 3.1), without solving")
+    d = sub.add_parser("dofs", help="degrees of freedom per level (Table 3.1), without solving",
+                       parents=[sized])
     d.add_argument("scene")
     d.add_argument("--levels", type=int, nargs="+", default=[1, 2, 3, 4])
     d.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
     d.set_defaults(func=cmd_dofs)
-    ad = sub.add_parser("adapt", help="adaptive refinement (Chapter 4), writes DIR/history.json")
+    ad = sub.add_parser("adapt", help="adaptive refinement (Chapter 4), writes DIR/history.json",
+                        parents=[sized])
     ad.add_argument("scene")
     ad.add_argument("--marking", choices=["max", "fraction", "dorfler"], default="dorfler")
     ad.add_argument("--theta", type=float, default=0.5, help="marking parameter in [0, 1]")
@@ -279,7 +372,8 @@ def parser() -> argparse.ArgumentParser:
     ad.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
     ad.add_argument("--out", default="out-adapt", help="output folder (default: out-adapt)")
     ad.set_defaults(func=cmd_adapt)
-    tu = sub.add_parser("tutorials", help="list the tutorials or write them as notebooks")
+    tu = sub.add_parser("tutorials", help="list the tutorials or write them as notebooks",
+                        parents=[common])
     tu.add_argument("--notebooks", metavar="DIR", default=None,
                     help="write the tutorials as .ipynb notebooks into DIR (needs jupytext)")
     tu.add_argument("--solutions", action="store_true",
@@ -288,7 +382,8 @@ def parser() -> argparse.ArgumentParser:
                     help="tutorials folder (default: tutorials/ of the source checkout)")
     tu.set_defaults(func=cmd_tutorials)
     fg = sub.add_parser("figures", help="regenerate every figure and table of Sections 3.4 "
-                                        "and 4.2 (and the work-precision study)")
+                                        "and 4.2 (and the work-precision study)",
+                        parents=[sized])
     fg.add_argument("--max-level", type=int, default=None, metavar="K",
                     help="finest uniform level; every other size follows from it "
                          "(default 5: 8-11 min on 2 cores; 8 = the thesis scale)")
@@ -310,7 +405,8 @@ def parser() -> argparse.ArgumentParser:
                          "for the README)")
     fg.set_defaults(func=cmd_figures)
     be = sub.add_parser("bench", help="contact-solve time / one linear solve, per level and "
-                                      "solver (Example 3.46), JSON with --json")
+                                      "solver (Example 3.46), JSON with --json",
+                        parents=[sized])
     be.add_argument("--levels", type=int, nargs="+", default=[1, 2, 3, 4, 5])
     be.add_argument("--cases", nargs="+", default=["thesis-3.46", "thesis-3.46-coulomb"])
     be.add_argument("--solvers", nargs="+", default=["uzawa", "uzawa-tuned", "active-set"])
@@ -327,12 +423,34 @@ def parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    args = parser().parse_args(argv)
+    """Run the command line; returns the exit status (see the module docstring).
+
+    Users never see a traceback: bad input is one message naming the field or flag
+    (status 2), anything unexpected one line saying it is a bug (status 3);
+    ``--debug`` lets every exception through with its traceback.
+    """
+    try:
+        args = parser().parse_args(argv)
+    except SystemExit as err:  # argparse printed the usage error (or the help)
+        return err.code if isinstance(err.code, int) else EXIT_BAD_INPUT
+    if args.debug:
+        return args.func(args)
     try:
         return args.func(args)
     except SceneError as err:
         print(f"ngdual: error: {err}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    except MemoryError:
+        print("ngdual: error: out of memory; choose a coarser level or maxh", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except KeyboardInterrupt:
+        print("ngdual: interrupted", file=sys.stderr)
+        return 130
+    except Exception as err:  # a bug: one line, the traceback with --debug
+        print(f"ngdual: internal error: {type(err).__name__}: {str(err)[:500]} (a bug in "
+              "ngdual: run again with --debug for the traceback and report it)",
+              file=sys.stderr)
+        return EXIT_INTERNAL
 
 
 if __name__ == "__main__":

@@ -17,7 +17,7 @@ from netgen.meshing import Element1D, Element2D, FaceDescriptor, MeshPoint, Pnt
 from netgen.meshing import Mesh as NetgenMesh
 
 from . import geometry
-from .scene import Geometry
+from .scene import Geometry, check_level, validate_geometry
 
 THESIS_LABELS = ("bottom", "right", "top", "left")
 
@@ -103,8 +103,14 @@ def refine_uniformly(mesh: ngs.Mesh, times: int) -> ngs.Mesh:
 
 
 def build_mesh(geo: Geometry, level: int | None = None) -> ngs.Mesh:
-    """The mesh of a scene geometry on ``level`` (default: the geometry's own level)."""
-    level = geo.level if level is None else level
+    """The mesh of a scene geometry on ``level`` (default: the geometry's own level).
+
+    The geometry is checked first (:func:`ngdual.scene.validate_geometry`): netgen never
+    sees a degenerate polygon. The size is not checked here; :func:`ngdual.budget.check`
+    does that for the runs that build meshes on a user's request.
+    """
+    validate_geometry(geo)
+    level = geo.level if level is None else check_level(level, "level")
     if geo.kind == "thesis-3.46":
         return thesis_mesh(level)
     return polygon_mesh(geo.points, geo.labels, geo.maxh, level, geo.arcs, geo.side_maxh)

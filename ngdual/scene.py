@@ -27,6 +27,7 @@ from __future__ import annotations
 import copy
 import dataclasses
 import math
+import re
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from importlib import resources
@@ -417,7 +418,7 @@ def load_scene(source: str | Path, overrides: list[str] | None = None) -> Scene:
     """
     name, data = _read_toml(source)
     scene = _build(name, apply_overrides(data, overrides))
-    validate(scene)
+    ensure_valid(scene)
     return scene
 
 
@@ -462,6 +463,19 @@ _FORMULAS = {"contact.gap", "friction.bound", "loads.body_force", "loads.tractio
              "loads.displacement"}
 
 
+def _field_type_problems(section: str, obj) -> list[tuple[str, str]]:
+    """``(field, message)`` for every setting of one section whose type is wrong."""
+    found = []
+    for f in dataclasses.fields(obj):
+        key, value = f"{section}.{f.name}", getattr(obj, f.name)
+        kinds = [k.strip() for k in str(f.type).split("|")]
+        if key in _FORMULAS or (value is None and "None" in kinds):
+            continue
+        if isinstance(value, bool) or not isinstance(value, _TYPES[kinds[0]]):
+            found.append((key, f"must be {_TYPE_NAMES[kinds[0]]}, got {value!r}"))
+    return found
+
+
 def _type_problems(scene: Scene) -> list[tuple[str, str]]:
     """``(field, message)`` for every setting of ``scene`` whose type is wrong."""
     found = []
@@ -473,14 +487,7 @@ def _type_problems(scene: Scene) -> list[tuple[str, str]]:
             found.append((section, f"must be a {cls.__module__}.{cls.__name__}, got "
                                    f"{type(obj).__name__}"))
             continue
-        for f in dataclasses.fields(cls):
-            key, value = f"{section}.{f.name}", getattr(obj, f.name)
-            kinds = [k.strip() for k in str(f.type).split("|")]
-            if key in _FORMULAS or (value is None and "None" in kinds):
-                continue
-            ok = _TYPES[kinds[0]]
-            if isinstance(value, bool) or not isinstance(value, ok):
-                found.append((key, f"must be {_TYPE_NAMES[kinds[0]]}, got {value!r}"))
+        found += _field_type_problems(section, obj)
     if not isinstance(scene.boundary, dict):
         found.append(("boundary", f"must be a table role -> labels, got {scene.boundary!r}"))
         return found
@@ -495,6 +502,7 @@ def _type_problems(scene: Scene) -> list[tuple[str, str]]:
 
 KINK_ANGLE = 1e-6  # radians: two contact sides meeting at a larger angle form a kink
 CUSP_ANGLE = np.pi * (1 - 1e-3)
+LABEL = re.compile(r"[A-Za-z0-9_-]+")
 SHORT_SIDE = 1e-9  # relative to the diameter: shorter sides are degenerate (netgen crashes)
 
 
@@ -523,9 +531,10 @@ def _validate_points(geo: Geometry) -> np.ndarray:
             problems.add(f"geometry.points[{i}]", f"must be a pair of finite numbers [x, y], "
                                                   f"got {p!r}")
     if not isinstance(geo.labels, (list, tuple)) or not all(
-            isinstance(lab, str) and lab for lab in geo.labels):
-        problems.add("geometry.labels", f"must be a list of non-empty strings, got "
-                                        f"{geo.labels!r}")
+            isinstance(lab, str) and LABEL.fullmatch(lab) for lab in geo.labels):
+        # labels become netgen boundary names, selected by regular expressions
+        problems.add("geometry.labels", f"must be a list of names made of letters, digits, "
+                                        f"'_' and '-', got {geo.labels!r}")
     elif len(geo.labels) != len(geo.points):
         problems.add("geometry.labels", f"need one label per side ({len(geo.points)}), "
                                         f"got {len(geo.labels)}")
@@ -552,7 +561,15 @@ def _validate_points(geo: Geometry) -> np.ndarray:
     return pts
 
 
-def _validate_geometry(geo: Geometry) -> None:
+def validate_geometry(geo: Geometry) -> None:
+    """Raise a :class:`SceneError` for a geometry that cannot be meshed (checked before
+    netgen sees it: a zero-length side crashes netgen, a self-intersecting one hangs it)."""
+    if not isinstance(geo, Geometry):
+        raise SceneTypeError("geometry", f"must be an ngdual.scene.Geometry, got "
+                                         f"{type(geo).__name__}")
+    wrong = [(f, m) for f, m in _field_type_problems("geometry", geo)]
+    if wrong:
+        raise SceneError("", "", wrong)
     if geo.kind not in GEOMETRY_KINDS:
         raise SceneError("geometry.kind", f"unknown kind {geo.kind!r}; use one of "
                                           + ", ".join(GEOMETRY_KINDS))
@@ -761,6 +778,29 @@ class SceneTypeError(SceneError, TypeError):
     """An argument of the Python API of the wrong type (a :class:`SceneError` and a TypeError)."""
 
 
+def check_level(level, field_name: str = "level", optional: bool = False) -> int | None:
+    """``level`` if it is a mesh level (an integer >= 1; None too if ``optional``)."""
+    if level is None and optional:
+        return None
+    if isinstance(level, bool) or not isinstance(level, (int, np.integer)):
+        raise SceneTypeError(field_name, f"must be an integer >= 1{' or None' * optional}, "
+                                         f"got {level!r}")
+    if level < 1:
+        raise SceneError(field_name, f"must be >= 1 (level 1 is the initial mesh), got {level}")
+    return int(level)
+
+
+def ensure_valid(scene: Scene) -> None:
+    """:func:`validate` ``scene`` unless it was validated and has not changed since."""
+    if not isinstance(scene, Scene):
+        raise SceneTypeError("scene", f"must be an ngdual.scene.Scene (see load_scene), got "
+                                      f"{type(scene).__name__}")
+    key = repr(scene)
+    if scene.__dict__.get("_validated_as") != key:
+        validate(scene)
+        scene.__dict__["_validated_as"] = key
+
+
 E_RANGE = (1e-30, 1e30)  # beyond, C^-1 ~ 1/E and sigma ~ E reach the ends of double precision
 
 
@@ -781,7 +821,7 @@ def validate(scene: Scene) -> None:
     wrong = {f.split(".")[0] for f in (p[0] for p in problems.found)}
     ok = {section: section not in wrong for section in ("geometry", "boundary", *_SECTIONS)}
     if ok["geometry"]:
-        ok["geometry"] = problems.run(_validate_geometry, scene.geometry)
+        ok["geometry"] = problems.run(validate_geometry, scene.geometry)
     if ok["geometry"] and ok["boundary"]:
         ok["boundary"] = problems.run(_validate_boundary, scene)
     if ok["material"]:

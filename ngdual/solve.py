@@ -17,29 +17,80 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 
+import numpy as np
+
+from . import budget
 from .forms import DiscreteProblem, assemble
 from .mesh import build_mesh
-from .scene import Scene
+from .quadrature_check import check_formulas
+from .scene import Scene, SceneError, SceneTypeError, check_level, ensure_valid
 from .solvers.fast import fast_solve
 from .solvers.nested import nested_uzawa
-from .solvers.result import Solution
+from .solvers.result import ConvergenceError, Solution
 from .solvers.uzawa import solve_linear, uzawa
 
 
 def solve_scene(scene: Scene, level: int | None = None,
-                progress: Callable[[int, float], None] | None = None) -> Solution:
-    """Mesh, assemble and solve ``scene`` on ``level`` (default: the scene's level)."""
+                progress: Callable[[int, float], None] | None = None,
+                allow_large: bool = False) -> Solution:
+    """Mesh, assemble and solve ``scene`` on ``level`` (default: the scene's level).
+
+    The scene is validated (once: a scene from :func:`ngdual.scene.load_scene` is not
+    checked again unless it was changed), the size of the mesh is estimated and refused
+    if it would not fit in memory (``allow_large=True`` tries anyway,
+    :mod:`ngdual.budget`), and the formulas are checked on the mesh before assembly
+    (:mod:`ngdual.quadrature_check`). Bad input raises :class:`ngdual.scene.SceneError`
+    naming the argument or field; a solve that fails raises
+    :class:`ngdual.solvers.result.ConvergenceError`.
+    """
     start = time.perf_counter()
-    problem = assemble(scene, build_mesh(scene.geometry, level))
+    ensure_valid(scene)
+    level = check_level(level, "level", optional=True)
+    if progress is not None and not callable(progress):
+        raise SceneTypeError("progress", f"must be a callable progress(iteration, "
+                                         f"increment), got {type(progress).__name__}")
+    if not isinstance(allow_large, bool):
+        raise SceneTypeError("allow_large", f"must be True or False, got {allow_large!r}")
+    budget.check(scene.geometry, level, "level", allow_large, method=scene.solver.method)
+    mesh = build_mesh(scene.geometry, level)
+    check_formulas(scene, mesh)
+    problem = assemble(scene, mesh)
     problem.level = scene.geometry.level if level is None else level
+    check_unknowns(problem)
     solution = solve_problem(problem, progress)
     solution.timings["total"] = time.perf_counter() - start
     return solution
 
 
+def check_unknowns(problem: DiscreteProblem) -> None:
+    """Refuse coarse boundary meshes that leave a multiplier without unknowns.
+
+    With h~ = ``htilde_factor`` h longer than a whole contact (or Neumann) chain, the
+    multipliers, zero at the chain's ends, have no unknown left and the contact or
+    traction condition would silently not be imposed.
+    """
+    scene, dofs = problem.scene, problem.spaces.dofs()
+    level = getattr(problem, "level", None)
+    mesh = f"level {level}" if level is not None else "this mesh"
+    factor = scene.contact.htilde_factor
+    for key, role, name in (("C", "contact", "lambda on Gamma_C"),
+                            ("N", "neumann", "phi on Gamma_N")):
+        if scene.labels(role) and dofs[key] == 0:
+            raise SceneError("contact.htilde_factor", f"h~ = {factor} h leaves {name} without "
+                             f"unknowns on {mesh}: Gamma_{role[0].upper()} has too few edges; "
+                             "choose a smaller htilde_factor or a finer level or maxh")
+    if scene.has_friction and dofs["L"] == 0:
+        raise SceneError("contact.hhat_factor", f"h^ leaves nu without unknowns on {mesh}; "
+                                                "choose hhat_factor = 1 or a finer level")
+
+
 def solve_problem(problem: DiscreteProblem,
                   progress: Callable[[int, float], None] | None = None) -> Solution:
-    """Run the algorithm the scene of an assembled ``problem`` calls for (any mesh)."""
+    """Run the algorithm the scene of an assembled ``problem`` calls for (any mesh).
+
+    A solution with a non-finite value or residual is never returned as a solution:
+    it raises :class:`ngdual.solvers.result.ConvergenceError` with the history.
+    """
     scene = problem.scene
     if scene.solver.method in ("auto", "active-set"):
         solution = fast_solve(problem, max_iter=scene.solver.max_iter, metric=scene.solver.metric,
@@ -57,4 +108,20 @@ def solve_problem(problem: DiscreteProblem,
                                 max_iter=s.max_iter, metric=s.metric, loop_order=s.loop_order,
                                 friction_metric=s.friction_metric,
                                 progress=progress)
+    _check_finite(solution)
     return solution
+
+
+def _check_finite(solution: Solution) -> None:
+    """Non-finite unknowns or residuals (overflow, a singular factor) are a failed solve."""
+    bad = [] if np.all(np.isfinite(solution.x)) else ["the unknowns"]
+    if solution.nu is not None and not np.all(np.isfinite(solution.nu)):
+        bad.append("nu")
+    bad += [f"residual {k}" for k, v in solution.residuals.items()
+            if isinstance(v, float) and not np.isfinite(v)]
+    if bad:
+        solution.converged = False
+        raise ConvergenceError(f"{solution.method}: {', '.join(bad)} are not finite (inf or "
+                               "nan): the problem overflows double precision or is singular; "
+                               "check the units of material.E and the loads",
+                               list(solution.history))
