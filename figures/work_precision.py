@@ -1,144 +1,186 @@
-"""What accuracy costs in time: error against wall time and DOFs, every method and solver.
+"""What accuracy costs in time: true errors against wall time and unknowns, every method.
 
-For Example 3.46 without friction and with Coulomb friction mu_f = 0.5: uniform refinement
-(levels 1..K) with every solver variant of ngdual.figures.SOLVER_VARIANTS (the default
-active-set solver and the thesis' Uzawa iterations), and the default solver with the three
-adaptive strategies (max theta = 0.5, fraction theta = 0.2, Doerfler theta = 0.5).
+Problems (ngdual.figures.TRUTH_PROBLEMS): Example 3.46 without friction and with Coulomb
+friction mu_f = 0.5, both with consistent end values at the clamped sides (the thesis'
+lambda = 0 there contradicts u = 0 on Gamma_D and leaves sigma ~ 1/r, not in L2: no error
+is finite), and the rigid flat punch.
 
-Two measures of the error. e_tot of (3.124): norms against Aitken limits, here of the
-uniform levels K-1, K, K+1 (K+1 only for this reference, default solver), so that level K
-has an error too. It compares norms, not functions: the adaptive meshes resolve the corner
-singularities of sigma that the uniform levels do not, their ||sigma||_X exceeds the
-uniform estimate of its limit, and (3.124) then reports a large error for them. Second
-row: the a posteriori estimator eta = (sum_T eta_{tot,T}^2)^(1/2) of (4.50), the measure
-the adaptive algorithms reduce.
+The error of every point is a true error (ngdual.verification.reference) against an
+overkill: ngdual's solution two uniform levels beyond the finest studied, checked by
+Richardson from the two levels below it (the overkill's own error is in the JSON and the
+index; a target below about twice it is not resolved). Two measures: the relative L2 error
+of the contact pressure on Gamma_C (ngdual: -sigma_n^h projected onto the h~ hats, as in
+ngdual.verification.analytic; the peer: its Nitsche pressure), and the relative error of
+sigma in the compliance norm (int A tau : tau)^(1/2) -- for the flat punch the pressure is
+not in L2 at the punch edges, so its pressure errors converge only logarithmically and the
+sigma panel is the one to read.
 
-Time: uniform -- the wall time of one solve on that level (mesh, assembly, factorisation,
-condensation, iteration; not the estimator); adaptive -- the cumulative wall time of all
-SOLVE-ESTIMATE-MARK-REFINE steps up to that mesh. Sweep tasks run two at a time on this
-machine, so the times carry that noise. The table gives, for the errors of the uniform
-levels 2..K (default solver), the least time (and its DOFs) each method needs to reach them.
+Methods: uniform refinement with the default active-set solver and with the thesis' Uzawa
+iterations; adaptive refinement (default solver) with max marking (theta = 0.5, 0.25) and
+Doerfler marking (theta = 0.5, 0.3) from level 1 up to the triangles of the finest uniform
+level; the primal peer benchmarks/primal_peer.py (P1 and P2 displacements, Nitsche
+contact, semismooth Newton) on the same uniform meshes and one level beyond.
+
+Time: uniform and peer -- the wall time of one solve (mesh, assembly, solve; not the
+estimator); adaptive -- cumulative over all SOLVE-ESTIMATE-MARK-REFINE steps to that mesh.
+The table gives the least time to reach 5 %, 2 % and 1 % error per method, and the ratio
+of the fastest ngdual method to the fastest peer.
 """
+
+import os
 
 from ngdual import plot
 from ngdual.figures import (
-    ADAPTIVE_RUNS,
-    PROBLEM_TITLES,
-    SOLVER_VARIANTS,
-    adapt_task,
-    errors,
+    TRUTH_PROBLEMS,
     markdown_table,
-    reference_norms,
     script_main,
-    solve,
+    true_error_study,
 )
 
 THESIS = "Work-precision (beyond the thesis)"
-STUDIES = ("uniform-frictionless", "uniform-coulomb", "variants", "adaptive",
-           "work-precision-reference")
+STUDIES = ("truth",)
+TARGETS = (0.05, 0.02, 0.01)
+MEASURES = {"pressure": "pressure error on $\\Gamma_C$ (rel. $L^2$) [-]",
+            "sigma_energy": "error of $\\sigma$ (rel. compliance norm) [-]"}
 MARKERS = "osD^vP*X"
-MEASURES = {"e_tot": r"estimated $e_{tot}$ (3.124) [norm units]",
-            "eta": r"estimator $\eta$ (4.50) [norm units]"}
-ROUND_OFF = 1e-3  # solvers agree to their tolerance, not to the last digit
 
 
-def cheapest(points: list[dict], key: str, target: float) -> dict | None:
-    """The point of least time whose error ``key`` is at most ``target`` (up to round-off)."""
-    hits = [p for p in points if p[key] is not None and p[key] <= target * (1 + ROUND_OFF)]
+def is_peer(method: str) -> bool:
+    return method.startswith("primal")
+
+
+def time_to_accuracy(points: list[dict], measure: str, target: float) -> dict | None:
+    """The point of least time whose error ``measure`` is at most ``target``."""
+    hits = [p for p in points if p.get(measure) is not None and p[measure] <= target]
     return min(hits, key=lambda p: p["time_s"]) if hits else None
 
 
-def run(ctx):
-    # COMPUTE: every curve's points (DOFs, time, e_tot, eta)
-    rows = []
-    for problem in ("frictionless", "coulomb"):
-        reference = reference_norms(ctx.compute(
-            [solve(ctx.plan, problem, lv) for lv in ctx.plan.work_precision_reference_levels]))
-        for variant in SOLVER_VARIANTS:
-            if problem not in variant.problems:
-                continue
-            records = ctx.compute([solve(ctx.plan, problem, lv, variant.overrides)
-                                   for lv in ctx.plan.levels])
-            for lv, r, e in zip(ctx.plan.levels, records, errors(records, reference)):
-                ok = r is not None and r["status"] == "ok"
-                rows.append({"problem": problem, "method": f"uniform, {variant.name} solver",
-                             "level_or_step": lv, "status": r["status"] if r else "missing",
-                             "ndof": r["ndof"] if ok else None,
-                             "time_s": r["timings_s"]["total"] if ok else None,
-                             "e_tot": e["e_tot"] if ok and e else None,
-                             "eta": r["estimator"]["eta"] if ok else None,
-                             "iterations": r["iterations"] if ok else None})
-        for strategy in ADAPTIVE_RUNS:
-            task = adapt_task(ctx.plan, problem, strategy)
-            history = (ctx.record(task) or {}).get("history", [])
-            for r, e in zip(history, errors(history, reference)):
-                rows.append({"problem": problem, "method": f"{strategy} marking theta = "
-                             f"{task.params['theta']}, default solver",
-                             "level_or_step": r["step"],
-                             "status": "ok" if r["converged"] else "not-converged",
-                             "ndof": r["dofs"]["total"], "time_s": r["cumulative_s"],
-                             "e_tot": e["e_tot"] if e else None, "eta": r["eta"],
-                             "iterations": r["iterations"]})
-    curves = {}
-    for r in rows:
-        if r["time_s"] is not None and r["ndof"] is not None:
-            curves.setdefault((r["problem"], r["method"]), []).append(r)
-    # WRITE
-    data = ctx.write_csv("work_precision.csv", rows, "error (3.124), estimator (4.50), wall "
-                         "time and DOFs of every method")
+def accuracy_table(rows: list[dict]) -> list[dict]:
+    """Least time to each target per problem, measure and method, and per problem the
+    fastest ngdual method against the fastest peer (``ratio`` = ngdual time / peer time)."""
     table = []
-    for (problem, method), pts in curves.items():
-        base = [r for r in rows if r["problem"] == problem and r["status"] == "ok"
-                and r["method"] == "uniform, default solver" and r["level_or_step"] >= 2]
-        for key in MEASURES:
-            for target in base:
-                hit = cheapest(pts, key, target[key])
-                table.append({"problem": problem, "measure": key,
-                              "target": f"{key}(level {target['level_or_step']}) = "
-                                        f"{target[key]:.3g}",
-                              "method": method, "time_s": hit["time_s"] if hit else None,
-                              "ndof": hit["ndof"] if hit else None,
-                              "level_or_step": hit["level_or_step"] if hit else None})
+    for problem in TRUTH_PROBLEMS:
+        mine = [r for r in rows if r["problem"] == problem and r["status"] == "ok"]
+        methods = list(dict.fromkeys(r["method"] for r in mine))
+        for measure in MEASURES:
+            for target in TARGETS:
+                best = {}
+                for method in methods:
+                    hit = time_to_accuracy([r for r in mine if r["method"] == method],
+                                           measure, target)
+                    table.append({"problem": problem, "measure": measure, "target": target,
+                                  "method": method, "time_s": hit and hit["time_s"],
+                                  "ndof": hit and hit["ndof"],
+                                  "level_or_step": hit and hit["level_or_step"]})
+                    if hit:
+                        side = "peer" if is_peer(method) else "ngdual"
+                        if side not in best or hit["time_s"] < best[side][1]:
+                            best[side] = (method, hit["time_s"])
+                ng, peer = best.get("ngdual"), best.get("peer")
+                table.append({"problem": problem, "measure": measure, "target": target,
+                              "method": "fastest ngdual / fastest peer",
+                              "fastest_ngdual": ng and ng[0], "fastest_peer": peer and peer[0],
+                              "ratio": ng[1] / peer[1] if ng and peer else None})
+    return table
+
+
+def adaptive_verdict(table: list[dict]) -> list[dict]:
+    """Per problem, measure and target: the fastest adaptive run against uniform refinement
+    (active set), by time to accuracy."""
+    out = []
+    keys = {(r["problem"], r["measure"], r["target"]) for r in table}
+    for problem, measure, target in sorted(keys):
+        same = [r for r in table if (r["problem"], r["measure"], r["target"])
+                == (problem, measure, target) and r.get("time_s") is not None]
+        uniform = next((r for r in same if r["method"] == "uniform, active set"), None)
+        adaptive = min((r for r in same if r["method"].startswith("adaptive")),
+                       key=lambda r: r["time_s"], default=None)
+        out.append({"problem": problem, "measure": measure, "target": target,
+                    "uniform_s": uniform and uniform["time_s"],
+                    "adaptive_s": adaptive and adaptive["time_s"],
+                    "adaptive_method": adaptive and adaptive["method"],
+                    "adaptive_wins": (None if not (uniform and adaptive)
+                                      else adaptive["time_s"] < uniform["time_s"])})
+    return out
+
+
+def run(ctx):
+    # COMPUTE: the true errors of every solution (cached with the records)
+    rows, references = [], {}
+    for problem in TRUTH_PROBLEMS:
+        study = true_error_study(ctx, problem)
+        references[problem] = study["reference"]
+        rows += [{"problem": problem, **r} for r in study["rows"]]
+    table = accuracy_table(rows)
+    verdict = adaptive_verdict(table)
+    machine = {"cpus": os.cpu_count(), "load_average": os.getloadavg()}
+    # WRITE
+    data = ctx.write_csv("work_precision.csv", rows, "true errors (pressure, sigma), wall "
+                         "time, DOFs and estimator of every solution")
     summary = ctx.write_csv("work_precision_table.csv", table,
-                            "least wall time (and DOFs) to reach the error of uniform level k")
-    # PLOT: one colour and marker per method, the same in every panel
-    methods = list(dict.fromkeys(m for _, m in curves))
+                            "least wall time to 5 %, 2 %, 1 % true error; ngdual / peer")
+    js = ctx.write_json("work_precision.json",
+                        {"targets": TARGETS, "time_to_accuracy": table,
+                         "adaptive_vs_uniform": verdict, "references": references,
+                         "machine": machine},
+                        "time to accuracy on true errors, overkill references with their "
+                        "Richardson checks, adaptive against uniform")
+    # PLOT: one row per problem, pressure and sigma against time and DOFs
+    methods = list(dict.fromkeys(r["method"] for r in rows))
     style = {m: {"color": f"C{i % 10}", "marker": MARKERS[i % len(MARKERS)], "ms": 4,
-                 "ls": "-" if m.startswith("uniform") else "--"} for i, m in enumerate(methods)}
+                 "ls": ":" if is_peer(m) else ("-" if m.startswith("uniform") else "--")}
+             for i, m in enumerate(methods)}
     panels = []
-    for problem in ("frictionless", "coulomb"):
-        mine = [(m, pts) for (p, m), pts in curves.items() if p == problem]
-        for key, ylabel in MEASURES.items():
-            for xkey, xlabel in (("time_s", "wall time [s]"), ("ndof", "degrees of freedom [-]")):
+    for problem, tp in TRUTH_PROBLEMS.items():
+        ref = references[problem]
+        for measure, ylabel in MEASURES.items():
+            floor = ref["richardson"][measure]["overkill_error"]
+            for xkey, xlabel in (("time_s", "wall time [s]"), ("ndof", "unknowns [-]")):
+                curves = []
+                for m in methods:
+                    pts = sorted((r for r in rows if r["problem"] == problem
+                                  and r["method"] == m and r.get(measure)),
+                                 key=lambda r: r[xkey])
+                    if pts:
+                        curves.append({"x": [r[xkey] for r in pts],
+                                       "y": [r[measure] for r in pts], "label": m, **style[m]})
                 panels.append({
-                    "title": f"{PROBLEM_TITLES[problem]}: {key} vs "
-                             + ("time" if xkey == "time_s" else "DOFs"),
-                    "xlabel": xlabel, "ylabel": ylabel, "loglog": True,
-                    "curves": [{"x": [r[xkey] for r in pts if r[key]],
-                                "y": [r[key] for r in pts if r[key]], "label": m, **style[m]}
-                               for m, pts in mine]})
+                    "title": f"{tp.title}: {measure.replace('_', ' ')} vs "
+                             + ("time" if xkey == "time_s" else "unknowns"),
+                    "xlabel": xlabel, "ylabel": ylabel, "loglog": True, "curves": curves,
+                    "hlines": [(t, None, {"color": "0.7", "lw": 0.6}) for t in TARGETS]
+                    + ([(floor, "overkill's own error (Richardson)",
+                         {"color": "k", "ls": "-.", "lw": 0.8})] if floor else [])})
     figs = plot.plot_curves(panels, ctx.figure_stem("work_precision"),
-                            "What accuracy costs: Example 3.46, uniform and adaptive "
-                            "refinement, every solver variant", panel_size=(5.6, 3.3),
-                            figure_legend=True)
-    fastest = {}
-    for row in table:
-        key = f"fastest to {row['target']}, {PROBLEM_TITLES[row['problem']]}"
-        if row["time_s"] is not None and (key not in fastest
-                                          or row["time_s"] < fastest[key][1]):
-            fastest[key] = (row["method"], row["time_s"])
-    ctx.entry(THESIS, "Work-precision: error against wall time and DOFs", [*figs, data, summary],
-              {k: f"{m} ({t:.2f} s)" for k, (m, t) in fastest.items()},
-              table=markdown_table([r for r in table if r["measure"] == "e_tot"],
-                                   {"problem": "problem", "target": "target error",
-                                    "method": "method", "time_s": "time [s]", "ndof": "DOFs",
+                            "What accuracy costs: true errors against an overkill, ngdual "
+                            "(uniform, adaptive, Uzawa) and a primal P1/P2 Nitsche peer",
+                            ncols=4, panel_size=(4.4, 3.2), figure_legend=True)
+    numbers = {}
+    for r in table:
+        if r["method"] == "fastest ngdual / fastest peer" and r["measure"] == "pressure":
+            numbers[f"{r['problem']}: time ngdual / peer to {r['target']:.0%} pressure "
+                    "error"] = (f"{r['ratio']:.2f} ({r['fastest_ngdual']} / "
+                                f"{r['fastest_peer']})" if r["ratio"] else "not reached")
+    for v in verdict:
+        numbers[f"{v['problem']}: adaptive beats uniform to {v['target']:.0%} "
+                f"{v['measure']}"] = ("not both reached" if v["adaptive_wins"] is None else
+                                      f"{v['adaptive_wins']} ({v['adaptive_s']:.2f} s "
+                                      f"{v['adaptive_method']} vs {v['uniform_s']:.2f} s)")
+    for p, ref in references.items():
+        for measure, check in ref["richardson"].items():
+            numbers[f"{p}: overkill level {ref['level']}, its {measure} error "
+                    "(Richardson)"] = check["overkill_error"]
+    ctx.entry(THESIS, "Work-precision: true errors against wall time and unknowns",
+              [*figs, data, summary, js], numbers,
+              table=markdown_table([r for r in table if r.get("time_s") is not None
+                                    and r["measure"] == "pressure"],
+                                   {"problem": "problem", "target": "target", "method": "method",
+                                    "time_s": "time [s]", "ndof": "unknowns",
                                     "level_or_step": "level / step"}),
-              notes=f"e_tot against the Aitken limit of uniform levels "
-                    f"{ctx.plan.work_precision_reference_levels}; it compares norms, so it "
-                    "overstates the error of adaptive meshes that resolve the corner "
-                    "singularities better than any uniform level (see the eta panels). Times "
-                    "measured with two sweep tasks running at once; adaptive times are "
-                    "cumulative over all steps. The eta targets are in the CSV table.")
+              notes=f"Machine: {machine['cpus']} cores, load average "
+                    f"{machine['load_average'][0]:.1f} at the end; sweep tasks run side by "
+                    "side, so times carry that noise. Errors against the overkill solutions "
+                    "named above; adaptive times are cumulative.")
 
 
 if __name__ == "__main__":

@@ -31,6 +31,7 @@ Figs. 3.24-3.28) run the thesis' Uzawa iterations (``solver.method = "uzawa"``).
 from __future__ import annotations
 
 import csv
+import hashlib
 import importlib.util
 import json
 import math
@@ -188,6 +189,15 @@ class Plan:
     def dorfler_refinements(self) -> int:
         return 2 * self.max_level
 
+    def truth_levels(self, problem: str) -> list[int]:
+        """Uniform levels of the true-error studies (:data:`TRUTH_PROBLEMS`): up to K - 1, so
+        that the overkill (two levels finer, K + 1) stays affordable."""
+        return list(range(1, self.max_level - TRUTH_PROBLEMS[problem].coarser))
+
+    def overkill_level(self, problem: str) -> int:
+        """The reference of the true errors: two uniform levels beyond the finest studied."""
+        return self.truth_levels(problem)[-1] + 2
+
     def describe(self) -> dict:
         names = ("max_level", "levels", "field_level", "reference_levels",
                  "work_precision_reference_levels", "rho_level",
@@ -195,6 +205,41 @@ class Plan:
                  "max_marking_refinements", "max_marking_snapshots", "fraction_refinements",
                  "fraction_snapshots", "dorfler_refinements")
         return {n: getattr(self, n) for n in names}
+
+
+@dataclass(frozen=True)
+class TruthProblem:
+    """A scene of the true-error studies: its overrides and how many levels coarser than K
+    its finest uniform level is (a flat punch level has ~6x the triangles of Example 3.46's)."""
+
+    scene: str
+    overrides: tuple[str, ...] = ()
+    coarser: int = 0
+    title: str = ""
+    level1_elements: int = 32
+    pressure_window: float | None = None
+
+
+# Example 3.46 with consistent end values (lambda = g - u_D.n at the clamped ends): the
+# thesis' lambda = 0 there contradicts u = 0 on Gamma_D, sigma ~ 1/r at the corners is not in
+# L2 and no error norm exists (see figures/effectivity.py); the peer solves this problem too
+CONSISTENT = ('contact.ends="consistent"',)
+TRUTH_PROBLEMS = {
+    "frictionless": TruthProblem("thesis-3.46-frictionless", CONSISTENT, 0,
+                                 r"Example 3.46, $\mu_f = 0$"),
+    "coulomb": TruthProblem("thesis-3.46-coulomb", CONSISTENT, 0,
+                            r"Example 3.46, $\mu_f = 0.5$"),
+    # the punch pressure ~ (a - |x|)^(-1/2) is not in L2: its error on the core |x| < a/2
+    # (as ngdual.verification.analytic); sigma (~ r^(-1/2)) is in L2 everywhere
+    "flat-punch": TruthProblem("flat-punch", (), 1, "flat punch", 206, 0.125),
+}
+TRUTH_ADAPTIVE = {
+    # key: (marking, theta); each run from level 1 until its mesh is as large as the finest
+    # uniform level's
+    "max 0.5": ("max", 0.5), "max 0.25": ("max", 0.25),
+    "dorfler 0.5": ("dorfler", 0.5), "dorfler 0.3": ("dorfler", 0.3),
+}
+PEER_ORDERS = (1, 2)
 
 
 # --- the tasks ----------------------------------------------------------------------------------
@@ -334,6 +379,81 @@ def adapt_task(plan: Plan, problem: str, strategy: str) -> Task:
                 f"{scene} {marking} theta={theta}", 4.0 * refinements)
 
 
+def truth_solve(plan: Plan, problem: str, level: int, uzawa: bool = False) -> Task:
+    """A uniform solve of a :data:`TRUTH_PROBLEMS` scene that keeps its sample arrays."""
+    tp = TRUTH_PROBLEMS[problem]
+    overrides = [*tp.overrides, *([UZAWA] if uzawa else [])]
+    return Task("solve", {"scene": tp.scene, "level": level, "overrides": overrides,
+                          "fields": False, "samples": True},
+                f"{tp.scene} L{level} samples" + (" uzawa" if uzawa else ""),
+                _cost(level + 1, problem == "coulomb"))
+
+
+def truth_adapt(plan: Plan, problem: str, strategy: str) -> Task:
+    """An adaptive run of a :data:`TRUTH_PROBLEMS` scene keeping every step's samples, up to
+    the triangles of its finest uniform level."""
+    tp = TRUTH_PROBLEMS[problem]
+    marking, theta = TRUTH_ADAPTIVE[strategy]
+    finest = plan.truth_levels(problem)[-1]
+    return Task("adapt", {"scene": tp.scene, "marking": marking, "theta": theta, "steps": 60,
+                          "level": 1, "overrides": list(tp.overrides), "snapshots": [],
+                          "samples": True, "max_elements": tp.level1_elements * 4 ** (finest - 1)},
+                f"{tp.scene} {strategy} samples", 2.0 * finest)
+
+
+def peer_solve(plan: Plan, problem: str, level: int, order: int) -> Task:
+    """The primal peer on a :data:`TRUTH_PROBLEMS` scene, pressure samples fine enough for
+    the overkill's Gamma_C edges."""
+    tp = TRUTH_PROBLEMS[problem]
+    return Task("peer", {"scene": tp.scene, "level": level, "order": order,
+                         "overrides": list(tp.overrides),
+                         "subdivisions": 2 ** max(plan.overkill_level(problem) - level, 0)},
+                f"{tp.scene} L{level} peer P{order}", _cost(level, False))
+
+
+def peer_levels(plan: Plan, problem: str) -> list[int]:
+    """The peer's levels: those of ngdual and one beyond (an independent check of the
+    overkill)."""
+    levels = plan.truth_levels(problem)
+    return [*levels, levels[-1] + 1]
+
+
+def truth_tasks(plan: Plan, problem: str) -> dict[str, list[Task]]:
+    """Every task of the true-error study of one problem, by method."""
+    levels = plan.truth_levels(problem)
+    out = {"uniform, active set": [truth_solve(plan, problem, lv) for lv in levels],
+           "uniform, Uzawa": [truth_solve(plan, problem, lv, True) for lv in levels]}
+    for strategy in TRUTH_ADAPTIVE:
+        out[f"adaptive {strategy}"] = [truth_adapt(plan, problem, strategy)]
+    for order in PEER_ORDERS:
+        out[f"primal P{order}"] = [peer_solve(plan, problem, lv, order)
+                                   for lv in peer_levels(plan, problem)]
+    return out
+
+
+def reference_tasks(plan: Plan, problem: str) -> list[Task]:
+    """The overkill and the level below it (the Richardson check)."""
+    level = plan.overkill_level(problem)
+    return [truth_solve(plan, problem, level - 1), truth_solve(plan, problem, level)]
+
+
+MANUFACTURED_CASES = ("frictionless", "coulomb-nodes")
+
+
+def manufactured_tasks(plan: Plan) -> dict[str, Task]:
+    """Manufactured cases (exact errors) on uniform levels 1..K-1 and Doerfler theta = 0.5
+    from level 1 (2K steps): the estimator against the truth."""
+    levels = list(range(1, plan.max_level))
+    out = {f"{case}, uniform L{lv}": Task("manufactured", {"case": case, "level": lv},
+                                           f"manufactured {case} L{lv}", 1.5 ** lv / 20)
+           for case in MANUFACTURED_CASES for lv in levels}
+    for case in MANUFACTURED_CASES:
+        out[f"{case}, adaptive"] = Task(
+            "manufactured", {"case": case, "level": 1, "marking": "dorfler", "theta": 0.5,
+                             "steps": 2 * plan.max_level}, f"manufactured {case} dorfler", 5.0)
+    return out
+
+
 def studies(plan: Plan) -> dict[str, list[Task]]:
     """Every study a script may declare in ``STUDIES``, as lists of tasks."""
     rho = rho_tasks(plan)
@@ -351,6 +471,10 @@ def studies(plan: Plan) -> dict[str, list[Task]]:
                        for problem in v.problems for lv in plan.levels]
     out["work-precision-reference"] = [solve(plan, problem, lv) for problem in SCENES
                                        for lv in plan.work_precision_reference_levels]
+    out["manufactured"] = list(manufactured_tasks(plan).values())
+    out["truth"] = [t for problem in TRUTH_PROBLEMS for t in
+                    [*reference_tasks(plan, problem),
+                     *(t for ts in truth_tasks(plan, problem).values() for t in ts)]]
     return out
 
 
@@ -431,6 +555,111 @@ def best(records: dict) -> tuple | None:
     """The key of the converged record with the fewest iterations (see :func:`iterations_key`)."""
     ok = {k: r for k, r in records.items() if r and r.get("status") == "ok"}
     return min(ok, key=lambda k: iterations_key(ok[k])) if ok else None
+
+
+def richardson_check(d_coarse: float, d_fine: float) -> dict:
+    """The overkill's own error from the distances d of the two levels below it (L-2, L-1)
+    to it, for errors e_k = C r^k orthogonal between levels (Galerkin orthogonality:
+    d_k^2 = e_k^2 - e_L^2): (d_{L-2} / d_{L-1})^2 = (1 + r^2) / r^2, so
+    r^2 = 1 / (ratio^2 - 1) and e_L = d_{L-1} r / (1 - r^2)^(1/2). ``rate`` = -log2 r (the
+    order in h); None where the distances do not decrease (ratio <= 1).
+
+    >>> round(richardson_check(5 ** 0.5, 1.0)["overkill_error"], 12)  # r = 1/2
+    0.57735026919
+    """
+    if not (d_coarse and d_fine) or d_coarse <= d_fine:
+        return {"r": None, "rate": None, "overkill_error": None}
+    r = 1 / math.sqrt((d_coarse / d_fine) ** 2 - 1)
+    if r >= 1:
+        return {"r": r, "rate": -math.log2(r), "overkill_error": None}
+    return {"r": r, "rate": -math.log2(r), "overkill_error": d_fine * r / math.sqrt(1 - r * r)}
+
+
+# measures of the true-error studies: key -> (what, how it is made relative)
+TRUE_MEASURES = {"pressure": "relative L2 error of the contact pressure on Gamma_C",
+                 "sigma_energy": "relative compliance-norm error of sigma"}
+
+
+def _measures(errors: dict) -> dict:
+    """The relative errors plotted (:data:`TRUE_MEASURES`) and the absolute total error
+    e = (||sigma - sigma_ref||^2 + ||u - u_ref||^2 + ||eta - eta_ref||^2)^(1/2) (L2; div sigma
+    has no error when f = 0) that the estimator is compared with."""
+    out = {"pressure": errors.get("pressure_rel"),
+           "pressure_max": errors.get("pressure_max"),
+           "sigma_energy": errors["sigma_energy"] / errors["sigma_energy_norm"],
+           "e_true": math.sqrt(sum(errors.get(k, 0.0) ** 2 for k in ("sigma", "u", "eta")))}
+    return out
+
+
+def _candidates(ctx: Context, problem: str) -> list[tuple[dict, dict]]:
+    """(row, sample arrays) of every solution of the true-error study of ``problem``."""
+    out = []
+    for method, tasks in truth_tasks(ctx.plan, problem).items():
+        for task, record in zip(tasks, ctx.compute(tasks)):
+            if record is None or record.get("status") != "ok":
+                out.append(({"method": method, "status": (record or {}).get("status",
+                                                                           "missing"),
+                             "message": (record or {}).get("message", "")[:200]}, {}))
+                continue
+            arrays = ctx.arrays(task)
+            if task.kind == "adapt":
+                for r in record["history"]:
+                    prefix = f"s{r['step']}_"
+                    out.append(({"method": method, "status": "ok", "level_or_step": r["step"],
+                                 "ndof": r["dofs"]["total"], "elements": r["elements"],
+                                 "time_s": r["cumulative_s"], "eta": r["eta"]},
+                                {k[len(prefix):]: v for k, v in arrays.items()
+                                 if k.startswith(prefix)}))
+            else:
+                eta = record.get("estimator", {}).get("eta")
+                out.append(({"method": method, "status": "ok",
+                             "level_or_step": task.params["level"], "ndof": record["ndof"],
+                             "time_s": record["timings_s"]["total"], "eta": eta}, arrays))
+    return out
+
+
+def true_error_study(ctx: Context, problem: str) -> dict:
+    """True errors of every method of one problem against its overkill, cached in
+    ``DIR/records`` (the errors are recomputed only when a task id changes).
+
+    Returns ``{"rows": [...], "reference": {...}}``: one row per solution (method,
+    level or adaptive step, DOFs, wall time, estimator eta, ``pressure``, ``pressure_max``,
+    ``sigma_energy``, ``e_true``, :func:`_measures`), and the overkill's level, DOFs and its
+    Richardson check per measure.
+    """
+    from .scene import load_scene
+    from .verification.reference import true_errors
+
+    tp = TRUTH_PROBLEMS[problem]
+    below, top = reference_tasks(ctx.plan, problem)
+    ids = [below.id, top.id] + [t.id for ts in truth_tasks(ctx.plan, problem).values()
+                                for t in ts]
+    digest = hashlib.sha1(json.dumps(ids).encode()).hexdigest()[:12]
+    cache = ctx.records_dir / f"true-errors-{problem}-{digest}.json"
+    if cache.is_file():
+        return json.loads(cache.read_text())
+    lam, mu = load_scene(tp.scene, list(tp.overrides)).material.lame
+    ref_record = require(ctx.record(top), top.label)
+    reference = ctx.arrays(top)
+    rows = []
+    for row, arrays in _candidates(ctx, problem):
+        if arrays:
+            row.update(_measures(true_errors(arrays, reference, lam, mu, tp.pressure_window)))
+        rows.append(row)
+    # Richardson: the two levels below the overkill against it
+    finest = next(r for r in rows if r["method"] == "uniform, active set"
+                  and r.get("level_or_step") == ctx.plan.truth_levels(problem)[-1])
+    below_errors = _measures(true_errors(ctx.arrays(below), reference, lam, mu,
+                                         tp.pressure_window))
+    check = {k: {"d_L-2": finest.get(k), "d_L-1": below_errors[k],
+                 **richardson_check(finest.get(k), below_errors[k])}
+             for k in ("pressure", "sigma_energy")}
+    data = _plain({"rows": rows, "reference": {
+        "scene": tp.scene, "overrides": list(tp.overrides), "level": top.params["level"],
+        "ndof": ref_record["ndof"], "time_s": ref_record["timings_s"]["total"],
+        "richardson": check}})
+    write_json(data, cache)
+    return data
 
 
 # --- the context the scripts see ----------------------------------------------------------------

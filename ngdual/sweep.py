@@ -81,14 +81,15 @@ def _status_of(solution) -> str:
     return "ok" if solution.converged else "not-converged"
 
 
-def solve_task(scene: str, level: int, overrides: list[str] = (), fields: bool = False
-               ) -> tuple[dict, dict]:
+def solve_task(scene: str, level: int, overrides: list[str] = (), fields: bool = False,
+               samples: bool = False) -> tuple[dict, dict]:
     """Solve one scene on one level: the result record of ``ngdual solve`` (and field arrays).
 
     The record also holds the a posteriori estimator (4.50) of the solution
     (``estimator``: eta = (sum_T eta_T^2)^(1/2), eta_sum = sum_T eta_T, its time;
     not part of ``timings_s``). With ``fields=True`` the arrays hold what the
-    figures of Section 3.4 plot (:func:`field_arrays`).
+    figures of Section 3.4 plot (:func:`field_arrays`); with ``samples=True`` the solution
+    as the arrays of :func:`ngdual.verification.reference.solution_samples` (true errors).
     """
     from .estimator import estimate
     from .post import result_record
@@ -101,7 +102,12 @@ def solve_task(scene: str, level: int, overrides: list[str] = (), fields: bool =
     indicators = estimate(solution)
     record["estimator"] = {"eta": indicators.total, "eta_sum": indicators.total_sum,
                            "seconds": indicators.seconds}
-    return record, (field_arrays(solution) if fields else {})
+    arrays = field_arrays(solution) if fields else {}
+    if samples:
+        from .verification.reference import solution_samples
+
+        arrays.update(solution_samples(solution))
+    return record, arrays
 
 
 def field_arrays(solution) -> dict[str, np.ndarray]:
@@ -185,8 +191,13 @@ def dofs_task(scene: str, level: int, overrides: list[str] = ()) -> tuple[dict, 
             "ndof": int(sum(dofs.values())), "h": mesh_size(mesh), "elements": mesh.ne}, {}
 
 
+class _Budget(Exception):
+    """An adaptive run reached its element budget."""
+
+
 def adapt_task(scene: str, marking: str, theta: float, steps: int, level: int,
-               overrides: list[str] = (), snapshots: list[int] = ()) -> tuple[dict, dict]:
+               overrides: list[str] = (), snapshots: list[int] = (), samples: bool = False,
+               max_elements: int | None = None) -> tuple[dict, dict]:
     """An adaptive run (:func:`ngdual.afem.adapt`): its history, with extras for Section 4.2.
 
     Every step record of :func:`ngdual.afem.step_record` gets ``eta_as`` (the
@@ -196,6 +207,9 @@ def adapt_task(scene: str, marking: str, theta: float, steps: int, level: int,
     refinements before included; not the extra H(div) estimate). The
     meshes of the steps in ``snapshots`` are kept as arrays ``points_<k>``,
     ``triangles_<k>`` and ``marked_<k>``. A ConvergenceError keeps the steps done.
+    With ``samples=True`` every step's solution is kept as the arrays of
+    :func:`ngdual.verification.reference.solution_samples`, prefixed ``s<k>_``; the run stops
+    after the first step whose mesh has at least ``max_elements`` triangles.
     """
     import ngsolve as ngs
 
@@ -225,8 +239,14 @@ def adapt_task(scene: str, marking: str, theta: float, steps: int, level: int,
                                                  for el in mesh.Elements(ngs.VOL)])
             arrays[f"marked_{k}"] = (np.zeros(mesh.ne, bool) if marked is None
                                      else np.asarray(marked, bool))
+        if samples:
+            from .verification.reference import solution_samples
+
+            arrays.update({f"s{k}_{n}": v for n, v in solution_samples(solution).items()})
         history.append(record)
         extra[0] += time.perf_counter() - t0
+        if max_elements is not None and record["elements"] >= max_elements:
+            raise _Budget
 
     run = {"scene": scene, "marking": marking, "theta": theta, "steps": steps, "level": level,
            "overrides": list(overrides)}
@@ -236,12 +256,64 @@ def adapt_task(scene: str, marking: str, theta: float, steps: int, level: int,
     except ConvergenceError as err:
         run.update(message=str(err))
         status = "failed"
+    except _Budget:
+        status = "ok" if all(r["converged"] for r in history) else "not-converged"
     run.update(status=status, history=history)
     return run, arrays
 
 
+def peer_task(scene: str, level: int, order: int, overrides: list[str] = (),
+              subdivisions: int = 1) -> tuple[dict, dict]:
+    """The scene solved by the primal peer (``benchmarks/primal_peer.py``: P``order``
+    displacements, Nitsche contact, semismooth Newton) on the scene's mesh of ``level``:
+    DOFs, Newton steps, wall time (meshing included) and the arrays of
+    :func:`benchmarks.primal_peer.primal_samples` (pressure samples on Gamma_C edges split
+    into ``subdivisions`` parts). Needs the source checkout (benchmarks/ is not installed)."""
+    import sys
+
+    root = str(Path(__file__).resolve().parent.parent)
+    if root not in sys.path:
+        sys.path.insert(0, root)
+    from benchmarks.primal_peer import NewtonError, primal_samples, solve_scene_primal
+
+    sc = _scene(scene, list(overrides))
+    try:
+        result, seconds = solve_scene_primal(sc, level, order)
+    except NewtonError as err:
+        return {"status": "failed", "message": str(err)}, {}
+    record = {"status": "ok", "scene": scene, "level": level, "order": order,
+              "ndof": int(result.ndof), "newton_iterations": result.newton_iterations,
+              "timings_s": {**{k: float(v) for k, v in result.times.items()},
+                            "total": seconds}}
+    return record, primal_samples(sc, result, subdivisions)
+
+
+def manufactured_task(case: str, level: int, marking: str | None = None, theta: float = 0.5,
+                      steps: int = 1) -> tuple[dict, dict]:
+    """A manufactured case (:mod:`ngdual.verification.manufactured`) on uniform ``level``
+    (``marking=None``) or adaptively from it: per step the DOFs, the estimator eta of (4.50)
+    and the exact errors (:func:`~ngdual.verification.manufactured.volume_errors`)."""
+    from .afem import adapt
+    from .verification.manufactured import manufactured_case, volume_errors
+
+    mc = manufactured_case(case)
+    history = []
+
+    def on_step(record, solution, indicators, marked):
+        history.append({"step": record["step"], "ndof": record["dofs"]["total"],
+                        "elements": record["elements"], "eta": record["eta"],
+                        "converged": record["converged"],
+                        "errors": volume_errors(mc, solution)})
+
+    adapt(mc.scene(), marking or "max", theta if marking else 0.0,
+          steps if marking else 1, level, on_step=on_step)
+    return {"status": "ok" if all(r["converged"] for r in history) else "not-converged",
+            "case": case, "history": history}, {}
+
+
 TASKS: dict[str, Callable[..., tuple[dict, dict]]] = {
-    "solve": solve_task, "dofs": dofs_task, "adapt": adapt_task}
+    "solve": solve_task, "dofs": dofs_task, "adapt": adapt_task, "peer": peer_task,
+    "manufactured": manufactured_task}
 
 
 # --- records on disk ----------------------------------------------------------------------------

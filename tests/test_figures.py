@@ -155,6 +155,43 @@ def test_a_rerun_computes_nothing(coarse_run, capsys):
     assert "0 computed" in capsys.readouterr().out
 
 
+def test_work_precision_plots_only_true_errors_and_the_peer(coarse_run):
+    """Every plotted point carries a finite true error against the overkill (no norm
+    differences), the primal peer P1 and P2 curves exist for both friction laws, and on
+    uniform meshes the stress error falls from level to level."""
+    rows = read_csv(coarse_run / "data" / "work_precision.csv")
+    assert "e_tot" not in rows[0]
+    ok = [r for r in rows if r["status"] == "ok"]
+    assert len(ok) == len(rows)
+    for r in ok:
+        for key in ("pressure", "sigma_energy", "time_s", "ndof"):
+            assert math.isfinite(float(r[key])) and float(r[key]) > 0, (r["method"], key)
+    for problem in ("frictionless", "coulomb"):
+        methods = {r["method"] for r in ok if r["problem"] == problem}
+        assert {"primal P1", "primal P2", "uniform, Uzawa"} <= methods
+        assert sum(m.startswith("adaptive") for m in methods) == 4
+        uniform = [float(r["sigma_energy"]) for r in ok if r["problem"] == problem
+                   and r["method"] == "uniform, active set"]
+        assert len(uniform) >= 2 and all(b < a for a, b in zip(uniform, uniform[1:]))
+    sidecar = json.loads((coarse_run / "figures" / "work_precision.json").read_text())
+    labels = set(sidecar["figure_legend"]) if sidecar["figure_legend"] else set()
+    assert {"primal P1", "primal P2"} <= labels, labels
+    result = json.loads((coarse_run / "data" / "work_precision.json").read_text())
+    ratios = [r for r in result["time_to_accuracy"]
+              if r["method"] == "fastest ngdual / fastest peer"]
+    assert {r["target"] for r in ratios} == {0.05, 0.02, 0.01}
+
+
+def test_the_estimator_tracks_the_exact_error_of_the_manufactured_cases(coarse_run):
+    """eta / e on the manufactured cases (exact errors) stays within a factor 2 over the
+    uniform levels: the estimator is efficient and reliable there."""
+    rows = read_csv(coarse_run / "data" / "effectivity.csv")
+    for case in ("manufactured frictionless", "manufactured coulomb-nodes"):
+        eff = [float(r["effectivity"]) for r in rows
+               if r["problem"] == case and r["method"] == "uniform"]
+        assert len(eff) >= 2 and max(eff) / min(eff) < 2 and 0.2 < min(eff), (case, eff)
+
+
 # --- killing a sweep --------------------------------------------------------------------------
 
 def test_a_killed_sweep_resumes_without_recomputing(tmp_path):
