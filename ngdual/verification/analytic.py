@@ -244,14 +244,19 @@ class TractionProfile:
         """Q = int q_h dx."""
         return self.integral(self.shear)
 
+    def centroid_of(self, values: np.ndarray) -> float:
+        """int x f dx / int f dx of the P1 function f with node ``values``, exactly."""
+        moment = 0.0
+        for k0, k1 in self.edge_nodes():
+            x0, x1, f0, f1 = self.x[k0], self.x[k1], values[k0], values[k1]
+            # int of x (f0 + (f1 - f0) s) over the edge, x = x0 + (x1 - x0) s
+            moment += (x1 - x0) * (x0 * (f0 + f1) / 2 + (x1 - x0) * (f0 / 6 + f1 / 3))
+        return moment / self.integral(values)
+
     @property
     def centroid(self) -> float:
         """int x p_h dx / P: the line of action of the normal force."""
-        total = 0.0
-        for x0, x1, p0, p1, *_ in self.edges():
-            # int of x (p0 + (p1 - p0) s) over the edge, x = x0 + (x1 - x0) s
-            total += (x1 - x0) * (x0 * (p0 + p1) / 2 + (x1 - x0) * (p0 / 6 + p1 / 3))
-        return total / self.force
+        return self.centroid_of(self.pressure)
 
     def contact_interval(self) -> tuple[float, float]:
         """(x_min, x_max) of the h~ nodes in contact."""
@@ -459,7 +464,9 @@ def traction_errors(solution: Solution, exact: CattaneoMindlin, *, x0: float = 0
     (:func:`traction_profile`). Returns ``l2`` and ``l1`` (relative, over Gamma_C), ``max``
     (at the h~ nodes, relative to max |q|), ``tangential_force`` Q_h = int q_h, the stick
     zone of the h^ mesh (the h^ edges with |nu| < 1 and F > 0 inside the contact set:
-    ``stick_half_width`` c_h and ``stick_centre``), ``c`` the exact stick half-width and
+    ``stick_half_width`` c_h and ``stick_centre``), ``stick_centroid`` the centroid of the
+    slip reserve mu_f p_h - |q_h| (exact: an ellipse over the stick zone, so this locates its
+    centre below the h^ resolution), ``c`` the exact stick half-width and
     ``hhat`` the longest h^ edge (the friction cell) meeting the stick zone.
     """
     from .manufactured import discrete_sets
@@ -480,7 +487,12 @@ def traction_errors(solution: Solution, exact: CattaneoMindlin, *, x0: float = 0
         for s, e in zip(px[:-1], px[1:]):
             if not stick or (max(s, e) >= lo and min(s, e) <= hi):
                 hhat = max(hhat, abs(e - s))
+    # mu_f p - |q| is mu_f p0 (c/a) sqrt(1 - (x - x0)^2/c^2)_+ exactly: its centroid locates
+    # the stick zone below the h^ resolution
+    reserve = np.where(profile.in_contact, np.maximum(
+        exact.mu_f * profile.pressure - np.abs(profile.shear), 0.0), 0.0)
     return {"l2": err["l2"] / err["norm_l2"], "l1": err["l1"] / err["norm_l1"],
+            "stick_centroid": profile.centroid_of(reserve),
             "max": _node_max(profile, exact.shear, "shear", x0, -np.inf, np.inf, peak),
             "tangential_force": profile.tangential_force,
             "stick_half_width": 0.5 * (hi - lo), "stick_centre": 0.5 * (hi + lo),
