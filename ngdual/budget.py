@@ -8,12 +8,13 @@ X = 680 + M = 256 + S = 81 + ... on 128 triangles) and the peak memory of a solv
 (about 2.5 kB per unknown: Example 3.46 with Coulomb friction on level 8, 3.9e6
 unknowns, peaks at 9 GB with the active-set solver; the Uzawa algorithms, with the
 saddle-point factorisation, need about 6 kB per unknown: 600 MB on level 5).
-:func:`check` refuses a run whose
-estimate exceeds the memory the machine has available, with the estimate in the
-message; ``allow_large=True`` (the CLI's ``--allow-large``) runs it anyway.
+:func:`check` refuses a run whose estimate exceeds the memory the machine has
+available, with the estimate in the message; ``allow_large=True`` (the CLI's
+``--allow-large``) runs it anyway.
 
->>> estimate(__import__("ngdual.scene", fromlist=["Geometry"]).Geometry(), 2).elements
-128
+>>> from ngdual.scene import Geometry
+>>> estimate(Geometry(), level=2).elements   # Example 3.46: 32 * 4 triangles
+128.0
 """
 
 from __future__ import annotations

@@ -21,6 +21,7 @@ import ast
 import math
 import operator
 import sys
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -187,7 +188,9 @@ class Expression:
             raise ExpressionError(f"formula too long ({len(text)} characters, at most "
                                   f"{MAX_LENGTH})")
         try:
-            tree = ast.parse(text, mode="eval")
+            with warnings.catch_warnings():  # "invalid decimal literal" for 2x: an error below
+                warnings.simplefilter("ignore", SyntaxWarning)
+                tree = ast.parse(text, mode="eval")
         except SyntaxError as err:
             raise ExpressionError(f"cannot parse {quote(text)}: {err.msg}") from None
         except (RecursionError, MemoryError, ValueError):

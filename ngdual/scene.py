@@ -305,31 +305,31 @@ def shipped_scenes() -> list[str]:
 
 def _read_toml(source: str | Path) -> tuple[str, dict]:
     if isinstance(source, bool) or not isinstance(source, (str, Path)):
-        raise SceneError("scene", f"must be a path or a shipped scene name, got "
-                                  f"{type(source).__name__}")
+        raise SceneTypeError("scene", f"must be a path or a shipped scene name, got "
+                                      f"{type(source).__name__}")
     path = Path(source)
     if path.is_dir():
-        raise SceneError("scene", f"{str(path)!r} is a directory; give a TOML scene file "
+        raise SceneError("scene", f"{repr(str(path))} is a directory; give a TOML scene file "
                                   "inside it or the name of a shipped scene")
     if path.suffix == ".toml" or path.exists():
         if not path.is_file():
-            raise SceneError("scene", f"no such scene file {str(path)!r}")
+            raise SceneError("scene", f"no such scene file {repr(str(path))}")
         try:
             text, default_name = path.read_text(encoding="utf-8"), path.stem
         except (OSError, UnicodeDecodeError) as err:
-            raise SceneError("scene", f"cannot read {str(path)!r}: "
+            raise SceneError("scene", f"cannot read {repr(str(path))}: "
                                       f"{getattr(err, 'strerror', None) or err}") from None
     else:
         name = str(source)
         if name not in shipped_scenes():
-            raise SceneError("scene", f"unknown scene {name!r}; shipped scenes: "
+            raise SceneError("scene", f"unknown scene {_show(name)}; shipped scenes: "
                                       + ", ".join(shipped_scenes()))
         text = resources.files("ngdual.scenes").joinpath(name + ".toml").read_text()
         default_name = name
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
-        raise SceneError("scene", f"invalid TOML in {str(source)!r}: {err}") from None
+        raise SceneError("scene", f"invalid TOML in {repr(str(source))}: {err}") from None
     return default_name, data
 
 
@@ -344,8 +344,8 @@ def apply_overrides(data: dict, overrides: list[str] | None) -> dict:
     """Apply ``--set section.key=value`` overrides (values parsed as TOML, else strings)."""
     if overrides is not None and (isinstance(overrides, str)
                                   or not all(isinstance(o, str) for o in overrides)):
-        raise SceneError("overrides", "must be a list of 'section.key=value' strings, got "
-                                      f"{overrides!r}")
+        raise SceneTypeError("overrides", "must be a list of 'section.key=value' strings, got "
+                                      f"{_show(overrides)}")
     data = copy.deepcopy(data)
     for item in overrides or []:
         if "=" not in item:
@@ -360,7 +360,7 @@ def apply_overrides(data: dict, overrides: list[str] | None) -> dict:
                                   + ", ".join(["boundary", *_SECTIONS]))
         section = data.setdefault(parts[0], {})
         if not isinstance(section, dict):
-            raise SceneError(parts[0], f"must be a table, got {section!r}")
+            raise SceneError(parts[0], f"must be a table, got {_show(section)}")
         section[parts[1]] = _parse_value(value)
     return data
 
@@ -377,7 +377,7 @@ def _build(name: str, data: dict) -> Scene:
                           + ", ".join(["name", "description", "boundary", *_SECTIONS]))
     for key in ("name", "description"):
         if key in data and not isinstance(data[key], str):
-            problems.add(key, f"must be a string, got {data[key]!r}")
+            problems.add(key, f"must be a string, got {_show(data[key])}")
     # a scene states its domain: no table silently becoming the thesis rectangle
     if "geometry" not in data:
         problems.add("geometry", "missing table: " + GEOMETRY_REQUIRED)
@@ -387,7 +387,7 @@ def _build(name: str, data: dict) -> Scene:
     for section, cls in _SECTIONS.items():
         values = data.get(section, {})
         if not isinstance(values, dict):
-            problems.add(section, f"must be a table [{section}], got {values!r}")
+            problems.add(section, f"must be a table [{section}], got {_show(values)}")
             values = {}
         names = {f.name for f in dataclasses.fields(cls)}
         for key in values:
@@ -399,7 +399,7 @@ def _build(name: str, data: dict) -> Scene:
     if "boundary" not in data:
         problems.add("boundary", "missing table: assign dirichlet/neumann/contact labels")
     elif not isinstance(data["boundary"], dict):
-        problems.add("boundary", f"must be a table [boundary], got {data['boundary']!r}")
+        problems.add("boundary", f"must be a table [boundary], got {_show(data['boundary'])}")
     else:
         for role, labels in data["boundary"].items():
             if role not in _ROLES:
@@ -417,21 +417,51 @@ def load_scene(source: str | Path, overrides: list[str] | None = None) -> Scene:
     2
     """
     name, data = _read_toml(source)
+    return scene_from_dict(data, overrides, name)
+
+
+def scene_from_dict(data: dict, overrides: list[str] | None = None,
+                    name: str = "scene") -> Scene:
+    """The validated scene of a TOML document already parsed into ``data`` (a dict).
+
+    >>> scene_from_dict({"geometry": {"kind": "thesis-3.46", "level": 1},
+    ...                  "boundary": {"dirichlet": ["left", "right", "top", "bottom"]}}).name
+    'scene'
+    """
+    if not isinstance(data, dict):
+        raise SceneTypeError("scene", f"must be a table (dict) of sections, got "
+                                      f"{type(data).__name__}")
     scene = _build(name, apply_overrides(data, overrides))
     ensure_valid(scene)
     return scene
+
+
+def _show(value, width: int = 60) -> str:
+    """``repr(value)`` for a message, shortened (user input can be arbitrarily long)."""
+    try:
+        text = repr(value)
+    except ValueError:  # an integer beyond Python's digit limit for str()
+        text = f"<an integer of {value.bit_length()} bits>"
+    return text if len(text) <= width else text[:width - 3] + "..."
 
 
 def _is_number(value) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool)
 
 
+def _finite(value) -> bool:
+    """A number (not a bool) that is finite in double precision (huge integers are not)."""
+    try:
+        return _is_number(value) and math.isfinite(value)
+    except OverflowError:
+        return False
+
+
 def _positive(value, field_name: str, integer: bool = False) -> None:
     kind = int if integer else (int, float)
-    if isinstance(value, bool) or not isinstance(value, kind) or not np.isfinite(value) \
-            or value <= 0:
+    if not isinstance(value, kind) or not _finite(value) or value <= 0:
         raise SceneError(field_name, f"must be a positive {'integer' if integer else 'number'}, "
-                                     f"got {value!r}")
+                                     f"got {_show(value)}")
 
 
 def _expression(text, field_name: str) -> Expression:
@@ -443,7 +473,8 @@ def _expression(text, field_name: str) -> Expression:
 
 def _pair(values, field_name: str) -> list[Expression]:
     if not isinstance(values, (list, tuple)) or len(values) != 2:
-        raise SceneError(field_name, f"must be a pair [x-component, y-component], got {values!r}")
+        raise SceneError(field_name, f"must be a pair [x-component, y-component], got "
+                                     f"{_show(values)}")
     problems = _Problems()
     out = []
     for i, v in enumerate(values):
@@ -472,7 +503,7 @@ def _field_type_problems(section: str, obj) -> list[tuple[str, str]]:
         if key in _FORMULAS or (value is None and "None" in kinds):
             continue
         if isinstance(value, bool) or not isinstance(value, _TYPES[kinds[0]]):
-            found.append((key, f"must be {_TYPE_NAMES[kinds[0]]}, got {value!r}"))
+            found.append((key, f"must be {_TYPE_NAMES[kinds[0]]}, got {_show(value)}"))
     return found
 
 
@@ -480,7 +511,7 @@ def _type_problems(scene: Scene) -> list[tuple[str, str]]:
     """``(field, message)`` for every setting of ``scene`` whose type is wrong."""
     found = []
     if not isinstance(scene.name, str):
-        found.append(("name", f"must be a string, got {scene.name!r}"))
+        found.append(("name", f"must be a string, got {_show(scene.name)}"))
     for section, cls in _SECTIONS.items():
         obj = getattr(scene, section)
         if not isinstance(obj, cls):
@@ -489,14 +520,15 @@ def _type_problems(scene: Scene) -> list[tuple[str, str]]:
             continue
         found += _field_type_problems(section, obj)
     if not isinstance(scene.boundary, dict):
-        found.append(("boundary", f"must be a table role -> labels, got {scene.boundary!r}"))
+        found.append(("boundary", f"must be a table role -> labels, got {_show(scene.boundary)}"))
         return found
     for role, labels in scene.boundary.items():
         if role not in _ROLES:
             found.append((f"boundary.{role}", f"unknown role; use one of {', '.join(_ROLES)}"))
         elif not isinstance(labels, (list, tuple)) or not all(isinstance(lab, str)
                                                               for lab in labels):
-            found.append((f"boundary.{role}", f"must be a list of side labels, got {labels!r}"))
+            found.append((f"boundary.{role}", f"must be a list of side labels, got "
+                                              f"{_show(labels)}"))
     return found
 
 
@@ -513,7 +545,7 @@ def _side_table(geo: Geometry, key: str, value: str) -> list[tuple[str, object]]
         raise SceneError(f"geometry.{key}", f"must be a table label = {value}")
     for label in table:
         if label not in geo.labels:
-            raise SceneError(f"geometry.{key}.{label}", f"unknown side label {label!r}; the "
+            raise SceneError(f"geometry.{key}.{label}", f"unknown side label {_show(label)}; the "
                                                         f"sides are {', '.join(geo.labels)}")
     return list(table.items())
 
@@ -522,19 +554,17 @@ def _validate_points(geo: Geometry) -> np.ndarray:
     """The polygon's vertices as an array; refuses non-numbers and degenerate polygons."""
     if not isinstance(geo.points, (list, tuple)) or len(geo.points) < 3:
         raise SceneError("geometry.points", f"need at least three [x, y] points, got "
-                                            f"{geo.points!r}")
+                                            f"{_show(geo.points)}")
     problems = _Problems()
     for i, p in enumerate(geo.points):
-        if not (isinstance(p, (list, tuple)) and len(p) == 2 and all(_is_number(c) and
-                                                                      math.isfinite(c)
-                                                                      for c in p)):
+        if not (isinstance(p, (list, tuple)) and len(p) == 2 and all(_finite(c) for c in p)):
             problems.add(f"geometry.points[{i}]", f"must be a pair of finite numbers [x, y], "
-                                                  f"got {p!r}")
+                                                  f"got {_show(p)}")
     if not isinstance(geo.labels, (list, tuple)) or not all(
             isinstance(lab, str) and LABEL.fullmatch(lab) for lab in geo.labels):
         # labels become netgen boundary names, selected by regular expressions
         problems.add("geometry.labels", f"must be a list of names made of letters, digits, "
-                                        f"'_' and '-', got {geo.labels!r}")
+                                        f"'_' and '-', got {_show(geo.labels)}")
     elif len(geo.labels) != len(geo.points):
         problems.add("geometry.labels", f"need one label per side ({len(geo.points)}), "
                                         f"got {len(geo.labels)}")
@@ -554,7 +584,7 @@ def _validate_points(geo: Geometry) -> np.ndarray:
                     side = i if j == i + 1 else j
                     raise SceneError("geometry.points", f"points[{i}] and points[{j}] "
                                      f"coincide at {where}: side {side} "
-                                     f"({geo.labels[side]!r}) has zero length; remove the "
+                                     f"({_show(geo.labels[side])}) has zero length; remove the "
                                      "repeated point")
                 raise SceneError("geometry.points", f"points[{i}] and points[{j}] coincide "
                                                     f"at {where}: the boundary touches itself")
@@ -571,22 +601,22 @@ def validate_geometry(geo: Geometry) -> None:
     if wrong:
         raise SceneError("", "", wrong)
     if geo.kind not in GEOMETRY_KINDS:
-        raise SceneError("geometry.kind", f"unknown kind {geo.kind!r}; use one of "
+        raise SceneError("geometry.kind", f"unknown kind {_show(geo.kind)}; use one of "
                                           + ", ".join(GEOMETRY_KINDS))
     _positive(geo.level, "geometry.level", integer=True)
     if geo.kind != "polygon":
         for key in ("arcs", "side_maxh", "points", "labels"):
             if getattr(geo, key):
                 raise SceneError(f"geometry.{key}", f"{key} needs kind = \"polygon\" (the "
-                                                    f"{geo.kind!r} geometry is fixed)")
+                                                    f"{_show(geo.kind)} geometry is fixed)")
         return
     _validate_points(geo)
     for label, centre in _side_table(geo, "arcs", "[x, y] (the arc's centre)"):
         ok = isinstance(centre, (list, tuple)) and len(centre) == 2 and all(
-            _is_number(c) and math.isfinite(c) for c in centre)
+            _finite(c) for c in centre)
         if not ok:
             raise SceneError(f"geometry.arcs.{label}", f"the centre must be [x, y], got "
-                                                       f"{centre!r}")
+                                                       f"{_show(centre)}")
     for label, h in _side_table(geo, "side_maxh", "mesh size"):
         _positive(h, f"geometry.side_maxh.{label}")
     curves = geo.curves()
@@ -613,16 +643,16 @@ def _validate_boundary(scene: Scene) -> None:
     for role, labels in scene.boundary.items():
         for label in labels:
             if label not in known:
-                raise SceneError(f"boundary.{role}", f"unknown boundary label {label!r}; the "
+                raise SceneError(f"boundary.{role}", f"unknown boundary label {_show(label)}; the "
                                                      f"geometry has {', '.join(sorted(known))}")
             if label in seen:
-                raise SceneError(f"boundary.{role}", f"label {label!r} is already "
+                raise SceneError(f"boundary.{role}", f"label {_show(label)} is already "
                                                      f"{seen[label]}")
             seen[label] = role
     missing = sorted(known - set(seen))
     if missing:
-        raise SceneError("boundary", f"boundary label {missing[0]!r} has no condition; list it "
-                                     "under dirichlet, neumann or contact")
+        raise SceneError("boundary", f"boundary label {_show(missing[0])} has no condition; "
+                                     "list it under dirichlet, neumann or contact")
     if not scene.labels("dirichlet"):
         raise SceneError("boundary.dirichlet", "at least one Dirichlet side is needed "
                                                "(rigid body motions are not excluded otherwise)")
@@ -689,13 +719,14 @@ def _validate_foundation(scene: Scene) -> None:
     f = scene.contact.foundation
     if not isinstance(f, dict) or set(f) != {"point", "normal"}:
         raise SceneError("contact.foundation", "must be a table {point = [x, y], normal = "
-                                               f"[nx, ny]}}, got {f!r}")
+                                               f"[nx, ny]}}, got {_show(f)}")
     for key in ("point", "normal"):
         v = f[key]
         ok = isinstance(v, (list, tuple)) and len(v) == 2 and all(
-            isinstance(c, (int, float)) and not isinstance(c, bool) and np.isfinite(c) for c in v)
+            _finite(c) for c in v)
         if not ok:
-            raise SceneError(f"contact.foundation.{key}", f"must be a pair of numbers, got {v!r}")
+            raise SceneError(f"contact.foundation.{key}", f"must be a pair of numbers, got "
+                                                          f"{_show(v)}")
     if np.linalg.norm(np.asarray(f["normal"], dtype=float)) == 0:
         raise SceneError("contact.foundation.normal", "must not be zero")
     if scene.contact.gap is not None:
@@ -724,7 +755,7 @@ def _validate_contact(scene: Scene, u_d: list[Expression]) -> None:
     """Foundation or gap, ends, kinks: what Gamma_C needs to be posed (see :class:`Contact`)."""
     con = scene.contact
     if con.ends not in CONTACT_ENDS:
-        raise SceneError("contact.ends", f"unknown choice {con.ends!r}; use one of "
+        raise SceneError("contact.ends", f"unknown choice {_show(con.ends)}; use one of "
                                          + ", ".join(CONTACT_ENDS))
     if not scene.has_contact:
         if con.foundation is not None:
@@ -784,7 +815,7 @@ def check_level(level, field_name: str = "level", optional: bool = False) -> int
         return None
     if isinstance(level, bool) or not isinstance(level, (int, np.integer)):
         raise SceneTypeError(field_name, f"must be an integer >= 1{' or None' * optional}, "
-                                         f"got {level!r}")
+                                         f"got {_show(level)}")
     if level < 1:
         raise SceneError(field_name, f"must be >= 1 (level 1 is the initial mesh), got {level}")
     return int(level)
@@ -854,7 +885,7 @@ def _validate_material(mat: Material) -> None:
                                            "the stresses stay within double precision; "
                                            "rescale the units")
     if not -1 < mat.nu < 0.5:
-        problems.add("material.nu", f"Poisson's ratio must lie in (-1, 0.5), got {mat.nu!r}")
+        problems.add("material.nu", f"Poisson's ratio must lie in (-1, 0.5), got {_show(mat.nu)}")
     problems.raise_any()
 
 
@@ -863,13 +894,13 @@ def _validate_contact_settings(con: Contact) -> None:
     with problems.check():
         _expression(con.gap_formula, "contact.gap")
     if con.ends not in CONTACT_ENDS:
-        problems.add("contact.ends", f"unknown choice {con.ends!r}; use one of "
+        problems.add("contact.ends", f"unknown choice {_show(con.ends)}; use one of "
                                      + ", ".join(CONTACT_ENDS))
     with problems.check():
         _positive(con.htilde_factor, "contact.htilde_factor", integer=True)
     if con.hhat_factor not in (1, 2):
         problems.add("contact.hhat_factor", f"must be 1 (h^ = h~) or 2 (h^ = 2h~), "
-                                            f"got {con.hhat_factor!r}")
+                                            f"got {_show(con.hhat_factor)}")
     problems.raise_any()
 
 
@@ -877,18 +908,18 @@ def _validate_friction_settings(scene: Scene) -> None:
     fr = scene.friction
     problems = _Problems()
     if fr.law not in FRICTION_LAWS:
-        problems.add("friction.law", f"unknown friction law {fr.law!r}; use one of "
+        problems.add("friction.law", f"unknown friction law {_show(fr.law)}; use one of "
                                      + ", ".join(FRICTION_LAWS))
     elif fr.law != "none" and not scene.has_contact:
-        problems.add("friction.law", f"{fr.law!r} friction needs a contact boundary "
+        problems.add("friction.law", f"{_show(fr.law)} friction needs a contact boundary "
                                      "(boundary.contact is empty)")
-    if not (math.isfinite(fr.mu) and fr.mu >= 0):
-        problems.add("friction.mu", f"friction coefficient must be >= 0, got {fr.mu!r}")
+    if not (_finite(fr.mu) and fr.mu >= 0):
+        problems.add("friction.mu", f"friction coefficient must be >= 0, got {_show(fr.mu)}")
     elif fr.law == "coulomb" and fr.mu == 0:
         problems.add("friction.mu", "Coulomb friction needs a coefficient mu > 0 (mu = 0 is "
                                     "frictionless: use friction.law = \"none\")")
     if fr.normal_stress not in NORMAL_STRESSES:
-        problems.add("friction.normal_stress", f"unknown choice {fr.normal_stress!r}; use "
+        problems.add("friction.normal_stress", f"unknown choice {_show(fr.normal_stress)}; use "
                                                "one of " + ", ".join(NORMAL_STRESSES))
     with problems.check():
         _expression(fr.bound, "friction.bound")
@@ -901,7 +932,7 @@ def _validate_solver(sol: Solver, problems: _Problems) -> None:
     for key, allowed in choices.items():
         value = getattr(sol, key)
         if value not in allowed:
-            problems.add(f"solver.{key}", f"unknown {key.replace('_', ' ')} {value!r}; use "
+            problems.add(f"solver.{key}", f"unknown {key.replace('_', ' ')} {_show(value)}; use "
                                           "one of " + ", ".join(allowed))
     for key in ("rho", "eps", "rho1", "rho2", "eps1", "eps2"):
         if problems.run(_positive, getattr(sol, key), f"solver.{key}") and key == "rho2" \
