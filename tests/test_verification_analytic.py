@@ -16,7 +16,7 @@ import pytest
 
 from ngdual.verification import cattaneo_mindlin, flat_punch, hertz
 from ngdual.verification.analytic import _nodes
-from ngdual.verification.contact_benchmarks import adaptive_study, domain_study, uniform_study
+from ngdual.verification.contact_benchmarks import domain_study, uniform_study
 from ngdual.verification.report import add_arguments, run
 
 
@@ -100,12 +100,3 @@ def test_flat_punch_domain_error_shrinks_with_the_box():
     domain = [abs(r["domain"]) for r in rows]
     assert domain[0] > domain[1] and domain[0] > domain[2], rows
     assert domain[2] < 0.003, rows
-
-
-@pytest.mark.slow
-def test_adaptive_hertz_reaches_the_uniform_level_4_error_with_fewer_unknowns():
-    uniform = uniform_study("hertz", (4,))[0]
-    rows = adaptive_study("hertz", steps=6)
-    reached = [r for r in rows if r["l2"] <= uniform["l2"]]
-    assert reached and reached[0]["ndof"] < uniform["ndof"], (
-        [(r["ndof"], r["l2"]) for r in rows], uniform["ndof"], uniform["l2"])

@@ -410,8 +410,7 @@ def pressure_errors(solution: Solution, exact, *, x0: float = 0.0) -> dict:
       edge meeting the contact zone (the resolution of ``half_width``).
     """
     profile = traction_profile(solution)
-    a = exact.a if isinstance(exact, FlatPunch) else (
-        exact.hertz.a if isinstance(exact, CattaneoMindlin) else exact.a)
+    a = getattr(exact, "hertz", exact).a
     core = (x0 - CORE * a, x0 + CORE * a)
     whole = _errors(profile, exact.pressure, exact.breaks, "pressure", x0,
                     l2=not exact.singular)
@@ -437,7 +436,7 @@ def pressure_errors(solution: Solution, exact, *, x0: float = 0.0) -> dict:
         "centre": 0.5 * (hi + lo),
         "centroid": profile.centroid,
         "a": a,
-        "htilde": _htilde_near(solution, profile, lo, hi),
+        "htilde": _htilde_near(profile, lo, hi),
     }
 
 
@@ -448,7 +447,7 @@ def _normal_direction(solution: Solution) -> np.ndarray:
     return foundation_line(contact)[1]
 
 
-def _htilde_near(solution: Solution, profile: TractionProfile, lo: float, hi: float) -> float:
+def _htilde_near(profile: TractionProfile, lo: float, hi: float) -> float:
     """The longest h~ edge with a node in [lo, hi] (all of Gamma_C if no node is in contact)."""
     longest = 0.0
     for x0, x1, *_ in profile.edges():

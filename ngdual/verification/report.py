@@ -82,8 +82,8 @@ def format_report(rows: dict) -> str:
                          f"{r['stick_centroid_a']:+7.3f}")
         parts.append("\n".join(lines))
     for name, study in rows["adaptive"].items():
-        parts.append("adaptive (Doerfler 0.5), step as level\n"
-                     + format_rows(study, KEYS[name]).split("\n", 1)[1])
+        parts.append(f"adaptive {name} (Doerfler 0.5; lvl = step, orders in N^-1/2)\n"
+                     + format_rows(study, KEYS[name], "N^-1/2").split("\n", 1)[1])
     parts.append(format_domain(rows["domain"]))
     return "\n\n".join(p for p in parts if p)
 
