@@ -4,6 +4,13 @@
 Tresca, Coulomb) whose contact, stick and slip sets are known exactly, and the study of
 every error per level with observed orders (:func:`manufactured_study`,
 :func:`convergence_orders`, :func:`format_study`).
+
+:mod:`ngdual.verification.analytic`: the half-plane contact solutions (Hertz, the rigid flat
+punch, Cattaneo-Mindlin) and the errors of a computed pressure and shear traction against
+them (:func:`pressure_errors`, :func:`traction_errors`).
+:mod:`ngdual.verification.contact_benchmarks`: those errors per level on the shipped contact
+scenes, adaptive runs and the finite-box study; :mod:`ngdual.verification.report`: the
+tables of ``ngdual verify``.
 """
 
 from .analytic import (
