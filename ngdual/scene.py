@@ -870,8 +870,9 @@ def validate(scene: Scene) -> None:
     if ok["solver"]:
         _validate_solver(scene.solver, problems)
     if all(ok[k] for k in ("geometry", "boundary", "loads", "contact", "friction")):
-        if problems.run(_validate_contact, scene, loads["displacement"]):
-            problems.run(_validate_data_on_sides, scene, loads)
+        if problems.run(_validate_formulas_on_sides, scene, loads) \
+                and problems.run(_validate_contact, scene, loads["displacement"]):
+            problems.run(_validate_gap_and_bound, scene)
     problems.raise_any()
 
 
@@ -943,13 +944,12 @@ def _validate_solver(sol: Solver, problems: _Problems) -> None:
     problems.run(_positive, sol.max_iter, "solver.max_iter", integer=True)
 
 
-def _validate_data_on_sides(scene: Scene, loads: dict[str, list[Expression]]) -> None:
-    """Gap, Tresca bound, traction and boundary displacement where they act.
+def _validate_formulas_on_sides(scene: Scene, loads: dict[str, list[Expression]]) -> None:
+    """Traction, boundary displacement, gap and Tresca bound where they act.
 
     Each formula must be finite on its closed sides (their end points are mesh vertices)
-    and integrable there (:func:`_integral_diverges_near`); the gap must be >= 0 and a
-    Tresca bound >= 0 and not zero everywhere. The body force and the quadrature points
-    of the actual mesh are checked before assembly (:mod:`ngdual.quadrature_check`).
+    and integrable there (:func:`_pole`). The body force and the quadrature points of the
+    actual mesh are checked before assembly (:mod:`ngdual.quadrature_check`).
     """
     problems = _Problems()
     curves = scene.geometry.curves()
@@ -966,10 +966,15 @@ def _validate_data_on_sides(scene: Scene, loads: dict[str, list[Expression]]) ->
         with problems.check():
             _formula_on_sides(expr, name, [c for c in curves if c.label in scene.labels(role)],
                               where[role])
-    if problems.found:
-        problems.raise_any()
+    problems.raise_any()
+
+
+def _validate_gap_and_bound(scene: Scene) -> None:
+    """The gap must be >= 0 on Gamma_C, a Tresca bound >= 0 and not zero everywhere."""
     if not scene.has_contact:
         return
+    problems = _Problems()
+    con, fr = scene.contact, scene.friction
     xy, normals = contact_samples(scene)
     x, y = xy[:, 0], xy[:, 1]
     g = gap_at(con, xy, normals)

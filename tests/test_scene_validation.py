@@ -33,6 +33,18 @@ BAD = [
     (["material.youngs=1"], "material.youngs", "unknown key"),
     (["loads.traction=['0']"], "loads.traction", "pair"),
     (["geometry.level=0"], "geometry.level", "positive"),
+    (["geometry.level=2.5"], "geometry.level", "integer"),
+    (["material.E=1e-300"], "material.E", "outside"),
+    (["material.E='2e5'"], "material.E", "must be a number"),
+    (["solver.rho2='abc'"], "solver.rho2", "must be a number"),
+    (["friction.law='tresca'"], "friction.bound", "needs a bound"),
+    (["friction.law='coulomb'"], "friction.mu", "mu > 0"),
+    (["friction.law='tresca'", "friction.bound='-1'"], "friction.bound", ">= 0"),
+    (["contact.gap='10**10**10'"], "contact.gap", "overflows"),
+    (["contact.gap='x*True'"], "contact.gap", "not a number"),
+    (["loads.traction=['0', '-800/x']"], "loads.traction[1]", "not integrable"),
+    (["loads.traction=['0', 'ifpos(x, 1)']"], "loads.traction[1]", "takes 3 arguments"),
+    (["loads.displacement=['0', 'log(y + 1)']"], "loads.displacement[1]", "not finite"),
 ]
 
 
@@ -159,3 +171,90 @@ def test_contact_sides_meeting_each_other_need_no_end_condition():
                                  "neumann": ["top"]})
     scene.loads.displacement = ["0", "y"]  # vanishes at the corners (+-1, 0) only
     validate(scene)
+
+
+def test_several_problems_in_one_scene_are_reported_together():
+    with pytest.raises(SceneError) as info:
+        load_scene("thesis-3.46-frictionless", ["material.E=0", "material.nu=0.7",
+                                                "solver.eps=-1", "contact.gap='x +'"])
+    assert set(info.value.fields) == {"material.E", "material.nu", "solver.eps", "contact.gap"}
+    lines = str(info.value).splitlines()
+    assert lines[0] == "4 problems in the scene:" and len(lines) == 5
+    assert info.value.field == info.value.fields[0]
+
+
+def test_a_scene_must_state_its_geometry():
+    """No [geometry] table (or no kind) is refused; it never becomes the thesis rectangle."""
+    from ngdual.scene import scene_from_dict
+
+    boundary = {"dirichlet": ["left", "right", "top", "bottom"]}
+    with pytest.raises(SceneError, match="geometry: missing table"):
+        scene_from_dict({"boundary": boundary})
+    with pytest.raises(SceneError, match="geometry.kind: missing"):
+        scene_from_dict({"geometry": {"level": 2}, "boundary": boundary})
+    scene = scene_from_dict({"geometry": {"kind": "thesis-3.46", "level": 2},
+                             "boundary": boundary})
+    assert scene.geometry.kind == "thesis-3.46" and scene.geometry.level == 2
+
+
+@pytest.mark.parametrize("points, words", [
+    ([[0, 0], [1, 0], [1, 0], [1, 1], [0, 1]], "points[1] and points[2] coincide"),
+    ([[0, 0], [1, 0], [1, 1], [0, 1], [0, 0]], "points[0] and points[4] coincide"),
+    ([[0, 0], [2, 0], [1, 1], [2, 2], [0, 2], [1, 1]], "the boundary touches itself"),
+    ([[0, 0], [2, 0], [2, 2], [1, -1], [0, 2]], "intersects itself"),
+])
+def test_degenerate_polygons_never_reach_netgen(points, words):
+    """A zero-length side crashed netgen (segfault); a positive-area bow-tie hung it."""
+    from ngdual.mesh import build_mesh
+    from ngdual.scene import Geometry
+
+    geo = Geometry(kind="polygon", points=points, labels=[f"s{i}" for i in range(len(points))])
+    with pytest.raises(SceneError, match="geometry.points") as info:
+        build_mesh(geo)
+    assert words in str(info.value)
+
+
+def test_integrable_singularities_pass_and_poles_do_not():
+    ok = ["-800/sqrt(abs(x - 0.3))", "-800*log(abs(x - 0.3))", "-800*ifpos(x - 0.3, 1, 0)",
+          "-800*exp(-1e4*(x - 0.3)**2)"]
+    for formula in ok:
+        load_scene("thesis-3.46-frictionless", [f"loads.traction=['0', '{formula}']"])
+    for formula in ("-800/(x - 0.3)", "1/(x*x - 0.09)", "3 + 1e-3/(x - 0.123)"):
+        with pytest.raises(SceneError, match="not integrable") as info:
+            load_scene("thesis-3.46-frictionless", [f"loads.traction=['0', '{formula}']"])
+        assert info.value.field == "loads.traction[1]"
+
+
+def test_constants_are_folded_once_in_floating_point():
+    from ngdual.expr import Expression, ExpressionError
+
+    assert Expression("2**10 + pi").constant == 1024 + __import__("math").pi
+    assert Expression("x**10**10").constant is None   # x-dependent: evaluated in floats
+    for text, words in (("9**9**9", "overflows"), ("exp(1000)", "overflows"),
+                        ("0**-1", "division by zero"), ("(-8)**(1/3)", "not a real number"),
+                        ("log(0)", "not defined"), ("max(x)", "takes 2 arguments")):
+        with pytest.raises(ExpressionError, match=words):
+            Expression(text)
+
+
+def test_a_scene_changed_after_loading_is_validated_again():
+    from ngdual.solve import solve_scene
+
+    scene = load_scene("thesis-3.46-frictionless")
+    scene.material.nu = 0.5
+    with pytest.raises(SceneError, match="material.nu"):
+        solve_scene(scene, 1)
+
+
+def test_the_size_estimate_matches_the_meshes():
+    """Exact for Example 3.46 (Table 3.1); within a factor 2 for netgen's polygons."""
+    from ngdual.budget import estimate
+    from ngdual.mesh import build_mesh
+
+    thesis = load_scene("thesis-3.46-frictionless").geometry
+    for level in (1, 2, 3):
+        assert estimate(thesis, level).elements == build_mesh(thesis, level).ne
+    for name in ("punch-on-foundation", "hertz-cylinder", "flat-punch", "wedge"):
+        geo = load_scene(name).geometry
+        ne = build_mesh(geo, 1).ne
+        assert 0.5 < estimate(geo, 1).elements / ne < 2, name
