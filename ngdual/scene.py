@@ -874,6 +874,7 @@ def validate(scene: Scene) -> None:
                 and problems.run(_validate_contact, scene, loads["displacement"]):
             problems.run(_validate_gap_and_bound, scene)
     problems.raise_any()
+    scene.__dict__["_validated_as"] = repr(scene)  # for ensure_valid
 
 
 def _validate_material(mat: Material) -> None:
