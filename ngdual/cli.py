@@ -35,9 +35,16 @@ def _history(err) -> str:
     if not history:
         return ""
     start = len(history) - min(len(history), HISTORY_ROWS)
-    rows = "  ".join(f"{start + k + 1}: {float(v):.3e}" for k, v in enumerate(history[start:]))
+    rows = "  ".join(f"{start + k + 1}: {_residual(v)}" for k, v in enumerate(history[start:]))
     return f"\nngdual: residual history, last {len(history) - start} of {len(history)} " \
            f"steps (step: residual): {rows}"
+
+
+def _residual(value) -> str:
+    try:
+        return f"{float(value):.3e}"
+    except (TypeError, ValueError):
+        return str(value)[:40]
 
 
 def _not_converged(err) -> int:

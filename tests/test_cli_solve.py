@@ -51,3 +51,25 @@ def test_non_rectangular_scene_solves_with_contact(tmp_path):
     assert record["converged"] and record["contact"]["nodes_in_contact"] >= 1
     assert record["residuals"]["sigma_n_positive"] < 1e-7
     assert record["residuals"]["lambda_n_negative"] == 0.0
+
+
+def test_checks_before_work_accept_an_existing_output_folder_and_debug_after_the_command(
+        tmp_path, capsys):
+    (tmp_path / "notes.txt").write_text("kept")
+    assert main(["solve", "thesis-3.46-frictionless", "--level", "1", "--no-plots", "--out",
+                 str(tmp_path), "--debug"]) == 0
+    assert (tmp_path / "result.json").is_file() and (tmp_path / "notes.txt").read_text() == "kept"
+    assert "Traceback" not in capsys.readouterr().err
+
+
+def test_a_refused_size_names_the_override_and_the_override_is_honoured(tmp_path, capsys,
+                                                                       monkeypatch):
+    import ngdual.budget
+
+    monkeypatch.setattr(ngdual.budget, "available_memory", lambda: 1e6)
+    args = ["solve", "thesis-3.46-frictionless", "--level", "1", "--no-plots", "--out",
+            str(tmp_path)]
+    assert main(args) == 2
+    assert "--allow-large" in capsys.readouterr().err and not any(tmp_path.iterdir())
+    assert main([*args, "--allow-large"]) == 0
+    assert (tmp_path / "result.json").is_file()
