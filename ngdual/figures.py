@@ -192,7 +192,7 @@ class Plan:
     def truth_levels(self, problem: str) -> list[int]:
         """Uniform levels of the true-error studies (:data:`TRUTH_PROBLEMS`): up to K - 1, so
         that the overkill (two levels finer, K + 1) stays affordable."""
-        return list(range(1, self.max_level - TRUTH_PROBLEMS[problem].coarser))
+        return list(range(1, max(2, self.max_level - TRUTH_PROBLEMS[problem].coarser)))
 
     def overkill_level(self, problem: str) -> int:
         """The reference of the true errors: two uniform levels beyond the finest studied."""

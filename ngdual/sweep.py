@@ -354,6 +354,7 @@ def execute(task: Task) -> tuple[dict, dict]:
     header = {"id": task.id, "kind": task.kind, "params": task.params, "label": task.label,
               "started": started, "wall_s": time.perf_counter() - start,
               "host": socket.gethostname(), "pid": os.getpid(),
+              "load_average": list(os.getloadavg()),  # at the end: wall times depend on it
               "python": platform.python_version(), "arrays": sorted(arrays),
               "versions": versions()}
     return {**header, **record, "status": record.get("status", "ok")}, arrays
