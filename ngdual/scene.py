@@ -3,9 +3,14 @@
 A scene is a TOML file (or the equivalent :class:`Scene` object). Every user
 error is detected here, by :func:`validate`, and reported as one
 :class:`SceneError` whose message names the offending field, e.g.
-``material.nu: Poisson's ratio must lie in (-1, 0.5), got 0.5``.
+``material.nu: Poisson's ratio must lie in (-1, 0.5), got 0.5``; several problems
+in one scene are reported together, one line each. Types, ranges, formulas
+(:mod:`ngdual.expr`: bounded, finite and integrable where they act) and the geometry
+(no repeated points, zero-length or crossing sides) are all checked before anything
+is meshed.
 
-The schema (all tables optional except ``geometry`` and ``boundary``)::
+The schema (all tables optional except ``geometry``, whose ``kind`` must be given, and
+``boundary``: a scene states its domain, it never defaults to the thesis rectangle)::
 
     name = "thesis-3.46-frictionless"
     [geometry]   kind = "thesis-3.46" | "polygon", level, points, labels, maxh, arcs
