@@ -307,6 +307,15 @@ def cmd_bench(args) -> int:
     return 0 if all(r["converged"] for r in run["records"]) else EXIT_NOT_CONVERGED
 
 
+def cmd_verify(args) -> int:
+    from .io import check_output_file
+    from .verification.report import run
+
+    if args.json:
+        check_output_file(args.json, "--json")
+    return run(args)
+
+
 def cmd_tutorials(args) -> int:
     """List the tutorials; with --notebooks DIR write them (and their solutions) as notebooks."""
     from .io import check_output_dir
@@ -426,6 +435,14 @@ def parser() -> argparse.ArgumentParser:
     be.add_argument("--blas-threads", type=int, default=1, metavar="N",
                     help="BLAS threads for every solver (default 1; 0: the libraries' own)")
     be.set_defaults(func=cmd_bench)
+    ve = sub.add_parser("verify", help="errors against exact solutions: manufactured contact "
+                                       "problems and the Hertz, flat-punch and "
+                                       "Cattaneo-Mindlin benchmarks, with observed orders")
+    ve.add_argument("--quick", action="store_true",
+                    help="two levels of two manufactured cases and of every benchmark (~20 s)")
+    ve.add_argument("--json", default=None, metavar="FILE",
+                    help="also write every row (with package versions) to FILE, atomically")
+    ve.set_defaults(func=cmd_verify)
     return p
 
 

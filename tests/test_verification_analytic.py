@@ -7,17 +7,16 @@ a sqrt(1 - |Q|/(mu_f P)). The benchmark settings and the separation of the finit
 are in :mod:`ngdual.verification.contact_benchmarks`.
 """
 
-import argparse
 import json
 import math
 
 import numpy as np
 import pytest
 
+from ngdual.cli import main
 from ngdual.verification import cattaneo_mindlin, flat_punch, hertz
 from ngdual.verification.analytic import _nodes
 from ngdual.verification.contact_benchmarks import domain_study, uniform_study
-from ngdual.verification.report import add_arguments, run
 
 
 def _integral(f, a, b):
@@ -78,10 +77,8 @@ def test_cattaneo_mindlin_stick_half_width_is_within_one_friction_cell():
 
 
 def test_verify_quick_prints_the_tables_and_writes_them(tmp_path, capsys):
-    parser = argparse.ArgumentParser()
-    add_arguments(parser)
     path = tmp_path / "verify.json"
-    assert run(parser.parse_args(["--quick", "--json", str(path)])) == 0
+    assert main(["verify", "--quick", "--json", str(path)]) == 0
     out = capsys.readouterr().out
     for title in ("manufactured case frictionless", "benchmark hertz", "benchmark flat-punch",
                   "benchmark cattaneo-mindlin", "stick zone"):

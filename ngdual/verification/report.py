@@ -5,11 +5,7 @@ benchmarks (:mod:`ngdual.verification.contact_benchmarks`) under uniform refinem
 full run adds the adaptive runs and the finite-box study. ``--quick`` runs two levels of
 each (under a minute), ``--json PATH`` writes every row (atomically).
 
-The CLI wires this in with :func:`add_arguments` and :func:`run`::
-
-    parser = subparsers.add_parser("verify")
-    add_arguments(parser)
-    ... run(args)
+:func:`run` is the command (``ngdual.cli`` defines its two options).
 """
 
 from __future__ import annotations
@@ -26,14 +22,6 @@ QUICK = {"manufactured": ("frictionless", "coulomb"), "manufactured_levels": (1,
          "benchmark_levels": (1, 2)}
 FULL = {"manufactured": tuple(CASES), "manufactured_levels": (1, 2, 3, 4, 5),
         "benchmark_levels": (1, 2, 3, 4)}
-
-
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """The options of ``ngdual verify``."""
-    parser.add_argument("--quick", action="store_true",
-                        help="two levels of two manufactured cases and of every benchmark")
-    parser.add_argument("--json", metavar="PATH", default=None,
-                        help="also write every row as JSON to PATH")
 
 
 def verification_rows(quick: bool = False) -> dict:
