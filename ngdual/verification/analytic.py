@@ -50,6 +50,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
+from ..friction import hat_projection
 from ..post import contact_traces, force_balance
 from ..scene import foundation_line
 from ..solvers.result import Solution
@@ -282,11 +283,10 @@ def traction_profile(solution: Solution) -> TractionProfile:
     end_hats = gamma_c.hat_means(pb.spaces.end_hats["lam_n"])           # fixed-end hats
     length = gamma_c.lengths
     along = np.sign(gamma_c.tangents @ _plane_direction(solution))
-    mass = np.concatenate([hats.T @ length, end_hats.T @ length])
-    t_n = np.concatenate([hats.T @ (length * traces.sigma_n),
-                          end_hats.T @ (length * traces.sigma_n)])
-    t_t = np.concatenate([hats.T @ (length * along * traces.sigma_t),
-                          end_hats.T @ (length * along * traces.sigma_t)])
+    sigma_n = np.concatenate([hat_projection(h, length, traces.sigma_n)
+                              for h in (hats, end_hats)])
+    sigma_t = np.concatenate([hat_projection(h, length, along * traces.sigma_t)
+                              for h in (hats, end_hats)])
     contact = np.concatenate([traces.coarse_in_contact, np.zeros(end_hats.shape[1], bool)])
     # column of every h~ node, chain by chain in chain order
     xs, columns, starts = [], [], []
@@ -305,8 +305,8 @@ def traction_profile(solution: Solution) -> TractionProfile:
         xs.append(chain.path_points[positions])
     columns = np.array(columns)
     x = _plane_coordinate(solution, np.vstack(xs))
-    return TractionProfile(x, np.array(starts), -t_n[columns] / mass[columns],
-                          t_t[columns] / mass[columns], contact[columns])
+    return TractionProfile(x, np.array(starts), -sigma_n[columns], sigma_t[columns],
+                          contact[columns])
 
 
 def _plane_direction(solution: Solution) -> np.ndarray:
