@@ -9,7 +9,7 @@ contact conditions see (:func:`ngdual.verification.analytic.traction_profile`; t
 fine-edge values of sigma_n^h, light, oscillate about it) -- against the analytic
 half-plane solution for the computed total force (Hertz, Sadowsky's flat punch,
 Cattaneo-Mindlin, whose tangential traction is shown too, with the computed stick zone
-shaded). The wedge has no closed form: its pressure is shown alone.
+shaded; the blunt wedge, p = (E* s / pi) arccosh(a / |x|)).
 """
 
 import numpy as np
@@ -27,8 +27,7 @@ WINDOW = 3.0       # the window shown: WINDOW contact half-widths around the con
 
 
 def exact_solution(scene, P: float, Q: float):
-    """The half-plane solution of the scene for the computed forces P (normal), Q (tangential),
-    or None (the wedge)."""
+    """The half-plane solution of the scene for the computed forces P (normal), Q (tangential)."""
     E, nu = scene.material.E, scene.material.nu
     if scene.geometry.arcs:
         (center,) = scene.geometry.arcs.values()
@@ -40,6 +39,11 @@ def exact_solution(scene, P: float, Q: float):
         k = scene.geometry.labels.index(scene.labels("contact")[0])
         a = 0.5 * abs(scene.geometry.points[k + 1][0] - scene.geometry.points[k][0])
         return analytic.flat_punch(P, a)
+    if scene.name == "wedge":
+        pts = np.asarray(scene.geometry.points)
+        k = scene.geometry.labels.index(scene.labels("contact")[0])
+        dx, dy = pts[(k + 1) % len(pts)] - pts[k]
+        return analytic.wedge(P, abs(dy / dx), E, nu)
     return None
 
 

@@ -97,3 +97,24 @@ def test_flat_punch_domain_error_shrinks_with_the_box():
     domain = [abs(r["domain"]) for r in rows]
     assert domain[0] > domain[1] and domain[0] > domain[2], rows
     assert domain[2] < 0.003, rows
+
+
+def test_wedge_pressure_converges_to_the_blunt_wedge_solution():
+    """The kinked Gamma_C of the wedge against p = (E* s / pi) arccosh(a/|x|), a = P/(E* s):
+    the L2 error of p_h falls on every level (slowly: the contact zone spans few h~ cells
+    and p is log-singular at the apex) and the contact zone lands within one h~ cell."""
+    from ngdual.scene import load_scene
+    from ngdual.solve import solve_scene
+    from ngdual.verification import pressure_errors, traction_profile, wedge
+
+    errors = []
+    for level in (2, 3, 4):
+        scene = load_scene("wedge")
+        solution = solve_scene(scene, level)
+        exact = wedge(traction_profile(solution).force, 0.1, scene.material.E,
+                      scene.material.nu)
+        row = pressure_errors(solution, exact)
+        assert row["max"] is None and math.isfinite(row["l2"])
+        errors.append(row["l2"])
+    assert errors[0] > errors[1] > errors[2], errors
+    assert abs(row["half_width"] - row["a"]) <= row["htilde"], row

@@ -18,6 +18,7 @@ from .analytic import (
     FlatPunch,
     HertzContact,
     TractionProfile,
+    Wedge,
     cattaneo_mindlin,
     flat_punch,
     hertz,
@@ -25,6 +26,7 @@ from .analytic import (
     pressure_errors,
     traction_errors,
     traction_profile,
+    wedge,
 )
 from .manufactured import (
     CASES,
@@ -48,9 +50,9 @@ from .manufactured import (
 from .piecewise import Piecewise
 
 __all__ = ["CASES", "CattaneoMindlin", "ExactSolution", "FlatPunch", "HertzContact",
-           "ManufacturedCase", "Piecewise", "TractionProfile", "boundary_errors",
+           "ManufacturedCase", "Piecewise", "TractionProfile", "Wedge", "boundary_errors",
            "cattaneo_mindlin", "contact_profile", "convergence_orders", "coulomb_case",
            "discrete_sets", "flat_punch", "format_study", "frictionless_case", "hertz",
            "intersection", "manufactured_case", "manufactured_study", "mcewen_approach",
            "pressure_errors", "print_study", "symmetric_difference", "traction_errors",
-           "traction_profile", "tresca_case", "volume_errors"]
+           "traction_profile", "tresca_case", "volume_errors", "wedge"]

@@ -6,6 +6,8 @@ Sections 2.8, 5.2, 7.1), P and Q forces per unit thickness, E* = E / (1 - nu^2):
 
 * Hertz (a cylinder of radius R on a rigid plane): a = sqrt(4 P R / (pi E*)),
   p(x) = p0 sqrt(1 - x^2/a^2), p0 = 2 P / (pi a).
+* A blunt wedge (flanks of slope s = cot of the semi-angle) on a rigid plane:
+  p(x) = (E* s / pi) arccosh(a / |x|), a = P / (E* s) (log-singular at the apex, in L2).
 * Rigid flat punch of half-width a (Sadowsky): p(x) = P / (pi sqrt(a^2 - x^2)), singular
   at x = +-a; the force on |x| < a/2 is (2/pi) arcsin(1/2) P = P/3.
 * Cattaneo-Mindlin (Hertz plus a tangential force |Q| < mu_f P, material with
@@ -149,6 +151,45 @@ class FlatPunch:
 def flat_punch(P: float, a: float) -> FlatPunch:
     """The rigid flat punch (Sadowsky 1928; Johnson 1985, eq. 2.64)."""
     return FlatPunch(P, a)
+
+
+@dataclass(frozen=True)
+class Wedge:
+    """A blunt elastic wedge with flanks of slope s pressed with force P on a rigid plane.
+
+    >>> w = wedge(P=2.0, slope=0.1, E=1.0, nu=0.0)
+    >>> round(w.a, 12), float(w.pressure(np.array([w.a, 2 * w.a]))[1])
+    (20.0, 0.0)
+    """
+
+    P: float
+    slope: float
+    E_star: float
+
+    singular = False   # log-singular at the apex, but in L2
+
+    @property
+    def a(self) -> float:
+        """a = P / (E* s): with P = (E*/2) int x h'(x) / sqrt(a^2 - x^2) dx, h = s |x|."""
+        return self.P / (self.E_star * self.slope)
+
+    @property
+    def breaks(self) -> tuple[float, ...]:
+        return (-self.a, 0.0, self.a)
+
+    def pressure(self, x: np.ndarray) -> np.ndarray:
+        """p(x) = (E* s / pi) arccosh(a / |x|) on |x| < a (inf at the apex), 0 outside."""
+        x = np.abs(np.asarray(x, dtype=float))
+        out = np.zeros_like(x)
+        inside = x < self.a
+        with np.errstate(divide="ignore"):
+            out[inside] = self.E_star * self.slope / math.pi * np.arccosh(self.a / x[inside])
+        return out
+
+
+def wedge(P: float, slope: float, E: float, nu: float) -> Wedge:
+    """The blunt wedge (Johnson 1985, Sec. 5.2), plane strain E* = E / (1 - nu^2)."""
+    return Wedge(P, slope, E / (1.0 - nu * nu))
 
 
 @dataclass(frozen=True)
@@ -393,15 +434,16 @@ def _node_max(profile: TractionProfile, exact_fn, which: str, x0: float, lo: flo
 def pressure_errors(solution: Solution, exact, *, x0: float = 0.0) -> dict:
     """Errors of the computed contact pressure against ``exact.pressure(x - x0)``.
 
-    ``exact``: :class:`HertzContact`, :class:`FlatPunch` or :class:`CattaneoMindlin` (its
-    Hertz pressure). The discrete pressure is the h~-hat projection of -sigma_n^h
-    (:func:`traction_profile`; the module docstring says why). Returns
+    ``exact``: :class:`HertzContact`, :class:`FlatPunch`, :class:`Wedge` or
+    :class:`CattaneoMindlin` (its Hertz pressure). The discrete pressure is the h~-hat
+    projection of -sigma_n^h (:func:`traction_profile`; the module docstring says why).
+    Returns
 
     * ``l2``: ||p_h - p||_L2(Gamma_C) / ||p||_L2 (None for the flat punch: p is not in L2),
     * ``l1``: ||p_h - p||_L1 / ||p||_L1, the force-type measure (bounds the relative error of
       the force on every subset of Gamma_C),
     * ``max``: max over the h~ nodes of |p_h - p| / max p (flat punch: over the core nodes,
-      against p(0)),
+      against p(0); None for the wedge, whose p is unbounded at the apex),
     * ``l2_core``, ``max_core``: the same on the core |x - x0| < a/2, away from the edges,
     * ``force`` P_h = int p_h, ``resultant`` the normal component of int sigma^h n ds,
       ``force_core`` int_{|x - x0| < a/2} p_h and ``force_core_exact``,
@@ -416,10 +458,13 @@ def pressure_errors(solution: Solution, exact, *, x0: float = 0.0) -> dict:
                     l2=not exact.singular)
     inner = _errors(profile, exact.pressure, exact.breaks, "pressure", x0, *core)
     peak = float(exact.pressure(np.array([0.0]))[0])
-    if exact.singular:
-        max_all = _node_max(profile, exact.pressure, "pressure", x0, *core, peak)
+    if not math.isfinite(peak):   # the wedge's apex: no maximum norm
+        max_all = max_core = None
+    elif exact.singular:
+        max_all = max_core = _node_max(profile, exact.pressure, "pressure", x0, *core, peak)
     else:
         max_all = _node_max(profile, exact.pressure, "pressure", x0, -np.inf, np.inf, peak)
+        max_core = _node_max(profile, exact.pressure, "pressure", x0, *core, peak)
     lo, hi = profile.contact_interval()
     balance = force_balance(solution)
     return {
@@ -427,7 +472,7 @@ def pressure_errors(solution: Solution, exact, *, x0: float = 0.0) -> dict:
         "l1": whole["l1"] / whole["norm_l1"],
         "max": max_all,
         "l2_core": inner["l2"] / inner["norm_l2"],
-        "max_core": _node_max(profile, exact.pressure, "pressure", x0, *core, peak),
+        "max_core": max_core,
         "force": profile.force,
         "resultant": float(balance.resultant @ _normal_direction(solution)),
         "force_core": profile.integral(profile.pressure, *core),
