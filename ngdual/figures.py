@@ -657,7 +657,7 @@ def true_error_study(ctx: Context, problem: str) -> dict:
     data = _plain({"rows": rows, "reference": {
         "scene": tp.scene, "overrides": list(tp.overrides), "level": top.params["level"],
         "ndof": ref_record["ndof"], "time_s": ref_record["timings_s"]["total"],
-        "richardson": check}})
+        "richardson": check}, "versions": versions()})
     write_json(data, cache)
     return data
 
