@@ -138,9 +138,10 @@ def run(ctx):
             for xkey, xlabel in (("time_s", "wall time [s]"), ("ndof", "unknowns [-]")):
                 curves = []
                 for m in methods:
+                    # in refinement order: the measured times carry noise
                     pts = sorted((r for r in rows if r["problem"] == problem
                                   and r["method"] == m and r.get(measure)),
-                                 key=lambda r: r[xkey])
+                                 key=lambda r: r["ndof"])
                     if pts:
                         curves.append({"x": [r[xkey] for r in pts],
                                        "y": [r[measure] for r in pts], "label": m, **style[m]})
