@@ -960,7 +960,9 @@ def write_index(out: Path, summary: dict, source: str | Path | None = None) -> P
 
 
 GALLERY = ("fig_3_11_von_mises", "fig_3_19_tangential_displacement", "fig_3_23_rho_grid",
-           "fig_4_13_", "work_precision")
+           "fig_4_13_", "work_precision",
+           *(f"contact_scenes_{name}" for name in ("hertz-cylinder", "flat-punch",
+                                                    "cattaneo-mindlin", "wedge")))
 
 
 def write_gallery(out: str | Path, dest: str | Path, width: int = 900,
