@@ -142,6 +142,7 @@ def run(ctx):
         ax_c.grid(alpha=0.3)
         ax_c.legend(loc="upper right", fontsize=8)
         ax_c.set_title(f"P = {P:.4g}" + (f", Q = {Q:.4g}" if abs(Q) > 1e-9 * abs(P) else ""))
+        fig.suptitle(f"{name}: stress near the contact zone and tractions on $\\Gamma_C$")
         files += plot.save_figure(fig, ctx.figure_stem(f"contact_scenes_{name}"))
         numbers[f"{name}: contact zone"] = [row["contact_from"], row["contact_to"]]
         if "exact_half_width" in row:
