@@ -10,6 +10,8 @@ runs the adaptive loop and writes ``DIR/history.json`` plus a mesh (.vol, .png) 
 writes them as Jupyter notebooks.
 ``ngdual bench [--levels ...] [--json FILE]`` times the contact solvers against one
 linear solve of the same matrix (the limit ratio, :mod:`ngdual.bench`).
+``ngdual verify [--quick] [--json FILE]`` prints the errors against exact solutions with
+observed orders (:mod:`ngdual.verification.report`).
 Exit status: 0 solved and converged, 1 not converged, 2 bad input (one message naming
 every field or flag at fault; nothing is written), 3 an internal error (a bug: the message
 says so; ``ngdual --debug ...`` shows the traceback). Runs whose estimated size exceeds the
