@@ -6,13 +6,12 @@ constant gap (red, g = 0.01 drawn 20x enlarged) and the gap (3.125) (blue). Righ
 gap functions of the shipped scenes. No solve: data/fig_3_10_geometry.csv samples t_0 and g.
 """
 
-import ngsolve as ngs
 import numpy as np
 
 from ngdual import plot
 from ngdual.expr import Expression
 from ngdual.figures import script_main
-from ngdual.mesh import thesis_mesh
+from ngdual.mesh import mesh_arrays, thesis_mesh
 from ngdual.scene import load_scene
 
 THESIS = "Fig. 3.10"
@@ -31,8 +30,7 @@ def run(ctx):
     gaps = {label: Expression(load_scene(name).contact.gap).numpy(x, -np.ones_like(x))
             for label, name in GAPS.items()}
     mesh = thesis_mesh(1)
-    points = np.array([v.point for v in mesh.vertices])
-    triangles = np.array([[v.nr for v in el.vertices] for el in mesh.Elements(ngs.VOL)])
+    points, triangles = mesh_arrays(mesh)
     # WRITE
     rows = [{"x1": xi, "t0_2": ti, **{label: g[i] for label, g in gaps.items()}}
             for i, (xi, ti) in enumerate(zip(x, load))]

@@ -162,12 +162,11 @@ def cmd_dofs(args) -> int:
 
 def cmd_adapt(args) -> int:
     """SOLVE -> ESTIMATE -> MARK -> REFINE; writes DIR/history.json and a mesh per step."""
-    import ngsolve as ngs
-    import numpy as np
 
     from . import budget, plot
     from .afem import adapt, reference_norms
     from .io import check_output_dir, write_json
+    from .mesh import mesh_arrays
     from .post import versions
     from .solvers.result import ConvergenceError
 
@@ -201,8 +200,7 @@ def cmd_adapt(args) -> int:
         stem = out / f"mesh_step{record['step']:02d}"
         stem.parent.mkdir(parents=True, exist_ok=True)
         mesh.ngmesh.Save(str(stem) + ".vol")
-        points = np.array([v.point for v in mesh.vertices])
-        triangles = np.array([[v.nr for v in el.vertices] for el in mesh.Elements(ngs.VOL)])
+        points, triangles = mesh_arrays(mesh)
         plot.plot_mesh(points, triangles, str(stem) + ".png",
                        f"{scene.name}, {args.marking} marking, step {record['step']}: "
                        f"{mesh.ne} triangles", marked)

@@ -48,6 +48,7 @@ from . import peers
 from .contact import gap_coefficient
 from .expr import Expression
 from .forms import boundary_regex
+from .mesh import element_diameters
 from .post import fields
 from .solvers.result import Solution
 
@@ -111,14 +112,6 @@ class Estimate:
     def summed(self) -> dict[str, float]:
         """sum_T of every squared term (their sum is ``total**2``)."""
         return {k: float(np.sum(v)) for k, v in self.terms.items()}
-
-
-def element_diameters(mesh: ngs.Mesh) -> np.ndarray:
-    """h_T = the longest edge of every triangle."""
-    pts = np.array([v.point for v in mesh.vertices])
-    tri = np.array([[v.nr for v in el.vertices] for el in mesh.Elements(ngs.VOL)])
-    p = pts[tri]
-    return np.linalg.norm(p - np.roll(p, 1, axis=1), axis=2).max(axis=1)
 
 
 def _tangent():

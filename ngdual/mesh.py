@@ -116,10 +116,20 @@ def build_mesh(geo: Geometry, level: int | None = None) -> ngs.Mesh:
     return polygon_mesh(geo.points, geo.labels, geo.maxh, level, geo.arcs, geo.side_maxh)
 
 
+def mesh_arrays(mesh: ngs.Mesh) -> tuple[np.ndarray, np.ndarray]:
+    """Vertex coordinates (n, 2) and the vertex numbers of every triangle (ne, 3)."""
+    points = np.array([v.point for v in mesh.vertices])
+    triangles = np.array([[v.nr for v in el.vertices] for el in mesh.Elements(ngs.VOL)])
+    return points, triangles
+
+
+def element_diameters(mesh: ngs.Mesh) -> np.ndarray:
+    """h_T = the longest edge of every triangle."""
+    points, triangles = mesh_arrays(mesh)
+    p = points[triangles]
+    return np.linalg.norm(p - np.roll(p, 1, axis=1), axis=2).max(axis=1)
+
+
 def mesh_size(mesh: ngs.Mesh) -> float:
     """The largest triangle diameter h (the first column of Table 3.1)."""
-    pts = np.array([v.point for v in mesh.vertices])
-    tri = np.array([[v.nr for v in el.vertices] for el in mesh.Elements(ngs.VOL)])
-    p = pts[tri]
-    edges = np.linalg.norm(p - np.roll(p, 1, axis=1), axis=2)
-    return float(edges.max())
+    return float(element_diameters(mesh).max())

@@ -275,8 +275,9 @@ def write_vtk(solution: Solution, filename: str) -> str:
 
 def element_values(mesh: ngs.Mesh, cf) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Vertex coordinates, triangles and the value of ``cf`` at every centroid (for plots)."""
-    points = np.array([v.point for v in mesh.vertices])
-    triangles = np.array([[v.nr for v in el.vertices] for el in mesh.Elements(ngs.VOL)])
+    from .mesh import mesh_arrays
+
+    points, triangles = mesh_arrays(mesh)
     centroids = points[triangles].mean(axis=1)
     mips = mesh(centroids[:, 0], centroids[:, 1])
     return points, triangles, np.asarray(cf(mips)).ravel()

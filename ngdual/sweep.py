@@ -211,10 +211,9 @@ def adapt_task(scene: str, marking: str, theta: float, steps: int, level: int,
     :func:`ngdual.verification.reference.solution_samples`, prefixed ``s<k>_``; the run stops
     after the first step whose mesh has at least ``max_elements`` triangles.
     """
-    import ngsolve as ngs
-
     from .afem import adapt
     from .estimator import estimate
+    from .mesh import mesh_arrays
     from .solvers.result import ConvergenceError
 
     history, arrays = [], {}
@@ -234,9 +233,7 @@ def adapt_task(scene: str, marking: str, theta: float, steps: int, level: int,
         k = record["step"]
         if k in snapshots:
             mesh = solution.problem.fes.mesh
-            arrays[f"points_{k}"] = np.array([v.point for v in mesh.vertices])
-            arrays[f"triangles_{k}"] = np.array([[v.nr for v in el.vertices]
-                                                 for el in mesh.Elements(ngs.VOL)])
+            arrays[f"points_{k}"], arrays[f"triangles_{k}"] = mesh_arrays(mesh)
             arrays[f"marked_{k}"] = (np.zeros(mesh.ne, bool) if marked is None
                                      else np.asarray(marked, bool))
         if samples:

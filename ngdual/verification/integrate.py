@@ -15,6 +15,8 @@ from __future__ import annotations
 import ngsolve as ngs
 import numpy as np
 
+from ..mesh import mesh_arrays
+
 
 def _cross(a: np.ndarray, b: np.ndarray) -> float:
     return float(a[0] * b[1] - a[1] * b[0])
@@ -66,8 +68,7 @@ class PiecewiseQuadrature:
 
     def __init__(self, mesh: ngs.Mesh, breaks, order: int):
         self.mesh, self.order = mesh, order
-        points = np.array([v.point for v in mesh.vertices])
-        triangles = np.array([[v.nr for v in el.vertices] for el in mesh.Elements(ngs.VOL)])
+        points, triangles = mesh_arrays(mesh)
         breaks = np.asarray(sorted(set(breaks)), dtype=float)
         rule = ngs.IntegrationRule(ngs.TRIG, order)
         ref = np.array([p[:2] for p in rule.points])

@@ -36,6 +36,8 @@ import math
 import ngsolve as ngs
 import numpy as np
 
+from ..mesh import mesh_arrays
+
 # reference coordinates of the P2 nodes: vertices 0, 1, 2 of NGSolve's reference triangle
 # (barycentric l_0 = x, l_1 = y, l_2 = 1 - x - y), then the midpoints of edges 01, 12, 20
 P2_NODES = ((1.0, 0.0), (0.0, 1.0), (0.0, 0.0), (0.5, 0.5), (0.0, 0.5), (0.5, 0.0))
@@ -53,8 +55,8 @@ def element_samples(mesh: ngs.Mesh, fields: dict[str, ngs.CoefficientFunction]) 
     nodes of every triangle (ne, 6, dim), evaluated inside the triangle."""
     ir = ngs.IntegrationRule(list(P2_NODES), [0.0] * 6)
     mips = mesh.MapToAllElements(ir, ngs.VOL)
-    out = {"vertices": np.array([v.point for v in mesh.vertices]),
-           "triangles": np.array([[v.nr for v in el.vertices] for el in mesh.Elements(ngs.VOL)])}
+    vertices, triangles = mesh_arrays(mesh)
+    out = {"vertices": vertices, "triangles": triangles}
     xy = np.asarray(ngs.CF((ngs.x, ngs.y))(mips)).reshape(mesh.ne, 6, 2)
     if not np.allclose(xy[:, :3], out["vertices"][out["triangles"]], atol=1e-12):
         raise RuntimeError("NGSolve's reference vertex order changed: P2_NODES must follow it")
