@@ -19,7 +19,7 @@ import time
 def one_level(scene_name: str, level: int, repeat: int) -> dict:
     from ngdual.estimator import estimate
     from ngdual.scene import load_scene
-    from ngdual.solve import solve_scene
+    from ngdual.solvers import solve_scene
     from ngdual.solvers.linear import Factorization
 
     solution = solve_scene(load_scene(scene_name), level)

@@ -19,7 +19,7 @@ import sys
 def one_level(scene_name: str, level: int, overrides: list[str]) -> dict:
     from ngdual.post import norms, versions
     from ngdual.scene import load_scene
-    from ngdual.solve import solve_scene
+    from ngdual.solvers import solve_scene
 
     scene = load_scene(scene_name, overrides)
     sol = solve_scene(scene, level)

@@ -30,7 +30,7 @@ from .mesh import build_mesh
 from .post import aitken_extrapolate, norms, total_error
 from .quadrature_check import check_formulas
 from .scene import Scene, SceneError, SceneTypeError, check_level, ensure_valid
-from .solve import check_unknowns, solve_problem, solve_scene
+from .solvers import check_unknowns, solve_problem, solve_scene
 from .solvers.result import Solution
 
 StepCallback = Callable[[dict, Solution, Estimate, np.ndarray | None], None]

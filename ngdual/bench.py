@@ -19,7 +19,7 @@ one scale.
 
 Solver variants: ``uzawa`` (Algorithm 3.38 / nested Uzawa 3.41 with Remark 3.45, the
 scene's default steps rho = rho1 = rho2 = 1), ``uzawa-tuned`` (the steps of ``TUNED``),
-``active-set`` (:mod:`ngdual.solvers.fast`). Functions return records; printing and file
+``active-set`` (:mod:`ngdual.solvers.active_set`). Functions return records; printing and file
 writing are in :mod:`ngdual.cli`.
 """
 
@@ -142,7 +142,7 @@ def _measure(case: str, level: int, solver: str) -> dict:
     from .mesh import build_mesh
     from .post import norms
     from .scene import load_scene
-    from .solve import solve_problem
+    from .solvers import solve_problem
     from .solvers.result import ConvergenceError
 
     scene = load_scene(CASES[case], _overrides(solver))

@@ -100,7 +100,7 @@ def _progress():
 def cmd_solve(args) -> int:
     from . import budget, plot, post
     from .io import check_output_dir, write_json
-    from .solve import solve_scene
+    from .solvers import solve_scene
     from .solvers.result import ConvergenceError
 
     level = check_level(args.level, "--level", optional=True)

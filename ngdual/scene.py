@@ -240,7 +240,7 @@ class Solver:
 
     ``method``: ``"uzawa"`` runs the thesis' Algorithm 3.38 / 3.41 (Remark 3.45 for
     Coulomb); ``"active-set"`` condenses onto Gamma_C and solves the contact problem
-    there by semismooth Newton (:mod:`ngdual.solvers.fast`: the same discrete solution
+    there by semismooth Newton (:mod:`ngdual.solvers.active_set`: the same discrete solution
     at about the cost of one linear solve); ``"auto"`` (default) picks the active-set
     solver, which is faster on every level measured (``ngdual bench``). The parameters
     below are those of the Uzawa iterations; the active-set solver needs none (it

@@ -93,7 +93,7 @@ def solve_task(scene: str, level: int, overrides: list[str] = (), fields: bool =
     """
     from .estimator import estimate
     from .post import result_record
-    from .solve import solve_scene
+    from .solvers import solve_scene
 
     solution = solve_scene(_scene(scene, list(overrides)), level)
     record = result_record(solution)
@@ -438,7 +438,7 @@ def remove_stale_temporaries(folder: str | Path) -> int:
 def warm_up() -> None:
     """Solve a tiny scene with each solver once, so that the first timed task of a worker does
     not pay for imports and NGSolve's first-call set-up."""
-    from .solve import solve_scene
+    from .solvers import solve_scene
 
     for method in ("auto", "uzawa"):
         solve_scene(_scene("thesis-3.46-coulomb", [f'solver.method="{method}"']), 1)

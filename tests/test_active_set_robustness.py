@@ -21,9 +21,8 @@ from ngdual.forms import assemble
 from ngdual.friction import build_friction_forms
 from ngdual.mesh import build_mesh
 from ngdual.scene import load_scene
-from ngdual.solve import solve_problem
-from ngdual.solvers import fast
-from ngdual.solvers.fast import fast_solve
+from ngdual.solvers import active_set, solve_problem
+from ngdual.solvers.active_set import active_set_solve
 from ngdual.solvers.nested import nested_uzawa
 from ngdual.solvers.result import ConvergenceError
 from ngdual.solvers.semismooth import EPS, SAFETY, condition_number, kkt_residuals
@@ -130,14 +129,14 @@ def test_damped_newton_ends_the_cycle_without_the_qp(monkeypatch):
         raise AssertionError("the QP fallback was called")
     monkeypatch.setattr(semismooth, "_qp_fallback", no_qp)
     calls = []
-    newton = fast.semismooth_newton
+    newton = active_set.semismooth_newton
 
     def recorded(G, b, n_c, Q=None, start=None, **kwargs):
         sol = newton(G, b, n_c, Q, start, **kwargs)
         calls.append((G, b, Q, sol))
         return sol
-    monkeypatch.setattr(fast, "semismooth_newton", recorded)
-    sol = fast_solve(pb)
+    monkeypatch.setattr(active_set, "semismooth_newton", recorded)
+    sol = active_set_solve(pb)
     assert_round_off(sol)
     assert max(c[3].iterations for c in calls) > 8  # the damped phase was needed
     for G, b, Q, state in calls:
@@ -169,15 +168,15 @@ def test_coulomb_failure_names_the_criterion_its_value_and_tolerance():
 def test_residual_check_names_the_criterion_its_value_and_tolerance(monkeypatch):
     """A solution off by 1e-6 in sigma fails the truth test, whatever the round-off level."""
     pb = problem("thesis-3.46-coulomb", 2)
-    unknowns = fast.HybridSystem.unknowns
+    unknowns = active_set.HybridSystem.unknowns
 
     def off(self, *args, **kwargs):
         x = unknowns(self, *args, **kwargs)
         x[pb.sigma] *= 1.0 + 1e-6
         return x
-    monkeypatch.setattr(fast.HybridSystem, "unknowns", off)
+    monkeypatch.setattr(active_set.HybridSystem, "unknowns", off)
     with pytest.raises(ConvergenceError) as info:
-        fast_solve(pb)
+        active_set_solve(pb)
     message = str(info.value)
     assert re.search(r"linear = \d\.\de-0[67] > \d\.\de-1\d", message), message
     assert "round-off level" in message and info.value.history

@@ -9,7 +9,7 @@ import pytest
 
 from ngdual import post
 from ngdual.scene import load_scene
-from ngdual.solve import solve_scene
+from ngdual.solvers import solve_scene
 
 STORED = json.loads((Path(__file__).parent / "data" / "behaviour_norms.json").read_text())
 CASES = sorted(STORED["norms"])

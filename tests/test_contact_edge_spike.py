@@ -34,7 +34,7 @@ from ngdual.expr import Expression
 from ngdual.forms import assemble, boundary_regex
 from ngdual.friction import build_friction_forms, tresca_bound
 from ngdual.mesh import build_mesh
-from ngdual.solve import solve_scene
+from ngdual.solvers import solve_scene
 from ngdual.verification.manufactured import (
     contact_profile,
     edge_spikes,

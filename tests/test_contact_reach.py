@@ -17,7 +17,7 @@ from ngdual.afem import adapt
 from ngdual.forms import assemble
 from ngdual.mesh import build_mesh
 from ngdual.scene import load_scene
-from ngdual.solve import solve_problem, solve_scene
+from ngdual.solvers import solve_problem, solve_scene
 
 NEW_SCENES = ("hertz-cylinder", "flat-punch", "cattaneo-mindlin", "wedge")
 TIGHT_UZAWA = ["solver.method='uzawa'", "solver.eps=1e-11", "solver.eps1=1e-11",

@@ -27,7 +27,7 @@ from ngdual import peers
 from ngdual.estimator import SIGMA_TERMS, TERMS, U_TERMS, estimate
 from ngdual.post import fields
 from ngdual.scene import Geometry, Loads, Material, Scene, load_scene, validate
-from ngdual.solve import solve_scene
+from ngdual.solvers import solve_scene
 
 NU = 0.3
 LEVELS = (1, 2, 3, 4)

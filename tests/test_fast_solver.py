@@ -21,9 +21,9 @@ from ngdual.forms import assemble
 from ngdual.friction import build_friction_forms
 from ngdual.mesh import build_mesh
 from ngdual.scene import SceneError, load_scene, shipped_scenes
-from ngdual.solve import solve_problem, solve_scene
+from ngdual.solvers import solve_problem, solve_scene
+from ngdual.solvers.active_set import active_set_solve
 from ngdual.solvers.cholesky import SchurCholesky
-from ngdual.solvers.fast import fast_solve
 from ngdual.solvers.hybrid import HybridSystem
 from ngdual.solvers.reference import solve_qp_friction
 from ngdual.solvers.result import ConvergenceError
@@ -181,7 +181,7 @@ def test_strongly_graded_mesh_agrees_with_the_qp_reference():
     scene = load_scene("thesis-3.46-coulomb", ["solver.method=active-set"])
     mesh, coarse = refine_towards(scene, build_mesh(scene.geometry, 2), (-4.0, 0.0), 6)
     pb = assemble(scene, mesh, coarse)
-    sol = fast_solve(pb)
+    sol = active_set_solve(pb)
     ref = solve_qp_friction(pb, "coulomb", scene.friction.mu)
     assert rel(sol.x[pb.sigma], ref.x[pb.sigma]) <= 1e-7
 

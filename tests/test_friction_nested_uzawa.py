@@ -11,7 +11,7 @@ from ngdual.forms import assemble
 from ngdual.friction import build_friction_forms
 from ngdual.mesh import build_mesh
 from ngdual.scene import load_scene
-from ngdual.solve import solve_scene
+from ngdual.solvers import solve_scene
 from ngdual.solvers.nested import box_projection, box_projection_qp, nested_uzawa
 from ngdual.solvers.projections import NonnegativeProjection, metric_matrix
 from ngdual.solvers.uzawa import uzawa

@@ -12,7 +12,7 @@ from ngdual.afem import refine_towards
 from ngdual.forms import assemble
 from ngdual.mesh import build_mesh
 from ngdual.scene import load_scene
-from ngdual.solve import solve_problem, solve_scene
+from ngdual.solvers import solve_problem, solve_scene
 from ngdual.solvers.reference import solve_qp_friction
 from ngdual.solvers.result import ConvergenceError
 

@@ -20,7 +20,7 @@ import pytest
 from ngdual.friction import build_friction_forms
 from ngdual.post import friction_diagnostics
 from ngdual.scene import load_scene
-from ngdual.solve import solve_scene
+from ngdual.solvers import solve_scene
 
 SCENES = ["thesis-3.46-coulomb-gap-abs", "thesis-3.46-coulomb-gap-3125"]
 LEVELS = (3, 4)

@@ -262,12 +262,12 @@ def test_non_convergence_shows_the_residual_history_and_writes_nothing(workspace
 
 def test_an_internal_error_is_one_line_and_debug_shows_the_traceback(workspace, capsys,
                                                                      monkeypatch):
-    import ngdual.solve
+    import ngdual.solvers
 
     def broken(*args, **kwargs):
         raise RuntimeError("boom")
 
-    monkeypatch.setattr(ngdual.solve, "solve_scene", broken)
+    monkeypatch.setattr(ngdual.solvers, "solve_scene", broken)
     assert cli.main([*SOLVE, "--out", "result"]) == 3
     err = capsys.readouterr().err
     assert "internal error: RuntimeError: boom" in err and "--debug" in err
@@ -277,7 +277,7 @@ def test_an_internal_error_is_one_line_and_debug_shows_the_traceback(workspace, 
 
 
 def test_a_non_finite_solution_is_never_converged():
-    from ngdual.solve import _check_finite
+    from ngdual.solvers import _check_finite
     from ngdual.solvers.result import ConvergenceError, Solution
 
     solution = Solution(problem=None, x=np.array([1.0, np.nan]), converged=True,
@@ -301,7 +301,7 @@ def _unvalidated(**material):
 
 
 def _solve(*args, **kwargs):
-    from ngdual.solve import solve_scene
+    from ngdual.solvers import solve_scene
     return solve_scene(*args, **kwargs)
 
 

@@ -36,7 +36,7 @@ from ngdual.expr import Expression
 from ngdual.mesh import mesh_size
 from ngdual.post import fields
 from ngdual.scene import Geometry, Loads, Material, Scene, validate
-from ngdual.solve import solve_scene
+from ngdual.solvers import solve_scene
 
 E = 100.0
 NUS = (0.3, 0.4999)

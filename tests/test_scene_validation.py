@@ -238,7 +238,7 @@ def test_constants_are_folded_once_in_floating_point():
 
 
 def test_a_scene_changed_after_loading_is_validated_again():
-    from ngdual.solve import solve_scene
+    from ngdual.solvers import solve_scene
 
     scene = load_scene("thesis-3.46-frictionless")
     scene.material.nu = 0.5

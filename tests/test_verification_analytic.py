@@ -104,7 +104,7 @@ def test_wedge_pressure_converges_to_the_blunt_wedge_solution():
     the L2 error of p_h falls on every level (slowly: the contact zone spans few h~ cells
     and p is log-singular at the apex) and the contact zone lands within one h~ cell."""
     from ngdual.scene import load_scene
-    from ngdual.solve import solve_scene
+    from ngdual.solvers import solve_scene
     from ngdual.verification import pressure_errors, traction_profile, wedge
 
     errors = []

@@ -42,7 +42,7 @@ import pytest
 
 from ngdual.expr import Expression
 from ngdual.post import contact_traces, friction_diagnostics
-from ngdual.solve import solve_scene
+from ngdual.solvers import solve_scene
 from ngdual.verification import (
     Piecewise,
     discrete_sets,

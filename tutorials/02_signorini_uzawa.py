@@ -35,9 +35,10 @@ from ngdual import peers, plot, post
 from ngdual.forms import assemble
 from ngdual.mesh import build_mesh
 from ngdual.scene import load_scene
+from ngdual.solvers.linear import solve_linear
 from ngdual.solvers.projections import NonnegativeProjection, metric_matrix
 from ngdual.solvers.reference import solve_qp
-from ngdual.solvers.uzawa import solve_linear, uzawa
+from ngdual.solvers.uzawa import uzawa
 from ngdual.tutorials import draw, output_dir, quick_mode, save_figure, save_results, show_file
 
 # %% [markdown]

@@ -41,7 +41,7 @@ from ngdual.forms import assemble
 from ngdual.friction import build_friction_forms
 from ngdual.mesh import build_mesh
 from ngdual.scene import load_scene
-from ngdual.solve import solve_problem
+from ngdual.solvers import solve_problem
 from ngdual.solvers.nested import box_projection, box_projection_qp, nested_uzawa
 from ngdual.solvers.projections import metric_matrix
 from ngdual.solvers.reference import solve_qp_friction

@@ -47,7 +47,7 @@ from ngdual.estimator import OTHER_TERMS, SIGMA_TERMS, TERMS, U_TERMS, estimate
 from ngdual.expr import Expression
 from ngdual.post import fields
 from ngdual.scene import Geometry, Loads, Material, Scene, load_scene, validate
-from ngdual.solve import solve_scene
+from ngdual.solvers import solve_scene
 from ngdual.tutorials import draw, output_dir, quick_mode, save_figure, save_results
 
 # %% [markdown]

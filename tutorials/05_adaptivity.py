@@ -42,7 +42,7 @@ from ngdual.afem import adapt, convergence_rate, reference_norms
 from ngdual.estimator import estimate
 from ngdual.marking import STRATEGIES, mark
 from ngdual.scene import load_scene
-from ngdual.solve import solve_scene
+from ngdual.solvers import solve_scene
 from ngdual.tutorials import output_dir, quick_mode, save_figure, save_results
 
 # %% [markdown]

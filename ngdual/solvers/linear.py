@@ -1,4 +1,5 @@
-"""One sparse LU factorisation of the fixed saddle-point matrix, reused for every solve.
+"""One sparse LU factorisation of the fixed saddle-point matrix, reused for every solve, and
+the linear solve of a problem without contact.
 
 The matrix [[A, B], [B^T, 0]] of Algorithms 3.38/3.41 never changes during the
 iteration, so it is factorised once (NGSolve's UMFPACK by default, SciPy's
@@ -19,6 +20,9 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from threadpoolctl import threadpool_limits
+
+from ..forms import DiscreteProblem
+from .result import Solution
 
 BACKENDS = ("umfpack", "superlu")
 BLAS_THREADS = 1
@@ -70,3 +74,16 @@ class Factorization:
         self._rhs.FV().NumPy()[:] = rhs
         self._sol.data = self._inv * self._rhs
         return self._sol.FV().NumPy().copy()
+
+
+def solve_linear(problem: DiscreteProblem, backend: str = "umfpack") -> Solution:
+    """One saddle-point solve: the whole problem when there is no contact boundary."""
+    saddle = problem.saddle
+    fact = Factorization(problem.block(saddle, saddle), backend)
+    start = time.perf_counter()
+    x = np.zeros(problem.K.shape[0])
+    x[saddle] = fact.solve(problem.F[saddle])
+    solve_s = time.perf_counter() - start
+    return Solution(problem, x, True, "linear",
+                    timings={"assemble": problem.assemble_seconds, "factorize": fact.seconds,
+                             "solve": solve_s})

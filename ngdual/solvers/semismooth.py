@@ -1,6 +1,6 @@
 """Contact with (given) Tresca friction on Gamma_C as a small dense problem: semismooth Newton.
 
-Condensed onto Gamma_C (:mod:`ngdual.solvers.fast`), (3.62) leaves the multipliers
+Condensed onto Gamma_C (:mod:`ngdual.solvers.active_set`), (3.62) leaves the multipliers
 z = (lambda_n, lambda_t) (coarse h~ P1 values) and nu (h^ values) with the traction
 moments t = (C_n^T sigma, C_t^T sigma) an affine function of z,
 

@@ -31,19 +31,6 @@ from .result import ConvergenceError, Solution
 DIVERGENCE_FACTOR = 1e6
 
 
-def solve_linear(problem: DiscreteProblem, backend: str = "umfpack") -> Solution:
-    """One saddle-point solve: the whole problem when there is no contact boundary."""
-    saddle = problem.saddle
-    fact = Factorization(problem.block(saddle, saddle), backend)
-    start = time.perf_counter()
-    x = np.zeros(problem.K.shape[0])
-    x[saddle] = fact.solve(problem.F[saddle])
-    solve_s = time.perf_counter() - start
-    return Solution(problem, x, True, "linear",
-                    timings={"assemble": problem.assemble_seconds, "factorize": fact.seconds,
-                             "solve": solve_s})
-
-
 def contact_residuals(lam: np.ndarray, traction: np.ndarray,
                       projection: NonnegativeProjection, lam_scale: float | None = None,
                       load_scale: float = 0.0) -> dict:

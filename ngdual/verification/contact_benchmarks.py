@@ -60,7 +60,7 @@ import numpy as np
 from ..afem import adapt
 from ..mesh import mesh_size
 from ..scene import Scene, load_scene
-from ..solve import solve_scene
+from ..solvers import solve_scene
 from ..solvers.result import Solution
 from .analytic import (
     cattaneo_mindlin,

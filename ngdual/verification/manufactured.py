@@ -60,7 +60,7 @@ from ..friction import hat_projection
 from ..mesh import mesh_size
 from ..post import contact_traces, fields, friction_diagnostics
 from ..scene import Contact, Friction, Geometry, Loads, Material, Scene, Solver, validate
-from ..solve import solve_scene
+from ..solvers import solve_scene
 from ..solvers.result import Solution
 from .integrate import PiecewiseQuadrature
 from .piecewise import Piecewise

@@ -11,7 +11,7 @@ from pathlib import Path
 
 from ngdual import post
 from ngdual.scene import load_scene, shipped_scenes
-from ngdual.solve import solve_scene
+from ngdual.solvers import solve_scene
 
 LEVELS = (1, 2, 3, 4)
 

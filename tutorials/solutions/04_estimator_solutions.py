@@ -11,7 +11,7 @@ import numpy as np
 
 from ngdual.estimator import SIGMA_TERMS, U_TERMS, estimate
 from ngdual.scene import Geometry, Loads, Material, Scene, load_scene, validate
-from ngdual.solve import solve_scene
+from ngdual.solvers import solve_scene
 from ngdual.tutorials import output_dir, quick_mode, save_results
 
 QUICK = quick_mode()

@@ -16,7 +16,7 @@ from ngdual.forms import assemble
 from ngdual.marking import mark
 from ngdual.mesh import build_mesh
 from ngdual.scene import load_scene
-from ngdual.solve import solve_problem, solve_scene
+from ngdual.solvers import solve_problem, solve_scene
 from ngdual.tutorials import output_dir, quick_mode, save_results
 
 QUICK = quick_mode()

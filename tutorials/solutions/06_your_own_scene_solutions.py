@@ -8,7 +8,7 @@ import numpy as np
 
 from ngdual import post
 from ngdual.scene import SceneError, load_scene
-from ngdual.solve import solve_scene
+from ngdual.solvers import solve_scene
 from ngdual.tutorials import output_dir, quick_mode, save_results
 
 QUICK = quick_mode()

@@ -131,7 +131,7 @@ def _roundoff_probe(problem: DiscreteProblem, hybrid: HybridSystem, chol: SchurC
     return level
 
 
-def fast_solve(problem: DiscreteProblem, law: str | None = None, mu_f: float = 0.0,
+def active_set_solve(problem: DiscreteProblem, law: str | None = None, mu_f: float = 0.0,
                tol: float = 1e-12, max_iter: int = 500, ordering: str = "amd",
                metric: str = "h12",
                progress: Callable[[int, float], None] | None = None) -> Solution:
@@ -165,7 +165,7 @@ def fast_solve(problem: DiscreteProblem, law: str | None = None, mu_f: float = 0
     # and immune to the spin-waiting of threaded BLAS on busy cores
     with threadpool_limits(limits=BLAS_THREADS, user_api="blas"):
         try:
-            return _fast_solve(problem, law, mu_f, tol, max_iter, ordering, metric, progress)
+            return _active_set_solve(problem, law, mu_f, tol, max_iter, ordering, metric, progress)
         except ConvergenceError as err:
             scene = problem.scene
             if (law or scene.friction.law) in ("tresca", "coulomb") \
@@ -177,7 +177,7 @@ def fast_solve(problem: DiscreteProblem, law: str | None = None, mu_f: float = 0
             raise
 
 
-def _fast_solve(problem: DiscreteProblem, law: str | None, mu_f: float, tol: float,
+def _active_set_solve(problem: DiscreteProblem, law: str | None, mu_f: float, tol: float,
                 max_iter: int, ordering: str, metric: str,
                 progress: Callable[[int, float], None] | None) -> Solution:
     scene = problem.scene

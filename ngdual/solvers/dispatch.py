@@ -8,7 +8,7 @@ Tresca / Coulomb     -> Algorithm 3.41 / Remark 3.45 (nested Uzawa)
 
 ``solver.method = "active-set"`` or ``"auto"`` (default): the hybridised system, one
 Cholesky factorisation, and for contact the semismooth Newton method on Gamma_C
-(:mod:`ngdual.solvers.fast`): the same discrete solution at about the cost of one linear
+(:mod:`ngdual.solvers.active_set`): the same discrete solution at about the cost of one linear
 solve.
 """
 
@@ -19,15 +19,16 @@ from collections.abc import Callable
 
 import numpy as np
 
-from . import budget
-from .forms import DiscreteProblem, assemble
-from .mesh import build_mesh
-from .quadrature_check import check_formulas
-from .scene import Scene, SceneError, SceneTypeError, check_level, ensure_valid
-from .solvers.fast import fast_solve
-from .solvers.nested import nested_uzawa
-from .solvers.result import ConvergenceError, Solution
-from .solvers.uzawa import solve_linear, uzawa
+from .. import budget
+from ..forms import DiscreteProblem, assemble
+from ..mesh import build_mesh
+from ..quadrature_check import check_formulas
+from ..scene import Scene, SceneError, SceneTypeError, check_level, ensure_valid
+from .active_set import active_set_solve
+from .linear import solve_linear
+from .nested import nested_uzawa
+from .result import ConvergenceError, Solution
+from .uzawa import uzawa
 
 
 def solve_scene(scene: Scene, level: int | None = None,
@@ -93,8 +94,8 @@ def solve_problem(problem: DiscreteProblem,
     """
     scene = problem.scene
     if scene.solver.method in ("auto", "active-set"):
-        solution = fast_solve(problem, max_iter=scene.solver.max_iter, metric=scene.solver.metric,
-                              progress=progress)
+        solution = active_set_solve(problem, max_iter=scene.solver.max_iter,
+                                    metric=scene.solver.metric, progress=progress)
     elif not scene.has_contact:
         solution = solve_linear(problem)
     elif not scene.has_friction:
