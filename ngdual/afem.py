@@ -27,8 +27,9 @@ from .estimator import Estimate, estimate
 from .forms import assemble
 from .marking import mark
 from .mesh import build_mesh
-from .post import aitken_extrapolate, norms, total_error
+from .post import norms
 from .quadrature_check import check_formulas
+from .rates import extrapolated_norms, total_error
 from .scene import Scene, SceneError, SceneTypeError, check_level, ensure_valid
 from .solvers import check_unknowns, solve_problem, solve_scene
 from .solvers.result import Solution
@@ -223,7 +224,7 @@ def reference_norms(scene: Scene, levels: list[int]) -> dict:
     """Norms of the exact solution, Aitken-extrapolated from uniform levels (Section 3.4).
 
     Uses the last three of ``levels`` (at least three, consecutive uniform
-    refinements); see :func:`ngdual.post.aitken_extrapolate` for its safeguard.
+    refinements); see :func:`ngdual.rates.aitken_extrapolate` for its safeguard.
     """
     ensure_valid(scene)
     if not isinstance(levels, (list, tuple)):
@@ -233,13 +234,4 @@ def reference_norms(scene: Scene, levels: list[int]) -> dict:
     if len(levels) < 3:
         raise SceneError("levels", f"Aitken extrapolation needs at least three levels, got "
                                    f"{list(levels)}")
-    sequence = [norms(solve_scene(scene, level)) for level in levels[-3:]]
-    return {q: (aitken_extrapolate([s[q] for s in sequence])
-                if all(s[q] is not None for s in sequence) else None)
-            for q in sequence[0]}
-
-
-def convergence_rate(ndofs, errors) -> float:
-    """Least-squares slope alpha/2 of e ~ N^{-alpha/2}: -d log e / d log N (cf. Section 3.4)."""
-    slope = np.polyfit(np.log(np.asarray(ndofs, float)), np.log(np.asarray(errors, float)), 1)[0]
-    return float(-slope)
+    return extrapolated_norms([norms(solve_scene(scene, level)) for level in levels[-3:]])

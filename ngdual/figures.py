@@ -47,7 +47,7 @@ import numpy as np
 
 from .bench import TUNED
 from .io import write_json
-from .post import aitken_extrapolate, total_error
+from .rates import aitken_extrapolate, total_error
 from .sweep import Runner, Task, load_arrays, load_record, versions
 
 DEFAULT_MAX_LEVEL = 5

@@ -1,28 +1,101 @@
-"""Atomic file output: results are written to a temporary file and renamed."""
+"""How results are written: atomically, as plain JSON, with the package versions.
+
+Every file ngdual writes (``result.json``, sweep records and arrays, figure data, bench
+runs) goes through :func:`atomic`: a temporary file in the target folder renamed into
+place, so a killed run never leaves a half-written file. JSON has no NaN or infinity and
+no numpy types: :func:`plain` turns them into None and Python numbers, once, for every
+writer. :func:`versions` is the provenance every record carries.
+"""
 
 from __future__ import annotations
 
 import json
+import math
 import os
+import platform
 import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
+from importlib import metadata
 from pathlib import Path
 
+# the packages a result depends on: the numerics, the linear algebra, the sweeps
+PACKAGES = ("ngsolve", "netgen-mesher", "numpy", "scipy", "cvxpy", "clarabel", "cvxopt",
+            "pymetis", "matplotlib", "dask", "distributed")
 
-def write_json(data: dict, path: str | Path) -> Path:
-    """Write ``data`` as JSON to ``path`` atomically (never a partial file)."""
+
+def versions() -> dict:
+    """Versions of ngdual, Python, the platform and :data:`PACKAGES` (None: not installed)."""
+    from . import __version__
+
+    out = {"ngdual": __version__, "python": platform.python_version(),
+           "platform": platform.platform()}
+    for pkg in PACKAGES:
+        try:
+            out[pkg] = metadata.version(pkg)
+        except metadata.PackageNotFoundError:
+            out[pkg] = None
+    return out
+
+
+def plain(value):
+    """``value`` as plain JSON data: numpy scalars and arrays as Python numbers and lists,
+    dict keys as strings, NaN and infinities as None (JSON has neither).
+
+    >>> plain({1: [float("nan"), 2.0]})
+    {'1': [None, 2.0]}
+    """
+    if isinstance(value, dict):
+        return {str(k): plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [plain(v) for v in value]
+    if hasattr(value, "tolist"):  # numpy arrays and scalars
+        return plain(value.tolist())
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
+@contextmanager
+def atomic(path: str | Path, mode: str = "w", **kwargs) -> Iterator:
+    """Open a temporary file next to ``path`` and rename it to ``path`` when the block ends
+    without an exception (removed otherwise): ``path`` is the old file or the whole new one.
+
+    >>> import tempfile, pathlib
+    >>> target = pathlib.Path(tempfile.mkdtemp()) / "a.txt"
+    >>> with atomic(target) as fh:
+    ...     _ = fh.write("done")
+    >>> target.read_text()
+    'done'
+    """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=path.name + ".", suffix=".tmp", dir=path.parent)
     try:
-        with os.fdopen(fd, "w") as fh:
-            json.dump(data, fh, indent=2, allow_nan=False)
-            fh.write("\n")
+        with os.fdopen(fd, mode, **kwargs) as fh:
+            yield fh
         os.chmod(tmp, 0o644)
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
-    return path
+
+
+def write_json(data: dict, path: str | Path) -> Path:
+    """Write ``plain(data)`` as JSON to ``path`` atomically (never a partial file)."""
+    with atomic(path) as fh:
+        json.dump(plain(data), fh, indent=2, allow_nan=False)
+        fh.write("\n")
+    return Path(path)
+
+
+def write_npz(arrays: dict, path: str | Path) -> Path:
+    """Write numpy ``arrays`` compressed to ``path`` atomically."""
+    import numpy as np
+
+    with atomic(path, "wb") as fh:
+        np.savez_compressed(fh, **arrays)
+    return Path(path)
 
 
 def check_output_dir(path: str | Path, field_name: str = "--out") -> Path:

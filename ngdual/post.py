@@ -7,14 +7,13 @@ closed) and lambda_t = -u_t on Gamma_C.
 
 from __future__ import annotations
 
-import platform
 from dataclasses import dataclass
-from importlib import metadata
 
 import ngsolve as ngs
 import numpy as np
 
-from . import __version__, peers
+from . import peers
+from .io import versions
 from .solvers.result import Solution
 
 CONTACT_TOL = 1e-8
@@ -221,18 +220,6 @@ def force_balance(solution: Solution, traces: ContactTraces | None = None) -> Fo
                         float(tension / total))
 
 
-def versions() -> dict:
-    """Versions of ngdual and the packages it depends on."""
-    out = {"ngdual": __version__, "python": platform.python_version(),
-           "platform": platform.platform()}
-    for pkg in ("ngsolve", "netgen-mesher", "numpy", "scipy", "cvxpy", "clarabel", "matplotlib"):
-        try:
-            out[pkg] = metadata.version(pkg)
-        except metadata.PackageNotFoundError:
-            out[pkg] = None
-    return out
-
-
 def result_record(solution: Solution) -> dict:
     """The result record of SPEC section 6 (plain JSON-serialisable data)."""
     pb = solution.problem
@@ -281,35 +268,6 @@ def element_values(mesh: ngs.Mesh, cf) -> tuple[np.ndarray, np.ndarray, np.ndarr
     centroids = points[triangles].mean(axis=1)
     mips = mesh(centroids[:, 0], centroids[:, 1])
     return points, triangles, np.asarray(cf(mips)).ravel()
-
-
-def aitken_extrapolate(values) -> float:
-    """Aitken's Delta^2 limit of a sequence from its last three terms (Section 3.4).
-
-    x_inf = x_2 - (x_2 - x_1)^2 / (x_2 - 2 x_1 + x_0). Where the differences
-    do not shrink (|x_2 - x_1| >= |x_1 - x_0|: no linear convergence yet) the
-    extrapolation is meaningless and the last term is returned.
-
-    >>> round(aitken_extrapolate([1.5, 1.25, 1.125]), 12)
-    1.0
-    """
-    x0, x1, x2 = (float(v) for v in list(values)[-3:])
-    d1, d2 = x1 - x0, x2 - x1
-    if d1 == 0 or abs(d2) >= abs(d1):
-        return x2
-    return x2 - d2 * d2 / (d2 - d1)
-
-
-def total_error(norms_h: dict, reference: dict) -> tuple[dict, float]:
-    """e_i(q) = | ||q_h||^2 - n_q^2 |^{1/2} per quantity and e_tot of (3.124).
-
-    ``norms_h`` is a :func:`norms` record, ``reference`` the (extrapolated)
-    norms n_q of the exact solution; quantities missing or ``None`` in either
-    (nu without friction) are left out.
-    """
-    errors = {q: float(np.sqrt(abs(norms_h[q] ** 2 - reference[q] ** 2)))
-              for q in norms_h if norms_h[q] is not None and reference.get(q) is not None}
-    return errors, float(np.sqrt(sum(e * e for e in errors.values())))
 
 
 @dataclass

@@ -150,8 +150,8 @@ def check_adaptivity(r: dict) -> None:
     """Marking as specified; Dörfler beats uniform on the L-shape; every run reduces eta."""
     assert r["marking_share"]["dorfler"] >= 0.5 and r["marking_example"]["fraction"] >= 26
     runs = r["l_shape"]
-    assert runs["uniform"]["rates"]["error"] <= 0.35
-    assert runs["dorfler"]["rates"]["error"] >= runs["uniform"]["rates"]["error"] + 0.15
+    assert runs["uniform"]["rates"]["error"] <= 0.7        # ngdual.rates: e ~ N^(-rate/2)
+    assert runs["dorfler"]["rates"]["error"] >= runs["uniform"]["rates"]["error"] + 0.3
     for name, run in runs.items():
         assert run["errors"][-1] < run["errors"][0] and run["etas"][-1] < run["etas"][0], name
         assert all(b > a for a, b in zip(run["ndofs"], run["ndofs"][1:])), name
@@ -215,7 +215,7 @@ def check_solutions(number: int, r: dict) -> None:
         assert all(row["ratio"] <= math.sqrt(row["elements"]) for row in r["sum_ratios"]["thesis"])
     elif number == 5:
         d = r["dorfler"]
-        assert d["0.5"]["rate"] > d["0.8"]["rate"] and d["0.5"]["rate"] > 0.45, d
+        assert d["0.5"]["rate"] > d["0.8"]["rate"] and d["0.5"]["rate"] > 0.9, d
         assert d["0.2"]["steps"] > d["0.5"]["steps"] > d["0.8"]["steps"], d
         eta, sigma = r["by_indicator"]["eta"], r["by_indicator"]["eta_sigma"]
         assert eta["top_edges"] > sigma["top_edges"], (eta, sigma)

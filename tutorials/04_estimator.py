@@ -46,6 +46,7 @@ from matplotlib.colors import LogNorm
 from ngdual.estimator import OTHER_TERMS, SIGMA_TERMS, TERMS, U_TERMS, estimate
 from ngdual.expr import Expression
 from ngdual.post import fields
+from ngdual.rates import observed_rates
 from ngdual.scene import Geometry, Loads, Material, Scene, load_scene, validate
 from ngdual.solvers import solve_scene
 from ngdual.tutorials import draw, output_dir, quick_mode, save_figure, save_results
@@ -294,9 +295,10 @@ for level in LEVELS:
                  "terms": {k: math.sqrt(v) for k, v in l2.summed().items()},
                  "as_l2": math.sqrt(l2.summed()["asymmetry"]),
                  "as_hdiv": math.sqrt(hdiv.summed()["asymmetry"])})
-for prev, row in zip(rows, rows[1:]):
-    row["rate_error"] = math.log2(prev["error"] / row["error"])
-    row["rate_eta"] = math.log2(prev["eta"] / row["eta"])
+ndofs = [r["ndof"] for r in rows]
+for key in ("error", "eta"):  # ngdual.rates: the order in h_N = N^(-1/2)
+    for row, rate in zip(rows[1:], observed_rates(ndofs, [r[key] for r in rows])[1:]):
+        row[f"rate_{key}"] = rate
 effectivity = [row["eta"] / row["error"] for row in rows]
 print(f"{'level':>5} {'ndof':>7} {'error':>10} {'eta':>10} {'eta/e':>6} {'rate e':>7} "
       f"{'rate eta':>8}")
@@ -310,8 +312,8 @@ print(f"effectivity band: [{min(effectivity):.3f}, {max(effectivity):.3f}]")
 # %% [markdown]
 # The error halves with h (first order, Theorem 3.35), and so does η: the effectivity
 # index hardly moves. Which terms make up η here? No contact, so the contact and
-# friction terms vanish; the rates show that every term decays at first order
-# (log₂ of the ratio between successive levels):
+# friction terms vanish; the rates (`ngdual.rates.observed_rates` between the last two
+# levels) show that every term decays at first order:
 
 # %%
 active_terms = [k for k in TERMS if rows[-1]["terms"][k] > 1e-12 * rows[-1]["eta"]]
@@ -319,10 +321,9 @@ print(f"{'term':15s} " + " ".join(f"{'level ' + str(r['level']):>10}" for r in r
 for name in active_terms:
     values = [r["terms"][name] for r in rows]
     print(f"{name:15s} " + " ".join(f"{v:10.3e}" for v in values)
-          + f"   {math.log2(values[-2] / values[-1]):4.2f}")
+          + f"   {observed_rates(ndofs[-2:], values[-2:])[1]:4.2f}")
 
 fig, ax = plt.subplots(figsize=(6.5, 4.5))
-ndofs = [r["ndof"] for r in rows]
 ax.loglog(ndofs, [r["error"] for r in rows], "o-", label="error e")
 ax.loglog(ndofs, [r["eta"] for r in rows], "s-", label=r"$\eta$, as($\sigma_h$) in $L^2$")
 ax.loglog(ndofs, [r["eta_hdiv"] for r in rows], "^--",

@@ -18,7 +18,7 @@
 #    fixed-fraction strategy of Section 4.2, and Dörfler's bulk criterion.
 # 3. On an L-shaped domain with a re-entrant corner (exact solution known): uniform
 #    refinement converges like N^{−α/2}, α ≈ 0.54, adaptive refinement like N^{−1/2};
-#    rates with `afem.convergence_rate`.
+#    rates with `ngdual.rates.fitted_rate` (the order in h_N = N^{−1/2}: e ~ N^{−rate/2}).
 # 4. Example 3.46 with Coulomb friction: where the indicators refine (Figs. 4.1-4.13),
 #    and the total error (3.124) against extrapolated norms (Table 4.4).
 #
@@ -38,9 +38,10 @@ import ngsolve as ngs
 import numpy as np
 
 from ngdual import corner
-from ngdual.afem import adapt, convergence_rate, reference_norms
+from ngdual.afem import adapt, reference_norms
 from ngdual.estimator import estimate
 from ngdual.marking import STRATEGIES, mark
+from ngdual.rates import fitted_rate
 from ngdual.scene import load_scene
 from ngdual.solvers import solve_scene
 from ngdual.tutorials import output_dir, quick_mode, save_figure, save_results
@@ -158,7 +159,7 @@ plot_meshes([(level2, marked_sets[s], f"{s}, theta = {examples[s]}: {marked_sets
 # %%
 l_shape = corner.l_shape_scene()
 alpha = corner.corner_exponent()
-print(f"corner exponent alpha = {alpha:.4f}: uniform rate alpha/2 = {alpha / 2:.3f}")
+print(f"corner exponent alpha = {alpha:.4f}: the uniform rate")
 exact = corner.exact_fields()
 
 
@@ -192,17 +193,18 @@ l_rates = {}
 for name, kept in l_runs.items():
     ndofs = [r["dofs"]["total"] for r in kept["history"]]
     etas = [r["eta"] for r in kept["history"]]
-    l_rates[name] = {"error": convergence_rate(ndofs[-3:], kept["errors"][-3:]),
-                     "eta": convergence_rate(ndofs[-3:], etas[-3:])}
+    l_rates[name] = {"error": fitted_rate(ndofs[-3:], kept["errors"][-3:]),
+                     "eta": fitted_rate(ndofs[-3:], etas[-3:])}
     print(f"{name:8s}: {len(ndofs)} steps, N = {ndofs[0]} .. {ndofs[-1]}, error "
           f"{kept['errors'][0]:.3e} -> {kept['errors'][-1]:.3e}, eta {etas[0]:.3e} -> "
           f"{etas[-1]:.3e}; rates (last 3 steps): error {l_rates[name]['error']:.3f}, "
           f"eta {l_rates[name]['eta']:.3f}")
 
 # %% [markdown]
-# Uniform refinement converges at about α/2 ≈ 0.27, all adaptive strategies at about
-# the optimal 1/2 (the rates from three steps are rough). The estimator follows the
-# error: it overestimates it by a factor that stays between about 2 and 5.
+# Uniform refinement converges at about the corner exponent α ≈ 0.54, all adaptive
+# strategies at about the optimal rate 1 (the rates from three steps are rough). The
+# estimator follows the error: it overestimates it by a factor that stays between about
+# 2 and 5.
 
 # %%
 fig, ax = plt.subplots(figsize=(7, 5))
@@ -343,5 +345,5 @@ print(f"wrote {save_results('05_adaptivity', results)}")
 #    those of η_{tot,T}. Which terms put the refinement on Γ_N and Γ_C?
 # 3. **The corners of Example 3.46.** Refine `thesis-3.46-frictionless` uniformly and
 #    with Dörfler marking (θ = 0.5), once with the gap g = 0.01 and once with g = 0
-#    (`load_scene(..., ["contact.gap='0'"])`). Compare η, its rate (`convergence_rate`)
+#    (`load_scene(..., ["contact.gap='0'"])`). Compare η, its rate (`fitted_rate`)
 #    and the largest asymmetry indicator. Explain the difference.
