@@ -27,7 +27,7 @@ def one_level(scene_name: str, level: int, repeat: int) -> dict:
 
     def linear_solve() -> None:
         saddle = problem.saddle
-        Factorization(problem.block(saddle, saddle)).solve(problem.F[saddle])
+        Factorization(problem.block(saddle, saddle)).solve(problem.rhs[saddle])
 
     def timed(fn) -> float:
         runs = []

@@ -112,7 +112,7 @@ class DiscreteProblem:
     ----------
     K : scipy.sparse.csr_matrix
         Symmetric matrix of all unknowns (sigma, u, eta, phi, lambda_t, lambda_n).
-    F : numpy.ndarray
+    rhs : numpy.ndarray
         Right-hand side (g, -f, 0, t0, 0, 0).
     lift : numpy.ndarray
         Fine coefficients of the known end values phi = -u_D at the ends of
@@ -127,7 +127,7 @@ class DiscreteProblem:
     names: list[str]
     P: sp.csr_matrix
     K: sp.csr_matrix
-    F: np.ndarray
+    rhs: np.ndarray
     blocks: dict[str, slice]
     lift: np.ndarray
     assemble_seconds: float

@@ -204,7 +204,7 @@ def test_hybridisation_reproduces_the_rows_of_the_assembled_system():
     x = hs.unknowns(w, lam_t, lam_n)
     Kx = pb.K @ x
     rows = np.concatenate([pb.sigma, pb.index("u1", "u2", "eta", "phi1", "phi2")])
-    assert np.abs(Kx[rows] - pb.F[rows]).max() <= 1e-10 * np.abs(Kx).max()
+    assert np.abs(Kx[rows] - pb.rhs[rows]).max() <= 1e-10 * np.abs(Kx).max()
     t_f = hs.r[last] - (H @ w)[last]
     n = len(ce)
     assert np.allclose(ce.hat_means.T @ t_f[:n], Kx[pb.lam_n], rtol=0, atol=1e-10 * n)

@@ -85,8 +85,8 @@ def test_qp_multipliers_satisfy_stationarity(level):
     x = solutions(level)[1].x
     s, y, lam = pb.sigma, pb.mult, pb.lam_n
     a_sigma = pb.block(s, s) @ x[s]
-    residual = a_sigma + pb.block(s, y) @ x[y] + pb.block(s, lam) @ x[lam] - pb.F[s]
-    assert np.linalg.norm(residual) <= 1e-10 * (np.linalg.norm(pb.F[s]) + np.linalg.norm(a_sigma))
+    residual = a_sigma + pb.block(s, y) @ x[y] + pb.block(s, lam) @ x[lam] - pb.rhs[s]
+    assert np.linalg.norm(residual) <= 1e-10 * (np.linalg.norm(pb.rhs[s]) + np.linalg.norm(a_sigma))
 
 
 @pytest.mark.parametrize("level", LEVELS)

@@ -90,8 +90,8 @@ def _linear_residual(problem: DiscreteProblem, x: np.ndarray,
     for names in _linear_blocks(problem):
         K_b = problem.K[names]
         terms = abs(K_b) @ np.abs(x)
-        scale = max(np.max(terms, initial=0.0), np.max(np.abs(problem.F[names]), initial=0.0))
-        defect = K_b @ x - problem.F[names] if dx is None else K_b @ dx
+        scale = max(np.max(terms, initial=0.0), np.max(np.abs(problem.rhs[names]), initial=0.0))
+        defect = K_b @ x - problem.rhs[names] if dx is None else K_b @ dx
         if scale > 0:
             worst = max(worst, float(np.max(np.abs(defect)) / scale))
     return worst
@@ -354,7 +354,7 @@ def _contact_conditions(problem: DiscreteProblem, x: np.ndarray, metric: str,
     lam, lam_t = x[problem.lam_n], x[problem.index("lam_t")]
     traction = problem.block(problem.sigma, problem.lam_n).T @ x[problem.sigma]
     scale = max(np.max(np.abs(lam), initial=0.0), np.max(np.abs(lam_t), initial=0.0))
-    b0 = problem.F[problem.mult]
+    b0 = problem.rhs[problem.mult]
     residuals = contact_residuals(lam, traction, projection, scale,
                                   max(np.max(np.abs(b0), initial=0.0), traction_scale))
     W = projection.W

@@ -171,7 +171,7 @@ class HybridSystem:
         values = self.rhs.FV().NumPy()
         for name in ("u1", "u2"):
             rg = self.fes.Range(self.names.index(name))
-            values[rg.start:rg.stop] = problem.F[problem.blocks[name]]
+            values[rg.start:rg.stop] = problem.rhs[problem.blocks[name]]
         condensed = self.rhs.CreateVector()
         condensed.data = self.rhs
         with _tasks(self.mesh):
@@ -191,8 +191,8 @@ class HybridSystem:
         hdiv = pb.spaces.components["r1"]
         labelled = _boundary_edges(mesh, facet, hdiv)
         fluxes = _normal_fluxes(hdiv, mesh, scene.labels("dirichlet") + scene.labels("contact"))
-        F1 = pb.F[pb.blocks["r1"]]
-        F2 = pb.F[pb.blocks["r2"]]
+        F1 = pb.rhs[pb.blocks["r1"]]
+        F2 = pb.rhs[pb.blocks["r2"]]
 
         def edges_of(role):
             rows = [labelled[lab] for lab in scene.labels(role) if lab in labelled]
@@ -252,7 +252,7 @@ class HybridSystem:
         self.H.sum_duplicates()
         r = -(T.T @ (r_cond - K @ c0))
         if n_phi:
-            r[self.phi_index] -= pb.F[pb.index("phi1", "phi2")]
+            r[self.phi_index] -= pb.rhs[pb.index("phi1", "phi2")]
         self.r = r
         self._continuous = peers.raviart_thomas(mesh)
         self._convert = ngs.ConvertOperator(self.rt, self._continuous)

@@ -82,7 +82,7 @@ def solve_linear(problem: DiscreteProblem, backend: str = "umfpack") -> Solution
     fact = Factorization(problem.block(saddle, saddle), backend)
     start = time.perf_counter()
     x = np.zeros(problem.K.shape[0])
-    x[saddle] = fact.solve(problem.F[saddle])
+    x[saddle] = fact.solve(problem.rhs[saddle])
     solve_s = time.perf_counter() - start
     return Solution(problem, x, True, "linear",
                     timings={"assemble": problem.assemble_seconds, "factorize": fact.seconds,

@@ -68,7 +68,7 @@ def _solve_qp(problem: DiscreteProblem, Q: sp.spmatrix | None = None) -> Solutio
     A = problem.block(i_sigma, i_sigma)
     B = problem.block(i_sigma, i_mult)
     C_n = problem.block(i_sigma, i_lam)
-    g, b = problem.F[i_sigma], problem.F[i_mult]
+    g, b = problem.rhs[i_sigma], problem.rhs[i_mult]
     modulus = problem.scene.material.plane_strain_modulus
     stress = max(np.max(np.abs(b), initial=0.0), modulus * np.max(np.abs(g), initial=0.0)) or 1.0
     A_s, g_s, b_s = modulus * A, modulus / stress * g, b / stress

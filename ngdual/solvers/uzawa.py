@@ -103,8 +103,8 @@ class ContactLoop:
         modulus = problem.scene.material.plane_strain_modulus
         self.projection = NonnegativeProjection(
             metric_matrix(problem.spaces.contact, modulus, metric))
-        self.g = problem.F[problem.sigma]
-        self.b0 = problem.F[problem.mult]
+        self.g = problem.rhs[problem.sigma]
+        self.b0 = problem.rhs[problem.mult]
         i_t = problem.index("lam_t")  # the saddle unknowns are a prefix of x: also positions in y
         n_c, n_t = self.C_n.shape[1], len(i_t)
         self.E_t = sp.csr_matrix((np.ones(n_t), (i_t, np.arange(n_t))), shape=(n, n_t))

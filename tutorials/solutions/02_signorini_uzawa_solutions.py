@@ -65,7 +65,7 @@ def uzawa_by_hand(problem, W, rho=1.0, eps=1e-8, max_iter=2000):
     lam = np.zeros(C_n.shape[1])
     y_old = np.zeros(len(saddle))
     for iteration in range(1, max_iter + 1):
-        rhs = problem.F[saddle].copy()
+        rhs = problem.rhs[saddle].copy()
         rhs[:n_sigma] -= C_n @ lam
         y = lu.solve(rhs)                                               # step 3
         lam_new = project(W @ lam + rho * (C_n.T @ y[:n_sigma]))        # step 4
