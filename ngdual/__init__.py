@@ -1,6 +1,74 @@
 """ngdual: dual-dual mixed finite elements (PEERS) for frictional contact in 2D elasticity.
 
-The data flow is one way: scene -> mesh -> spaces -> forms -> solver -> post.
+The data flow is one way: scene -> mesh -> spaces -> forms -> solver -> estimator ->
+marking -> adaptive loop -> post-processing. ``import ngdual as nd`` gives the names a
+notebook needs:
+
+>>> import ngdual as nd
+>>> scene = nd.load_scene("thesis-3.46-coulomb", ["geometry.level=2"])
+>>> solution = nd.solve(scene)                                   # doctest: +SKIP
+>>> nd.norms(solution)["sigma_X"]                                # doctest: +SKIP
+
+Scenes: :func:`load_scene`, :func:`validate`, :func:`shipped_scenes`, :class:`Scene`,
+:class:`SceneError`. Solving: :func:`solve` (mesh, assemble, solve; Algorithms 3.38/3.41
+or the active-set method), :class:`Solution`. Adaptivity (Chapter 4): :func:`estimate`
+(the indicators of eq. 4.50), :func:`mark`, :func:`adapt` (SOLVE, ESTIMATE, MARK,
+REFINE). Post-processing: :func:`fields`, :func:`norms`, :func:`contact_traces`,
+:func:`force_balance`, :func:`result_record`. Plotting: :func:`plot_contact_traces`,
+:func:`plot_element_field`, :func:`plot_mesh`.
+
+The names are loaded lazily (PEP 562): ``import ngdual`` imports neither NGSolve nor
+matplotlib, so that the command line starts fast; the first use of a name imports its
+module.
 """
 
+from __future__ import annotations
+
+import importlib
+
 __version__ = "0.1.0"
+
+# public name -> (module, attribute): the one table of the public API
+_PUBLIC = {
+    "load_scene": ("ngdual.scene", "load_scene"),
+    "validate": ("ngdual.scene", "validate"),
+    "shipped_scenes": ("ngdual.scene", "shipped_scenes"),
+    "Scene": ("ngdual.scene", "Scene"),
+    "SceneError": ("ngdual.scene", "SceneError"),
+    "solve": ("ngdual.solvers", "solve_scene"),
+    "Solution": ("ngdual.solvers", "Solution"),
+    "adapt": ("ngdual.afem", "adapt"),
+    "estimate": ("ngdual.estimator", "estimate"),
+    "mark": ("ngdual.marking", "mark"),
+    "fields": ("ngdual.post", "fields"),
+    "norms": ("ngdual.post", "norms"),
+    "contact_traces": ("ngdual.post", "contact_traces"),
+    "force_balance": ("ngdual.post", "force_balance"),
+    "result_record": ("ngdual.post", "result_record"),
+    "plot_contact_traces": ("ngdual.plot", "plot_contact_traces"),
+    "plot_element_field": ("ngdual.plot", "plot_element_field"),
+    "plot_mesh": ("ngdual.plot", "plot_mesh"),
+}
+
+__all__ = ["__version__", *_PUBLIC]
+
+
+def __getattr__(name: str):
+    """Import the module of a public name (or a submodule, ``nd.post``) on first use."""
+    if name.startswith("__"):
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    if name in _PUBLIC:
+        module, attribute = _PUBLIC[name]
+        value = getattr(importlib.import_module(module), attribute)
+        globals()[name] = value  # later look-ups do not come back here
+        return value
+    try:
+        return importlib.import_module(f"{__name__}.{name}")
+    except ModuleNotFoundError as err:
+        if err.name != f"{__name__}.{name}":
+            raise
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

@@ -1,0 +1,263 @@
+"""How far each contact solver is from the cost of one linear solve (``ngdual bench``).
+
+For Example 3.46 without friction (``thesis-3.46``) and with Coulomb friction
+(``thesis-3.46-coulomb``), per level and solver variant, one record with the DOFs, the
+assembly time, the contact-solve time and its parts, iterations, peak memory and the
+**limit ratio**
+
+    limit_ratio = seconds_total / linear_seconds,
+
+seconds_total being everything the solver does after assembly (factorisation,
+condensation, iterations, recovery of all unknowns, the final residual checks) and
+linear_seconds one factorisation plus one solve of the same saddle-point matrix with the
+solver's own linear algebra, measured in the same run: NGSolve's UMFPACK on
+[[A, B], [B^T, 0]] for the Uzawa variants, the hybridised system with its Cholesky
+factorisation (:mod:`ngdual.solvers.hybrid`, :mod:`ngdual.solvers.cholesky`) for the
+active-set solver. ``limit_ratio_fastest`` divides by the fastest linear solve measured
+in the run instead (the Uzawa records measure both), so that the variants are compared on
+one scale.
+
+Solver variants: ``uzawa`` (Algorithm 3.38 / nested Uzawa 3.41 with Remark 3.45, the
+scene's default steps rho = rho1 = rho2 = 1), ``uzawa-tuned`` (the steps of ``TUNED``),
+``active-set`` (:mod:`ngdual.solvers.active_set`). Functions return records; printing and file
+writing are in :mod:`ngdual.cli`.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import platform
+import resource
+import subprocess
+import sys
+import time
+from importlib import metadata
+
+from threadpoolctl import threadpool_limits
+
+CASES = {"thesis-3.46": "thesis-3.46-frictionless", "thesis-3.46-coulomb": "thesis-3.46-coulomb"}
+SOLVERS = ("uzawa", "uzawa-tuned", "active-set")
+# The steps with the fewest iterations in a scan of Example 3.46 on levels 3-5 (rho in
+# 0.8..1.9, rho1 in 0.8..1.5, rho2 in 1..1.9): rho = 1.1 (h12 metric, Algorithm 3.38:
+# 14 steps instead of 16), rho1 = 1.2 and rho2 = 1.8 (nested Uzawa, rho2 relative to the
+# computed stability bound of the nu step, which must stay below 2: 54 outer steps instead
+# of 102 on level 4, the count still growing with the level).
+TUNED = {"rho": 1.1, "rho1": 1.2, "rho2": 1.8}
+ISOLATE_FROM_LEVEL = 4
+# UMFPACK and CHOLMOD call the first OpenBLAS in the process (NGSolve's, threaded); on 2
+# cores shared with other processes its spin-waiting threads made the same UMFPACK
+# factorisation take 0.8 s or 34 s. One thread for every solver keeps the comparison fair.
+BLAS_THREADS = 1
+_WARM: set = set()
+
+
+def _overrides(solver: str) -> list[str]:
+    if solver == "active-set":
+        return ["solver.method=active-set"]
+    if solver == "uzawa":
+        return ["solver.method=uzawa"]
+    if solver == "uzawa-tuned":
+        return ["solver.method=uzawa"] + [f"solver.{k}={v}" for k, v in TUNED.items()]
+    raise ValueError(f"unknown solver {solver!r}; use one of {SOLVERS}")
+
+
+def linear_seconds(problem, backend: str) -> dict:
+    """One factorisation and one solve of the saddle-point system of ``problem``.
+
+    ``backend``: ``"umfpack"`` ([[A, B], [B^T, 0]] by NGSolve's UMFPACK) or
+    ``"hybrid-cholesky"`` (hybridisation, static condensation, CHOLMOD, one solve and the
+    recovery of sigma and u). Returns the times and, for Cholesky, the factor's nonzeros.
+    """
+    from .solvers.cholesky import SchurCholesky
+    from .solvers.hybrid import HybridSystem
+    from .solvers.linear import Factorization
+
+    start = time.perf_counter()
+    if backend == "umfpack":
+        saddle = problem.saddle
+        fact = Factorization(problem.block(saddle, saddle), "umfpack")
+        factorized = time.perf_counter()
+        fact.solve(problem.F[saddle])
+        nnz = None
+    elif backend == "hybrid-cholesky":
+        hybrid = HybridSystem(problem)
+        chol = SchurCholesky(hybrid.H, hybrid.contact_index)
+        factorized = time.perf_counter()
+        hybrid.unknowns(chol.solve(hybrid.r))
+        nnz = chol.nnz
+    else:
+        raise ValueError(f"unknown backend {backend!r}")
+    end = time.perf_counter()
+    return {"backend": backend, "factorize": factorized - start, "solve": end - factorized,
+            "total": end - start, "nnz_factor": nnz}
+
+
+def _peak_rss_mb() -> float:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+
+def versions() -> dict:
+    """Package versions (those of every result record, plus the linear-algebra packages)."""
+    from .post import versions as base
+
+    out = base()
+    for pkg in ("cvxopt", "pymetis"):
+        try:
+            out[pkg] = metadata.version(pkg)
+        except metadata.PackageNotFoundError:
+            out[pkg] = None
+    return out
+
+
+def machine() -> dict:
+    """What the timings were measured on (the load average shows other processes)."""
+    return {"processor": platform.processor() or platform.machine(),
+            "cpu_count": os.cpu_count(), "load_average": list(os.getloadavg()),
+            "OPENBLAS_NUM_THREADS": os.environ.get("OPENBLAS_NUM_THREADS")}
+
+
+def run_one(case: str, level: int, solver: str, blas_threads: int | None = BLAS_THREADS,
+            warm_up: bool = True) -> dict:
+    """Assemble ``case`` on ``level``, time the linear solves and the contact solver.
+
+    All of it runs with ``blas_threads`` BLAS threads (None: the libraries' defaults); with
+    ``warm_up`` the same record is computed on level 1 first, so that one-time costs
+    (imports, code generation) fall on no measurement (once per process).
+    """
+    from . import forms, solve  # noqa: F401  (loads NGSolve and its BLAS before the limit)
+
+    with threadpool_limits(limits=blas_threads, user_api="blas"):
+        if warm_up and (case, solver) not in _WARM:
+            _measure(case, 1, solver)
+            _WARM.add((case, solver))
+        load = list(os.getloadavg())
+        record = _measure(case, level, solver)
+    record.update(blas_threads=blas_threads, load_average=load)
+    return record
+
+
+def _measure(case: str, level: int, solver: str) -> dict:
+    from .forms import assemble
+    from .mesh import build_mesh
+    from .post import norms
+    from .scene import load_scene
+    from .solvers import solve_problem
+    from .solvers.result import ConvergenceError
+
+    scene = load_scene(CASES[case], _overrides(solver))
+    start = time.perf_counter()
+    problem = assemble(scene, build_mesh(scene.geometry, level))
+    problem.level = level
+    assemble_s = time.perf_counter() - start
+    # the active-set records skip UMFPACK (minutes from level 7 on); the Uzawa records
+    # measure both, the Cholesky of the hybridised system costing little
+    backends = ("hybrid-cholesky",) if solver == "active-set" else ("umfpack", "hybrid-cholesky")
+    linear = {b: linear_seconds(problem, b) for b in backends}
+    own = linear[backends[0]]
+    start, cpu = time.perf_counter(), time.process_time()
+    error = None
+    try:
+        solution = solve_problem(problem)
+    except ConvergenceError as err:
+        solution, error = None, str(err)
+    total, cpu = time.perf_counter() - start, time.process_time() - cpu
+    fastest = min(v["total"] for v in linear.values())
+    record = {
+        "case": case, "scene": scene.name, "level": level, "solver": solver,
+        "method": solution.method if solution else None,
+        "ndof": int(problem.K.shape[0]), "dofs": problem.spaces.dofs(),
+        "converged": bool(solution and solution.converged), "error": error,
+        "iterations": {k: int(v) for k, v in solution.iterations.items()} if solution else None,
+        "seconds_assemble": assemble_s,
+        "seconds_total": total,
+        "cpu_seconds_total": cpu,
+        "seconds_parts": {k: float(v) for k, v in solution.timings.items()
+                          if k != "assemble"} if solution else {},
+        "linear_seconds": own["total"],
+        "linear": linear,
+        "limit_ratio": total / own["total"],
+        "limit_ratio_fastest": total / fastest,
+        "nnz_factor": own["nnz_factor"],
+        "residuals": {k: float(v) for k, v in solution.residuals.items()} if solution else {},
+        "norms": norms(solution) if solution else None,
+        "peak_rss_mb": _peak_rss_mb(),
+    }
+    return record
+
+
+def _run_isolated(case: str, level: int, solver: str, timeout: float | None,
+                  blas_threads: int | None) -> dict:
+    """:func:`run_one` in a fresh process, so that its peak memory is its own."""
+    cmd = [sys.executable, "-m", "ngdual.bench", case, str(level), solver, str(blas_threads)]
+    try:
+        out = subprocess.run(cmd, check=True, capture_output=True, text=True, timeout=timeout)
+    except subprocess.TimeoutExpired:
+        return {"case": case, "scene": CASES[case], "level": level, "solver": solver,
+                "converged": False, "error": f"timed out after {timeout} s",
+                "seconds_total": None, "limit_ratio": None, "iterations": None,
+                "peak_rss_mb": None}
+    except subprocess.CalledProcessError as err:
+        return {"case": case, "scene": CASES[case], "level": level, "solver": solver,
+                "converged": False, "error": err.stderr.strip().splitlines()[-1:],
+                "seconds_total": None, "limit_ratio": None, "iterations": None,
+                "peak_rss_mb": None}
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def bench(levels, cases=tuple(CASES), solvers=SOLVERS, isolate: str = "auto",
+          timeout: float | None = None, on_record=None,
+          blas_threads: int | None = BLAS_THREADS) -> dict:
+    """All records for ``cases`` x ``levels`` x ``solvers``, with versions and machine.
+
+    ``isolate``: ``"always"`` runs every record in its own process (its own peak memory;
+    ``peak_rss_scope = "run"``), ``"never"`` runs all in this process (peak memory of the
+    process so far, ``"process"``), ``"auto"`` isolates from level ``ISOLATE_FROM_LEVEL``
+    on. ``timeout`` bounds an isolated run. ``on_record(run)`` is called after each record
+    with everything so far (for progress and atomic partial output).
+    """
+    for case in cases:
+        if case not in CASES:
+            raise ValueError(f"unknown case {case!r}; use one of {tuple(CASES)}")
+    for solver in solvers:
+        _overrides(solver)
+    run = {"benchmark": "limit-ratio", "versions": versions(),
+           "machine": {**machine(), "blas_threads": blas_threads}, "tuned": TUNED,
+           "records": []}
+    for case in cases:
+        for level in levels:
+            for solver in solvers:
+                isolated = isolate == "always" or (isolate == "auto"
+                                                   and level >= ISOLATE_FROM_LEVEL)
+                if isolated:
+                    record = _run_isolated(case, level, solver, timeout, blas_threads)
+                else:
+                    record = run_one(case, level, solver, blas_threads)
+                record["peak_rss_scope"] = "run" if isolated else "process"
+                record["versions"] = run["versions"]
+                run["records"].append(record)
+                if on_record:
+                    on_record(run)
+    run["machine"]["load_average_end"] = list(os.getloadavg())
+    return run
+
+
+def summary_rows(run: dict) -> list[dict]:
+    """One flat row per record for a table."""
+    rows = []
+    for r in run["records"]:
+        its = r.get("iterations") or {}
+        rows.append({"case": r["case"], "level": r["level"], "solver": r["solver"],
+                     "ndof": r.get("ndof"), "assemble": r.get("seconds_assemble"),
+                     "linear": r.get("linear_seconds"), "total": r.get("seconds_total"),
+                     "ratio": r.get("limit_ratio"), "ratio_fastest": r.get("limit_ratio_fastest"),
+                     "outer": its.get("outer"), "inner": its.get("inner"),
+                     "rss": r.get("peak_rss_mb"), "converged": r.get("converged"),
+                     "error": r.get("error")})
+    return rows
+
+
+if __name__ == "__main__":  # child process of _run_isolated
+    case_, level_, solver_, threads_ = sys.argv[1], int(sys.argv[2]), sys.argv[3], sys.argv[4]
+    print(json.dumps(run_one(case_, level_, solver_,
+                             None if threads_ == "None" else int(threads_))))

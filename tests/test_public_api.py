@@ -1,0 +1,74 @@
+"""``import ngdual as nd``: a small documented public API, loaded lazily.
+
+Every name of ``nd.__all__`` resolves and carries a docstring; importing ngdual imports
+neither NGSolve nor matplotlib (the command line stays fast and a notebook keeps its
+matplotlib backend); the five lines of the README solve Example 3.46 with Coulomb friction.
+"""
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+import ngdual as nd
+
+
+def test_every_public_name_resolves_and_has_a_docstring():
+    assert len(nd.__all__) == len(set(nd.__all__)) and 10 <= len(nd.__all__) <= 25
+    for name in nd.__all__:
+        value = getattr(nd, name)
+        if name == "__version__":
+            assert isinstance(value, str) and value.count(".") >= 1
+            continue
+        doc = getattr(value, "__doc__", None)
+        assert doc and doc.strip(), f"nd.{name} has no docstring"
+
+
+def test_public_names_are_the_pipeline_functions():
+    from ngdual import afem, estimator, marking, post, scene, solvers
+
+    assert nd.solve is solvers.solve_scene
+    assert nd.load_scene is scene.load_scene and nd.Scene is scene.Scene
+    assert nd.adapt is afem.adapt and nd.estimate is estimator.estimate
+    assert nd.mark is marking.mark and nd.contact_traces is post.contact_traces
+    assert nd.norms is post.norms
+
+
+def test_dir_lists_the_public_names_and_unknown_names_raise():
+    assert set(nd.__all__) <= set(dir(nd))
+    with pytest.raises(AttributeError, match="no attribute 'no_such_name'"):
+        nd.no_such_name  # noqa: B018
+
+
+def test_submodules_are_reachable_as_attributes():
+    assert nd.post.norms is nd.norms
+
+
+def test_importing_ngdual_imports_neither_ngsolve_nor_pyplot():
+    code = ("import sys, json, ngdual; print(json.dumps({m: m in sys.modules for m in "
+            "('ngsolve', 'netgen', 'matplotlib', 'matplotlib.pyplot')}))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True).stdout
+    assert not any(json.loads(out).values()), out
+
+
+def test_a_scene_loads_without_ngsolve():
+    code = ("import sys, ngdual as nd; nd.load_scene('thesis-3.46-coulomb'); "
+            "print('ngsolve' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True).stdout
+    assert out.strip() == "False"
+
+
+def test_the_readme_example_solves_example_3_46_with_coulomb_friction():
+    scene = nd.load_scene("thesis-3.46-coulomb", ["geometry.level=2"])
+    solution = nd.solve(scene)
+    assert solution.converged
+    record = nd.result_record(solution)
+    assert record["dofs"]["X"] == 680                         # Table 3.1, level 2
+    assert record["contact"]["nodes_in_contact"] > 0
+    traces = nd.contact_traces(solution)
+    force = nd.force_balance(solution, traces).multiplier_force  # on the h~ hats, n = (0, -1)
+    assert force[1] > 0 and abs(force[0]) < 1e-9 * force[1]    # the foundation pushes up
+    assert traces.lam_n.min() >= -1e-12                      # lambda_n >= 0 (3.62)
