@@ -44,7 +44,7 @@ from ngdual.marking import STRATEGIES, mark
 from ngdual.rates import fitted_rate
 from ngdual.scene import load_scene
 from ngdual.solvers import solve_scene
-from ngdual.tutorials import output_dir, quick_mode, save_figure, save_results
+from ngdual.studies.tutorials import output_dir, quick_mode, save_figure, save_results
 
 # %% [markdown]
 # ## Parameters
@@ -152,7 +152,7 @@ plot_meshes([(level2, marked_sets[s], f"{s}, theta = {examples[s]}: {marked_sets
 # σ ∈ H^{α−ε}: uniform refinement gives e ~ h^α ~ N^{−α/2}.
 
 # %%
-# The exact solution is in `ngdual.corner` (read its source: Williams' formulas written as
+# The exact solution is in `ngdual.verification.corner` (read its source: Williams' formulas written as
 # scene expressions in x and y), with the scene and the exact error of PEERS,
 # (‖σ − σ_h‖² + ‖div σ_h‖² + ‖u − u_h‖² + ‖η − η_h‖²)^{1/2}.
 

@@ -18,7 +18,7 @@ from ngdual.mesh import build_mesh
 from ngdual.rates import fitted_rate
 from ngdual.scene import load_scene
 from ngdual.solvers import solve_problem, solve_scene
-from ngdual.tutorials import output_dir, quick_mode, save_results
+from ngdual.studies.tutorials import output_dir, quick_mode, save_results
 
 QUICK = quick_mode()
 TARGET_DOFS = 1500 if QUICK else 8000       # Exercise 1: refine until N reaches this
@@ -64,7 +64,7 @@ def adapt_until(scene, marking, theta, max_dofs, level=1, indicator="eta", error
 # back to α ≈ 0.54. θ ≈ 0.5 is the usual compromise.
 
 # %%
-l_shape = corner.l_shape_scene()          # Williams' corner solution (ngdual.corner)
+l_shape = corner.l_shape_scene()          # Williams' corner solution (ngdual.verification.corner)
 exact = corner.exact_fields()
 
 
