@@ -26,11 +26,18 @@ import pytest
 from ngdual.afem import adapt, reference_norms, refine
 from ngdual.boundary import BoundaryMeshes, CoarseMesh
 from ngdual.cli import main
-from ngdual.verification.corner import LABELS, POINTS, corner_exponent, exact_error, exact_fields, l_shape_scene
 from ngdual.marking import mark_fraction, mark_max
 from ngdual.mesh import polygon_mesh, refine_uniformly, thesis_mesh
 from ngdual.rates import fitted_rate
 from ngdual.scene import Geometry, Scene, load_scene, validate
+from ngdual.verification.corner import (
+    LABELS,
+    POINTS,
+    corner_exponent,
+    exact_error,
+    exact_fields,
+    l_shape_scene,
+)
 
 # --- coarse boundary meshes ----------------------------------------------------------------------
 
