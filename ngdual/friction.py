@@ -27,8 +27,8 @@ from . import peers
 from .contact import ContactBoundary
 from .expr import Expression
 from .forms import DiscreteProblem, boundary_regex
+from .tolerances import friction_vanishes
 
-NEGLIGIBLE = 1e-6  # hat moments of sigma_n below this fraction of the largest are zero
 GAUSS = (np.array([0.5 - np.sqrt(15) / 10, 0.5, 0.5 + np.sqrt(15) / 10]),
          np.array([5, 8, 5]) / 18)
 
@@ -135,12 +135,13 @@ def hat_projection(midpoint_hats: sp.csr_matrix, lengths: np.ndarray,
     and not removable from the discrete solution while lambda_n is P1 on h~ (see the
     README, "Contact problems beyond the thesis").
 
-    Moments below ``NEGLIGIBLE`` times the largest are zero: an iterative contact solve
-    leaves moments of the size of its tolerance where the body separates.
+    Moments that vanish by :func:`ngdual.tolerances.friction_vanishes` (1e-6 of the largest)
+    are zero: an iterative contact solve leaves moments of the size of its tolerance where
+    the body separates.
     """
     weights = midpoint_hats.T @ lengths
     moments = midpoint_hats.T @ (lengths * sigma_n)
-    moments[np.abs(moments) <= NEGLIGIBLE * np.abs(moments).max(initial=0.0)] = 0.0
+    moments[friction_vanishes(moments)] = 0.0
     return moments / weights
 
 

@@ -412,7 +412,11 @@ def _build(name: str, data: dict) -> Scene:
                 continue
             boundary[role] = [labels] if isinstance(labels, str) else labels
     problems.raise_any()
-    return Scene(name=str(data.get("name", name)), boundary=boundary, **kwargs)
+    scene = Scene(name=str(data.get("name", name)), boundary=boundary, **kwargs)
+    # what the document sets, also where it repeats a default (see _settings_without_effect)
+    scene.__dict__["_given"] = frozenset(f"{section}.{key}" for section in _SECTIONS
+                                         for key in data.get(section, {}))
+    return scene
 
 
 def load_scene(source: str | Path, overrides: list[str] | None = None) -> Scene:
@@ -874,6 +878,11 @@ def validate(scene: Scene) -> None:
         ok["friction"] = problems.run(_validate_friction_settings, scene)
     if ok["solver"]:
         _validate_solver(scene.solver, problems)
+    if ok["solver"] and ok["friction"] and scene.solver.method in SOLVER_METHODS:
+        reported = {f for f, _ in problems.found}
+        for f, m in _settings_without_effect(scene):
+            if f not in reported:  # one problem per field: its bad value comes first
+                problems.add(f, m)
     if all(ok[k] for k in ("geometry", "boundary", "loads", "contact", "friction")):
         if problems.run(_validate_formulas_on_sides, scene, loads) \
                 and problems.run(_validate_contact, scene, loads["displacement"]):
@@ -948,6 +957,46 @@ def _validate_solver(sol: Solver, problems: _Problems) -> None:
                                         "iteration converges (it is relative to the stability "
                                         "bound)")
     problems.run(_positive, sol.max_iter, "solver.max_iter", integer=True)
+
+
+# The settings each choice reads. "uzawa" reads those of Algorithm 3.38 or of Algorithm 3.41
+# (Remark 3.45), whichever the friction law calls for: one set of Uzawa parameters serves
+# the scenes of every law (e.g. the tuned steps of ``ngdual bench``).
+SOLVER_READS = {"auto": ("method", "metric", "max_iter"),
+                "active-set": ("method", "metric", "max_iter"),
+                "uzawa": tuple(f.name for f in dataclasses.fields(Solver))}
+FRICTION_READS = {"none": ("law",), "tresca": ("law", "bound"),
+                  "coulomb": ("law", "mu", "normal_stress")}
+
+
+def _given(scene: Scene, section: str) -> set[str]:
+    """The keys of ``section`` the user set: in the scene's document (TOML, overrides), or,
+    for a scene built in Python, those that differ from the default."""
+    obj, given = getattr(scene, section), scene.__dict__.get("_given", frozenset())
+    return {f.name for f in dataclasses.fields(obj)
+            if f"{section}.{f.name}" in given or getattr(obj, f.name) != f.default}
+
+
+def _settings_without_effect(scene: Scene) -> list[tuple[str, str]]:
+    """``(field, message)`` for every setting the chosen method or friction law ignores.
+
+    A setting that does nothing is an error, not a silence: ``solver.rho`` with the
+    active-set solver, ``friction.mu`` without Coulomb friction, ...
+    """
+    found = []
+    method = scene.solver.method
+    for key in sorted(_given(scene, "solver") - set(SOLVER_READS[method])):
+        found.append((f"solver.{key}", f"does nothing with solver.method = {method!r}: the "
+                      "active-set solver iterates to round-off and reads only metric and "
+                      "max_iter; remove it, or set solver.method = \"uzawa\" for the "
+                      "thesis' Algorithms 3.38 / 3.41"))
+    law = scene.friction.law if scene.friction.law in FRICTION_LAWS else "none"
+    users = {"mu": "coulomb", "normal_stress": "coulomb", "bound": "tresca"}
+    for key in sorted(_given(scene, "friction") - set(FRICTION_READS[law])):
+        found.append((f"friction.{key}", f"does nothing with friction.law = {law!r}: only "
+                      f"{users[key]!r} friction uses it; remove it, or set friction.law = "
+                      f"\"{users[key]}\""))
+    return found
 
 
 def _validate_formulas_on_sides(scene: Scene, loads: dict[str, list[Expression]]) -> None:

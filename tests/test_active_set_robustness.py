@@ -26,6 +26,7 @@ from ngdual.solvers.active_set import active_set_solve
 from ngdual.solvers.nested import nested_uzawa
 from ngdual.solvers.result import ConvergenceError
 from ngdual.solvers.semismooth import EPS, SAFETY, condition_number, kkt_residuals
+from ngdual.solvers.settings import ActiveSetSettings, NestedUzawaSettings
 
 CHECKED = ("linear", "boundary_kkt", "lambda_n_negative", "sigma_n_positive", "complementarity",
            "natural", "nu_sign", "nu_bound", "tangential", "sigma_t_bound", "coulomb_bound")
@@ -72,8 +73,8 @@ def assert_same_as_uzawa(sol, ref, rtol=1e-8):
 
 def tight_uzawa(pb):
     """Algorithm 3.41 with Remark 3.45 at the tolerances of tests/test_hard_cases.py."""
-    sol = nested_uzawa(pb, "coulomb", mu_f=pb.scene.friction.mu, eps1=1e-11, eps2=1e-10,
-                       max_iter=4000)
+    sol = nested_uzawa(pb, NestedUzawaSettings.from_scene(pb.scene, eps1=1e-11, eps2=1e-10,
+                                                          max_iter=4000))
     assert sol.converged
     return sol
 
@@ -136,7 +137,7 @@ def test_damped_newton_ends_the_cycle_without_the_qp(monkeypatch):
         calls.append((G, b, Q, sol))
         return sol
     monkeypatch.setattr(active_set, "semismooth_newton", recorded)
-    sol = active_set_solve(pb)
+    sol = active_set_solve(pb, ActiveSetSettings.from_scene(pb.scene))
     assert_round_off(sol)
     assert max(c[3].iterations for c in calls) > 8  # the damped phase was needed
     for G, b, Q, state in calls:
@@ -176,7 +177,7 @@ def test_residual_check_names_the_criterion_its_value_and_tolerance(monkeypatch)
         return x
     monkeypatch.setattr(active_set.HybridSystem, "unknowns", off)
     with pytest.raises(ConvergenceError) as info:
-        active_set_solve(pb)
+        active_set_solve(pb, ActiveSetSettings.from_scene(pb.scene))
     message = str(info.value)
     assert re.search(r"linear = \d\.\de-0[67] > \d\.\de-1\d", message), message
     assert "round-off level" in message and info.value.history

@@ -28,10 +28,12 @@ from ngdual.solvers.hybrid import HybridSystem
 from ngdual.solvers.reference import solve_qp_friction
 from ngdual.solvers.result import ConvergenceError
 from ngdual.solvers.semismooth import EPS, SAFETY, kkt_residuals, semismooth_newton
+from ngdual.solvers.settings import ActiveSetSettings, Model, UzawaSettings
 from ngdual.solvers.uzawa import uzawa
 
 RTOL = 1e-8
-TIGHT = ["solver.eps=1e-11", "solver.eps1=1e-11", "solver.eps2=1e-10"]
+UZAWA = "solver.method=uzawa"
+TIGHT = ["solver.eps=1e-11", "solver.eps1=1e-11", "solver.eps2=1e-10"]  # Uzawa only
 LEVELS = (1, 2, 3)
 
 
@@ -41,7 +43,7 @@ def rel(a, b):
 
 @cache
 def problem(name, level, *overrides):
-    scene = load_scene(name, [*TIGHT, *overrides])
+    scene = load_scene(name, [*(TIGHT if UZAWA in overrides else []), *overrides])
     pb = assemble(scene, build_mesh(scene.geometry, level))
     pb.level = level
     return pb
@@ -55,10 +57,10 @@ def reference(name, level, *overrides):
     stagnates and the QP's fixed point on F does not settle: there F = 0 and the Coulomb
     solution is the frictionless one, the reference is then Algorithm 3.38.
     """
-    pb = problem(name, level, "solver.method=uzawa", *overrides)
+    pb = problem(name, level, UZAWA, *overrides)
     scene = pb.scene
     if scene.friction.law == "coulomb" and fast(name, level, *overrides).friction_bound.max() == 0:
-        sol = uzawa(pb, eps=1e-11)
+        sol = uzawa(pb, UzawaSettings.from_scene(scene, eps=1e-11))
         assert sol.converged
         return sol, "frictionless"
     try:
@@ -67,7 +69,7 @@ def reference(name, level, *overrides):
             return sol, "uzawa"
     except ConvergenceError:
         pass
-    return solve_qp_friction(pb, scene.friction.law, scene.friction.mu), "qp"
+    return solve_qp_friction(pb, Model.of(scene)), "qp"
 
 
 @cache
@@ -147,10 +149,9 @@ def test_default_method_is_active_set_and_uzawa_stays_available():
     assert auto.method == "active-set-coulomb"
     assert uzawa.method.startswith("nested-uzawa-coulomb")
     assert post.result_record(auto)["parameters"]["solver"]["method"] == "auto"
-    linear = solve_scene(load_scene("thesis-3.46-coulomb", ["boundary.contact=[]",
-                                                            "boundary.dirichlet=[\"left\", "
-                                                            "\"right\", \"bottom\"]",
-                                                            "friction.law=\"none\""]), 2)
+    linear = solve_scene(load_scene("thesis-3.46-frictionless", ["boundary.contact=[]",
+                                                                 "boundary.dirichlet=[\"left\", "
+                                                                 "\"right\", \"bottom\"]"]), 2)
     assert linear.method == "linear"
 
 
@@ -181,8 +182,8 @@ def test_strongly_graded_mesh_agrees_with_the_qp_reference():
     scene = load_scene("thesis-3.46-coulomb", ["solver.method=active-set"])
     mesh, coarse = refine_towards(scene, build_mesh(scene.geometry, 2), (-4.0, 0.0), 6)
     pb = assemble(scene, mesh, coarse)
-    sol = active_set_solve(pb)
-    ref = solve_qp_friction(pb, "coulomb", scene.friction.mu)
+    sol = active_set_solve(pb, ActiveSetSettings.from_scene(scene))
+    ref = solve_qp_friction(pb, Model.of(scene))
     assert rel(sol.x[pb.sigma], ref.x[pb.sigma]) <= 1e-7
 
 
@@ -190,7 +191,7 @@ def test_hybridisation_reproduces_the_rows_of_the_assembled_system():
     """For any lambda, the hybrid solve satisfies the sigma, u, eta, phi rows of K x = F, and
     t(zeta) are the moments C_n^T sigma, C_t^T sigma and the fine-edge sigma_n of friction.py."""
     pb = problem("thesis-3.46-coulomb", 2)
-    hs = HybridSystem(pb)
+    hs = HybridSystem(pb, Model.of(pb.scene))
     H, last = hs.H, hs.contact_index
     assert abs(H - H.T).max() <= 1e-14 * abs(H).max()
     rest = np.setdiff1d(np.arange(hs.n_w), last)

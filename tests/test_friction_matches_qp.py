@@ -18,6 +18,7 @@ from ngdual.mesh import build_mesh
 from ngdual.scene import load_scene
 from ngdual.solvers import solve_problem
 from ngdual.solvers.reference import solve_qp_friction
+from ngdual.solvers.settings import Model
 
 RTOL = 1e-5
 CASES = [(name, level) for name in ("thesis-3.46-coulomb", "thesis-3.46-coulomb-gap0")
@@ -29,7 +30,7 @@ def solutions(name, level):
     scene = load_scene(name, ["solver.method=uzawa", "solver.eps1=1e-11", "solver.eps2=1e-10"])
     problem = assemble(scene, build_mesh(scene.geometry, level))
     return (scene, solve_problem(problem),
-            solve_qp_friction(problem, scene.friction.law, scene.friction.mu))
+            solve_qp_friction(problem, Model.of(scene)))
 
 
 @pytest.mark.parametrize(("name", "level"), CASES)

@@ -14,6 +14,7 @@ from ngdual.scene import load_scene
 from ngdual.solvers import solve_scene
 from ngdual.solvers.nested import box_projection, box_projection_qp, nested_uzawa
 from ngdual.solvers.projections import NonnegativeProjection, metric_matrix
+from ngdual.solvers.settings import NestedUzawaSettings, UzawaSettings
 from ngdual.solvers.uzawa import uzawa
 
 
@@ -79,9 +80,10 @@ def _coulomb_problem(level=2):
         "thesis-3.46-coulomb").geometry, level))
 
 
-def _nested(**options):
-    params = {"mu_f": 0.5, "eps1": 1e-11, "eps2": 1e-10, **options}
-    return nested_uzawa(_coulomb_problem(), "coulomb", **params)
+def _nested(condensed=True, **options):
+    pb = _coulomb_problem()
+    settings = NestedUzawaSettings.from_scene(pb.scene, eps1=1e-11, eps2=1e-10, **options)
+    return nested_uzawa(pb, settings, condensed=condensed)
 
 
 @pytest.mark.parametrize("variant", [{"loop_order": "contact-outer"},
@@ -103,7 +105,8 @@ def test_condensed_iteration_repeats_the_sparse_solves_exactly():
 def test_frictionless_uzawa_condensed_equals_sparse():
     problem = assemble(load_scene("thesis-3.46-frictionless"),
                        build_mesh(load_scene("thesis-3.46-frictionless").geometry, 3))
-    a, b = uzawa(problem, eps=1e-10), uzawa(problem, eps=1e-10, condensed=True)
+    settings = UzawaSettings.from_scene(problem.scene, eps=1e-10)
+    a, b = uzawa(problem, settings), uzawa(problem, settings, condensed=True)
     assert a.iterations == b.iterations and a.history == pytest.approx(b.history, rel=1e-6)
     assert np.linalg.norm(a.x - b.x) <= 1e-10 * np.linalg.norm(a.x)
 

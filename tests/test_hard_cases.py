@@ -15,6 +15,7 @@ from ngdual.scene import load_scene
 from ngdual.solvers import solve_problem, solve_scene
 from ngdual.solvers.reference import solve_qp_friction
 from ngdual.solvers.result import ConvergenceError
+from ngdual.solvers.settings import Model
 
 UZAWA = "solver.method=uzawa"  # these cases test the thesis' algorithms (Alg. 3.41, Rem. 3.45)
 TIGHT = [UZAWA, "solver.eps1=1e-11", "solver.eps2=1e-10"]
@@ -38,7 +39,7 @@ def test_gap_zero_with_hhat_equal_htilde_gives_the_unique_sigma_or_names_the_rem
     not unique, sigma is. Either the QP's sigma is reached or the error names h^."""
     scene = load_scene("thesis-3.46-coulomb-gap0", ["contact.hhat_factor=1", *TIGHT])
     problem = assemble(scene, build_mesh(scene.geometry, level))
-    reference = solve_qp_friction(problem, "coulomb", scene.friction.mu)
+    reference = solve_qp_friction(problem, Model.of(scene))
     try:
         sol = solve_problem(problem)
     except ConvergenceError as err:
@@ -100,7 +101,7 @@ def test_large_friction_coefficients_converge_or_fail_clearly(mu_f):
         assert "friction.mu" in str(err) and err.history
         return
     assert sol.converged
-    reference = solve_qp_friction(problem, "coulomb", mu_f)
+    reference = solve_qp_friction(problem, Model.of(scene))
     assert sigma_difference(sol, reference) < 1e-6
     assert sol.residuals["sigma_t_bound"] <= 1e-12
 
@@ -114,7 +115,7 @@ def test_strongly_graded_mesh_at_a_corner_of_the_contact_boundary():
     assert sol.converged
     r = sol.residuals
     assert r["natural"] < 1e-8 and r["sigma_t_bound"] <= 1e-12 and r["nu_sign"] < 1e-6
-    reference = solve_qp_friction(problem, "coulomb", scene.friction.mu)
+    reference = solve_qp_friction(problem, Model.of(scene))
     assert sigma_difference(sol, reference) < 1e-6
     n = post.norms(sol)
     assert all(np.isfinite(v) for v in n.values() if v is not None)

@@ -100,6 +100,10 @@ CASES = [
      "needs a bound"),
     ("coulomb-without-mu", [*SOLVE, "--set", "friction.law='coulomb'"], "friction.mu",
      "mu > 0"),
+    ("rho-with-active-set", [*SOLVE, "--set", "solver.rho=2"], "solver.rho",
+     "does nothing with solver.method = 'auto'"),
+    ("mu-without-coulomb", [*SOLVE, "--set", "friction.mu=0.3"], "friction.mu",
+     "does nothing with friction.law = 'none'"),
     ("htilde-too-coarse", ["solve", THESIS, "--level", "2", "--set",
                            "contact.htilde_factor=100"], "contact.htilde_factor",
      "without unknowns"),
@@ -277,7 +281,7 @@ def test_an_internal_error_is_one_line_and_debug_shows_the_traceback(workspace, 
 
 
 def test_a_non_finite_solution_is_never_converged():
-    from ngdual.solvers import _check_finite
+    from ngdual.solvers.dispatch import _check_finite
     from ngdual.solvers.result import ConvergenceError, Solution
 
     solution = Solution(problem=None, x=np.array([1.0, np.nan]), converged=True,

@@ -1,9 +1,11 @@
 """Bad scenes fail at validation with one line naming the field; the CLI exits 2, writes nothing."""
 
+import dataclasses
+
 import pytest
 
 from ngdual.cli import main
-from ngdual.scene import SceneError, load_scene, shipped_scenes
+from ngdual.scene import Friction, SceneError, Solver, load_scene, shipped_scenes, validate
 
 BAD = [
     (["boundary.contact=['floor']"], "boundary.contact", "unknown boundary label"),
@@ -45,6 +47,18 @@ BAD = [
     (["loads.traction=['0', '-800/x']"], "loads.traction[1]", "not integrable"),
     (["loads.traction=['0', 'ifpos(x, 1)']"], "loads.traction[1]", "takes 3 arguments"),
     (["loads.displacement=['0', 'log(y + 1)']"], "loads.displacement[1]", "not finite"),
+    # a setting the chosen method or friction law ignores is an error, also at its default
+    (["solver.rho=2"], "solver.rho", "does nothing with solver.method = 'auto'"),
+    (["solver.rho=1.0"], "solver.rho", "does nothing with solver.method = 'auto'"),
+    (["solver.method='active-set'", "solver.loop_order='contact-outer'"], "solver.loop_order",
+     "does nothing with solver.method = 'active-set'"),
+    (["friction.mu=0.3"], "friction.mu", "does nothing with friction.law = 'none'"),
+    (["friction.normal_stress='fine-edges'"], "friction.normal_stress", "only 'coulomb'"),
+    (["friction.bound='100'"], "friction.bound", "only 'tresca'"),
+    (["friction.law='tresca'", "friction.bound='100'", "friction.mu=0.5"], "friction.mu",
+     "does nothing with friction.law = 'tresca'"),
+    (["friction.law='coulomb'", "friction.mu=0.5", "friction.bound='100'"], "friction.bound",
+     "does nothing with friction.law = 'coulomb'"),
 ]
 
 
@@ -68,6 +82,38 @@ def test_cli_exits_2_and_writes_no_result(tmp_path, capsys, overrides, field, wo
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and field in err
     assert not any(tmp_path.iterdir())
+
+
+def test_a_setting_without_effect_is_named_only_once_with_its_bad_value_first():
+    """rho = 0 under the active-set solver: the bad value is the one problem reported."""
+    with pytest.raises(SceneError) as info:
+        load_scene("thesis-3.46-frictionless", ["solver.rho=0"])
+    assert info.value.fields == ["solver.rho"] and "positive" in str(info.value)
+
+
+def test_switching_a_shipped_coulomb_scene_to_no_friction_names_its_coefficient():
+    with pytest.raises(SceneError) as info:
+        load_scene("thesis-3.46-coulomb", ["friction.law='none'"])
+    assert info.value.fields == ["friction.mu"]
+
+
+def test_uzawa_accepts_the_settings_of_both_algorithms():
+    """Algorithm 3.38 or 3.41 follows from the friction law: one set of Uzawa parameters
+    serves every law (the shipped scenes and the tuned steps of ngdual bench)."""
+    for name in ("thesis-3.46-frictionless", "thesis-3.46-coulomb"):
+        scene = load_scene(name, ["solver.method='uzawa'", "solver.rho=1.1", "solver.rho1=1.2",
+                                  "solver.eps2=1e-8"])
+        assert scene.solver.rho1 == 1.2
+
+
+def test_a_scene_built_in_python_is_checked_by_what_differs_from_the_defaults():
+    scene = load_scene("thesis-3.46-frictionless")
+    validate(scene)                       # every setting at its default: nothing to report
+    bad = dataclasses.replace(scene, solver=Solver(rho=2.0),
+                              friction=Friction(law="none", mu=0.3))
+    with pytest.raises(SceneError) as info:
+        validate(bad)
+    assert info.value.fields == ["solver.rho", "friction.mu"]
 
 
 def test_unknown_scene_name_lists_the_shipped_ones():

@@ -16,6 +16,7 @@ from ngdual.forms import assemble
 from ngdual.mesh import build_mesh
 from ngdual.scene import load_scene
 from ngdual.solvers.reference import solve_qp
+from ngdual.solvers.settings import Model, UzawaSettings
 from ngdual.solvers.uzawa import uzawa
 
 LEVELS = [1, 2, 3, 4]
@@ -33,7 +34,8 @@ def problem(level):
 def solutions(level):
     """(Uzawa in the h12 metric, reference QP) on ``level``, computed once per session."""
     pb = problem(level)
-    return uzawa(pb, eps=1e-10, metric="h12"), solve_qp(pb)
+    return (uzawa(pb, UzawaSettings.from_scene(pb.scene, eps=1e-10, metric="h12")),
+            solve_qp(pb, Model.of(pb.scene)))
 
 
 def relative_difference(a, b):
@@ -99,6 +101,7 @@ def test_uzawa_and_qp_find_the_same_contact_nodes(level):
 
 def test_euclidean_metric_gives_the_same_solution_as_h12():
     h12, _ = solutions(3)
-    euclidean = uzawa(problem(3), eps=1e-10, metric="euclidean")
+    pb = problem(3)
+    euclidean = uzawa(pb, UzawaSettings.from_scene(pb.scene, eps=1e-10, metric="euclidean"))
     assert euclidean.converged
     assert_norms_agree(euclidean, h12)

@@ -1,13 +1,24 @@
 """Solvers for the discrete problem (3.62) and the one entry point that picks among them.
 
 :func:`solve_scene` meshes, assembles and solves a scene; :func:`solve_problem` runs the
-algorithm the settings call for on an assembled problem: the linear solve
+algorithm its settings call for on an assembled problem: the linear solve
 (:mod:`.linear`), Uzawa (Algorithm 3.38, :mod:`.uzawa`), nested Uzawa (Algorithm 3.41,
 :mod:`.nested`) or the active-set method on Gamma_C (:mod:`.active_set`); the reference
-QP (:mod:`.reference`) checks them.
+QP (:mod:`.reference`) checks them. The settings (:mod:`.settings`) are built once from
+the scene; no solver reads the scene itself.
 """
 
 from .dispatch import check_unknowns, solve_problem, solve_scene
 from .result import ConvergenceError, Solution
+from .settings import (
+    ActiveSetSettings,
+    LinearSettings,
+    Model,
+    NestedUzawaSettings,
+    UzawaSettings,
+    solver_settings,
+)
 
-__all__ = ["ConvergenceError", "Solution", "check_unknowns", "solve_problem", "solve_scene"]
+__all__ = ["ActiveSetSettings", "ConvergenceError", "LinearSettings", "Model",
+           "NestedUzawaSettings", "Solution", "UzawaSettings", "check_unknowns",
+           "solve_problem", "solve_scene", "solver_settings"]

@@ -41,9 +41,10 @@ Tolerances. Every residual is relative to the size of its terms, and every toler
   on level 6 1e-13 to 7e-13 for nu = 0.25 and 4e-10 for nu = 0.4999, 4e-8 after 14 adaptive
   steps of cattaneo-mindlin, which the former fixed tolerance 1e-9 took for a failure.
 
-The Coulomb bound is zero where it is below ``SAFETY delta_0 mu_f`` times the stress scale
-(round-off of a vanishing normal stress, formerly a fixed 1e-12; physical bounds are above
-1e-4 of it, rounding errors of a separated Gamma_C below 1e-16). The fixed point stops at
+The Coulomb bound is zero where :func:`ngdual.tolerances.friction_vanishes` says so: at most
+1e-6 of its largest value, or below the round-off of a vanishing normal stress,
+``SAFETY delta_0 mu_f`` times the stress scale (rounding errors of a separated Gamma_C are
+below 1e-16 of it). The fixed point stops at
 ``tol`` or, once its change no longer halves per step below ``SAFETY eps kappa_1(G)`` (the
 round-off of F), there; the semismooth Newton method stops at the same level.
 """
@@ -59,13 +60,15 @@ import scipy.sparse as sp
 from threadpoolctl import threadpool_limits
 
 from ..forms import DiscreteProblem
-from ..friction import build_friction_forms, tresca_bound
-from .cholesky import BLAS_THREADS, SchurCholesky
+from ..friction import FrictionForms, build_friction_forms, tresca_bound
+from ..tolerances import BLAS_THREADS, COULOMB_FIXED_POINT_TOL, friction_vanishes
+from .cholesky import SchurCholesky
 from .hybrid import HybridSystem
-from .nested import sign_residual
+from .nested import friction_residuals
 from .projections import NonnegativeProjection, metric_matrix
 from .result import ConvergenceError, Solution
 from .semismooth import EPS, SAFETY, BoundarySolution, condition_number, semismooth_newton
+from .settings import ActiveSetSettings, Model
 from .uzawa import contact_residuals
 
 RELAXATION_MIN = 1.0 / 64  # smallest relaxation of the Coulomb fixed point
@@ -80,10 +83,10 @@ def _linear_blocks(problem: DiscreteProblem) -> list[np.ndarray]:
 
 def _linear_residual(problem: DiscreteProblem, x: np.ndarray,
                      dx: np.ndarray | None = None) -> float:
-    """Largest blockwise relative residual of the rows sigma, u, eta, phi of K x = F.
+    """Largest blockwise relative residual of the rows sigma, u, eta, phi of K x = rhs.
 
     Each block (their units differ) is measured against the size of its own terms,
-    ||K_b x - F_b|| / max(|| |K_b| |x| ||, ||F_b||) in the max norm. With ``dx``: the
+    ||K_b x - rhs_b|| / max(|| |K_b| |x| ||, ||rhs_b||) in the max norm. With ``dx``: the
     residual K_b dx that a change dx of the solution x causes, on the same scale.
     """
     worst = 0.0
@@ -97,9 +100,9 @@ def _linear_residual(problem: DiscreteProblem, x: np.ndarray,
     return worst
 
 
-def _material_condition(problem: DiscreteProblem) -> float:
-    """(lambda + 2 mu) / mu: the condition of the compliance (see the module docstring)."""
-    lam, mu = problem.scene.material.lame
+def _material_condition(model: Model) -> float:
+    """(lambda + 2 mu) / mu (Lamé's): the condition of the compliance (module docstring)."""
+    lam, mu = model.lame
     return (lam + 2 * mu) / mu
 
 
@@ -121,7 +124,7 @@ def _roundoff_probe(problem: DiscreteProblem, hybrid: HybridSystem, chol: SchurC
     dw = chol.solve_with_last(chol.forward(perturbation), np.zeros(len(hybrid.contact_index)))
     dx = hybrid.unknowns(w + dw, lam_t, lam_n) - x
     level = _linear_residual(problem, x, dx)
-    if problem.scene.has_contact:
+    if lam_t is not None:  # with contact: the tractions on Gamma_C too
         sigma, d_sigma = x[problem.sigma], dx[problem.sigma]
         for rows in (problem.lam_n, problem.index("lam_t")):
             C = problem.block(problem.sigma, rows)
@@ -131,27 +134,22 @@ def _roundoff_probe(problem: DiscreteProblem, hybrid: HybridSystem, chol: SchurC
     return level
 
 
-def active_set_solve(problem: DiscreteProblem, law: str | None = None, mu_f: float = 0.0,
-               tol: float = 1e-12, max_iter: int = 500, ordering: str = "amd",
-               metric: str = "h12",
-               progress: Callable[[int, float], None] | None = None) -> Solution:
+def active_set_solve(problem: DiscreteProblem, settings: ActiveSetSettings,
+                     tol: float = COULOMB_FIXED_POINT_TOL, ordering: str = "amd",
+                     progress: Callable[[int, float], None] | None = None) -> Solution:
     """Solve (3.62) by condensation onto Gamma_C and semismooth Newton there.
 
     Parameters
     ----------
-    law : {None, "none", "tresca", "coulomb"}
-        Friction law (default: the scene's).
-    mu_f : float
-        Coulomb coefficient (default: the scene's).
+    settings : ActiveSetSettings
+        The model (material, boundary parts, friction law, mu_f, h^), ``max_iter`` (bound
+        on the Coulomb fixed-point steps) and ``metric`` (of the natural residual of the
+        contact condition, reporting only).
     tol : float
         Relative change of F at which the Coulomb fixed point (3.123) stops (or at its
         round-off level, where it stagnates above ``tol``).
-    max_iter : int
-        Bound on the Coulomb fixed-point steps.
     ordering : {"amd", "metis"}
         Fill-reducing ordering of the hybridised matrix.
-    metric : str
-        Metric of the natural residual of the contact condition (reporting only).
 
     Raises
     ------
@@ -161,15 +159,14 @@ def active_set_solve(problem: DiscreteProblem, law: str | None = None, mu_f: flo
         round-off level; the message names the criterion, its value and its tolerance,
         ``history`` holds the iteration's residuals.
     """
+    model = settings.model
     # the dense work is small (at most a few thousand unknowns): one BLAS thread is as fast
     # and immune to the spin-waiting of threaded BLAS on busy cores
     with threadpool_limits(limits=BLAS_THREADS, user_api="blas"):
         try:
-            return _active_set_solve(problem, law, mu_f, tol, max_iter, ordering, metric, progress)
+            return _active_set_solve(problem, settings, tol, ordering, progress)
         except ConvergenceError as err:
-            scene = problem.scene
-            if (law or scene.friction.law) in ("tresca", "coulomb") \
-                    and scene.contact.hhat_factor == 1:
+            if model.has_friction and model.hhat_factor == 1:
                 raise ConvergenceError(f"{err}; with h^ = h~ the inf-sup condition (3.74) "
                                        "for nu fails where the contact zone reaches the end of "
                                        "Gamma_C: try contact.hhat_factor = 2",
@@ -177,15 +174,13 @@ def active_set_solve(problem: DiscreteProblem, law: str | None = None, mu_f: flo
             raise
 
 
-def _active_set_solve(problem: DiscreteProblem, law: str | None, mu_f: float, tol: float,
-                max_iter: int, ordering: str, metric: str,
-                progress: Callable[[int, float], None] | None) -> Solution:
-    scene = problem.scene
-    law = scene.friction.law if law is None else law
-    mu_f = mu_f or scene.friction.mu
+def _active_set_solve(problem: DiscreteProblem, settings: ActiveSetSettings, tol: float,
+                      ordering: str, progress: Callable[[int, float], None] | None) -> Solution:
+    model = settings.model
+    law, mu_f = model.law, model.mu_f
     timings = {"assemble": problem.assemble_seconds}
     start_all = time.perf_counter()
-    hybrid = HybridSystem(problem)                                              # step 1
+    hybrid = HybridSystem(problem, model)                                       # step 1
     timings["hybridize"] = hybrid.assemble_seconds + hybrid.reduce_seconds
     chol = SchurCholesky(hybrid.H, hybrid.contact_index, ordering)             # step 2
     timings["cholesky"] = sum(chol.seconds.values())
@@ -193,12 +188,12 @@ def _active_set_solve(problem: DiscreteProblem, law: str | None, mu_f: float, to
     timings["factorize"] = timings["hybridize"] + timings["cholesky"]
     start = time.perf_counter()
     y = chol.forward(hybrid.r)
-    if not scene.has_contact:
+    if not model.has_contact:
         w = chol.backward(y)
         x = hybrid.unknowns(w)
         timings["solve"] = time.perf_counter() - start
         residuals = {"linear": _linear_residual(problem, x)}
-        _check(residuals, EPS * _material_condition(problem),
+        _check(residuals, EPS * _material_condition(model),
                lambda: _roundoff_probe(problem, hybrid, chol, w, x), [])
         timings["total_solver"] = time.perf_counter() - start_all
         return Solution(problem, x, True, "linear", residuals=residuals, timings=timings)
@@ -206,16 +201,16 @@ def _active_set_solve(problem: DiscreteProblem, law: str | None, mu_f: float, to
     boundary = BoundaryProblem(hybrid, chol, y)
     timings["boundary"] = time.perf_counter() - start
     # the a priori round-off level delta_0 (module docstring)
-    level = max(boundary.roundoff, EPS * _material_condition(problem))
-    forms = build_friction_forms(problem) if law in ("tresca", "coulomb") else None
+    level = max(boundary.roundoff, EPS * _material_condition(model))
+    forms = build_friction_forms(problem) if model.has_friction else None
     if law == "coulomb":                                                        # step 3
-        zero = SAFETY * level * mu_f * boundary.stress_scale
-        state, F, history, iterations = _coulomb_fixed_point(boundary, forms, mu_f, tol,
-                                                             max_iter, progress, zero)
+        noise = SAFETY * level * mu_f * boundary.stress_scale
+        state, bound, history, iterations = _coulomb_fixed_point(
+            boundary, forms, mu_f, tol, settings.max_iter, progress, noise)
     else:
-        F = tresca_bound(forms, problem) if law == "tresca" else None
+        bound = tresca_bound(forms, problem) if law == "tresca" else None
         state = semismooth_newton(boundary.G, boundary.b, boundary.n_c,
-                                  forms.q_matrix(F).toarray() if F is not None else None,
+                                  forms.q_matrix(bound).toarray() if bound is not None else None,
                                   tol=SAFETY * boundary.roundoff)
         history, iterations = [], {"outer": 1, "inner": state.iterations}
     ce = hybrid.contact                                                         # step 4
@@ -223,28 +218,29 @@ def _active_set_solve(problem: DiscreteProblem, law: str | None, mu_f: float, to
                            ce.hat_means @ state.lam_t - ce.offset_t])
     w = chol.solve_with_last(y, zeta)
     x = hybrid.unknowns(w, state.lam_t, state.lam_n)
-    nu = state.nu if F is not None else None
+    nu = state.nu if bound is not None else None
     timings["solve"] = time.perf_counter() - start
 
     residuals = {"boundary_kkt": max(state.residuals.values()),
                  "qp_fallback": float(state.fallback),
                  "linear": _linear_residual(problem, x),
-                 **_contact_conditions(problem, x, metric, boundary.traction_scale)}
+                 **_contact_conditions(problem, x, settings.metric, model.plane_strain_modulus,
+                                       boundary.traction_scale)}
     if nu is not None:
-        residuals.update(_friction_conditions(problem, forms, x, nu, F,
-                                              boundary.traction_scale))
+        residuals.update(friction_residuals(forms, problem, x, nu, bound,
+                                            boundary.traction_scale))
     if law == "coulomb":
-        F_x = _coulomb_bound(forms, forms.T_n @ x, mu_f, zero)
-        residuals["coulomb_bound"] = float(np.max(np.abs(F_x - F), initial=0.0) / (
-            max(np.max(F_x, initial=0.0), mu_f * boundary.stress_scale) or 1.0))
+        bound_x = _coulomb_bound(forms, forms.T_n @ x, mu_f, noise)
+        residuals["coulomb_bound"] = float(np.max(np.abs(bound_x - bound), initial=0.0) / (
+            max(np.max(bound_x, initial=0.0), mu_f * boundary.stress_scale) or 1.0))
     _check(residuals, level, lambda: _roundoff_probe(
         problem, hybrid, chol, w, x, state.lam_t, state.lam_n, boundary.traction_scale),
         history)
     timings["total_solver"] = time.perf_counter() - start_all
     return Solution(problem, x, True, "active-set" if law == "none" else f"active-set-{law}",
                     iterations=iterations, residuals=residuals, history=history,
-                    timings=timings, nu=nu, friction_bound=F,
-                    nu_l2=forms.l2_norm_nu(nu, forms.per_hat_edge(F) > 0)
+                    timings=timings, nu=nu, friction_bound=bound, friction_forms=forms,
+                    nu_l2=forms.l2_norm_nu(nu, forms.per_hat_edge(bound) > 0)
                     if nu is not None else None)
 
 
@@ -279,8 +275,8 @@ class BoundaryProblem:
         return (self.a_f - self.B_f @ z)[:len(self.lengths)] / self.lengths
 
 
-def _coulomb_fixed_point(boundary: BoundaryProblem, forms, mu_f: float, tol: float,
-                         max_iter: int, progress, zero: float):
+def _coulomb_fixed_point(boundary: BoundaryProblem, forms: FrictionForms, mu_f: float,
+                         tol: float, max_iter: int, progress, noise: float):
     """Remark 3.45 on Gamma_C: F^0 from the frictionless solution, then Phi(F) = mu_f |sigma_n|
     of (3.123) for the Tresca solution with bound F, warm-started, until F = Phi(F).
 
@@ -292,55 +288,58 @@ def _coulomb_fixed_point(boundary: BoundaryProblem, forms, mu_f: float, tol: flo
     the thesis) until the residual fails to decrease (the iteration oscillates, e.g. for
     large mu_f), then halved each time it does so, down to ``RELAXATION_MIN``. A fixed point
     of the relaxed map is a fixed point of Phi: the solution is the same, and where the plain
-    iteration contracts (all shipped scenes), so are the iterates. Values of F below
-    ``zero`` (round-off of a vanishing normal stress) count as 0.
+    iteration contracts (all shipped scenes), so are the iterates. Where F is zero follows
+    :func:`ngdual.tolerances.friction_vanishes` with the round-off ``noise`` of a vanishing
+    normal stress.
     """
     G, b, n_c = boundary.G, boundary.b, boundary.n_c
     floor = SAFETY * boundary.roundoff  # = kkt_tolerance(G)
     state = semismooth_newton(G, b, n_c, tol=floor)
     inner = state.iterations
-    F = _coulomb_bound(forms, boundary.normal_stress(state), mu_f, zero)
+    bound = _coulomb_bound(forms, boundary.normal_stress(state), mu_f, noise)
     history: list[float] = []
     omega, change = 1.0, np.inf
     for outer in range(1, max_iter + 1):
-        state = semismooth_newton(G, b, n_c, forms.q_matrix(F).toarray(), start=state,
+        state = semismooth_newton(G, b, n_c, forms.q_matrix(bound).toarray(), start=state,
                                   tol=floor)
         inner += state.iterations
-        F_map = _coulomb_bound(forms, boundary.normal_stress(state), mu_f, zero)
-        change = float(np.linalg.norm(F_map - F) / (np.linalg.norm(F_map) or 1.0))
+        mapped = _coulomb_bound(forms, boundary.normal_stress(state), mu_f, noise)
+        change = float(np.linalg.norm(mapped - bound) / (np.linalg.norm(mapped) or 1.0))
         history.append(change)
         if progress:
             progress(outer, change)
         previous = history[-2] if len(history) > 1 else np.inf
         if change <= tol or (change <= floor and change > 0.5 * previous):
             # the last F: its own Tresca solution, so that F, nu and z belong together
-            F = F_map
-            state = semismooth_newton(G, b, n_c, forms.q_matrix(F).toarray(), start=state,
+            bound = mapped
+            state = semismooth_newton(G, b, n_c, forms.q_matrix(bound).toarray(), start=state,
                                       tol=floor)
             inner += state.iterations
-            return state, F, history, {"outer": outer, "inner": int(inner)}
+            return state, bound, history, {"outer": outer, "inner": int(inner)}
         if change >= previous:
             omega = max(0.5 * omega, RELAXATION_MIN)
-        F = F + omega * (F_map - F)
+        bound = bound + omega * (mapped - bound)
     raise ConvergenceError(f"the Coulomb fixed point (3.123) did not converge in "
                            f"solver.max_iter = {max_iter} steps: its relative change of F = "
                            f"{change:.1e} > {tol:.1e} (relaxation omega = {omega:g}); try a "
                            "smaller friction.mu", history)
 
 
-def _coulomb_bound(forms, sigma_n: np.ndarray, mu_f: float, zero: float) -> np.ndarray:
-    """F of (3.123) (``FrictionForms.coulomb_bound_of``), zero where it is round-off.
+def _coulomb_bound(forms: FrictionForms, sigma_n: np.ndarray, mu_f: float,
+                   noise: float) -> np.ndarray:
+    """F of (3.123) (``FrictionForms.coulomb_bound_of``), zero where it vanishes.
 
     On a separated part of Gamma_C the normal stress entering F vanishes up to rounding
     errors of the stress scale; a bound made of rounding errors would turn the friction
-    conditions there into conditions on noise, so values <= ``zero`` count as 0.
+    conditions there into conditions on noise, so F is zero where
+    :func:`ngdual.tolerances.friction_vanishes` says so, with the round-off level ``noise``.
     """
-    F = forms.coulomb_bound_of(sigma_n, mu_f)
-    F[F <= zero] = 0.0
-    return F
+    bound = forms.coulomb_bound_of(sigma_n, mu_f)
+    bound[friction_vanishes(bound, noise)] = 0.0
+    return bound
 
 
-def _contact_conditions(problem: DiscreteProblem, x: np.ndarray, metric: str,
+def _contact_conditions(problem: DiscreteProblem, x: np.ndarray, metric: str, modulus: float,
                         traction_scale: float) -> dict:
     """contact_residuals of :mod:`ngdual.solvers.uzawa` on the assembled C_n.
 
@@ -348,8 +347,8 @@ def _contact_conditions(problem: DiscreteProblem, x: np.ndarray, metric: str,
     the projection's argument, max(||lambda_n||_W, ||W^{-1} t||_W) (t = C_n^T sigma), not
     to ||lambda_n||_W alone: where the body barely separates (lambda_n ~ 1e-6 of the
     displacement W^{-1} t), the round-off of t would otherwise count a million times.
+    ``modulus`` is E*, the scale of the metric W.
     """
-    modulus = problem.scene.material.plane_strain_modulus
     projection = NonnegativeProjection(metric_matrix(problem.spaces.contact, modulus, metric))
     lam, lam_t = x[problem.lam_n], x[problem.index("lam_t")]
     traction = problem.block(problem.sigma, problem.lam_n).T @ x[problem.sigma]
@@ -365,30 +364,6 @@ def _contact_conditions(problem: DiscreteProblem, x: np.ndarray, metric: str,
     residuals["natural"] = float(np.sqrt(max(step @ projection.matvec(step), 0.0))
                                  / (terms or 1.0))
     return residuals
-
-
-def _friction_conditions(problem: DiscreteProblem, forms, x: np.ndarray, nu: np.ndarray,
-                         F: np.ndarray, traction_scale: float) -> dict:
-    """(3.62)_5,7 and |sigma_t| <= F tested with the h~ hats, relative to the traction scale.
-
-    As :func:`~ngdual.solvers.nested.friction_residuals`, but the tangential residuals are
-    measured against max(|C_n^T sigma|, |C_t^T sigma|, int F mu_i, ``traction_scale``)
-    rather than the bound alone, which may vanish (no contact, F = mu_f |sigma_n| = 0)
-    while the tractions do not.
-    """
-    Q = forms.q_matrix(F)
-    sigma = x[problem.sigma]
-    tangential = problem.block(problem.sigma, problem.index("lam_t")).T @ sigma
-    normal = problem.block(problem.sigma, problem.lam_n).T @ sigma
-    bound = Q.T @ np.ones(forms.n_nu)
-    scale = max(np.max(np.abs(tangential), initial=0.0), np.max(np.abs(normal), initial=0.0),
-                np.max(bound, initial=0.0), traction_scale) or 1.0
-    return {
-        "nu_sign": sign_residual(Q, nu, x[problem.index("lam_t")]),
-        "nu_bound": float(max(0.0, np.abs(nu).max(initial=0.0) - 1.0)),
-        "tangential": float(np.max(np.abs(tangential - Q.T @ nu), initial=0.0) / scale),
-        "sigma_t_bound": float(max(0.0, np.max(np.abs(tangential) - bound, initial=0.0)) / scale),
-    }
 
 
 def _check(residuals: dict, level: float, probe: Callable[[], float],

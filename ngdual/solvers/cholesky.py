@@ -24,11 +24,9 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from threadpoolctl import threadpool_limits
 
+from ..tolerances import BLAS_THREADS
+
 ORDERINGS = ("amd", "metis")
-# CHOLMOD's BLAS calls bind to the first OpenBLAS in the process (NGSolve's, threaded).
-# Measured on 2 cores (Example 3.46, level 7): 1.5 s with one BLAS thread, 8.7 s with two
-# when other processes compete for the cores (spin-waiting threads); one is the default.
-BLAS_THREADS = 1
 
 
 def fill_reducing_order(H: sp.spmatrix, method: str = "amd") -> np.ndarray:

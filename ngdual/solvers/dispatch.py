@@ -28,6 +28,14 @@ from .active_set import active_set_solve
 from .linear import solve_linear
 from .nested import nested_uzawa
 from .result import ConvergenceError, Solution
+from .settings import (
+    ActiveSetSettings,
+    LinearSettings,
+    NestedUzawaSettings,
+    Settings,
+    UzawaSettings,
+    solver_settings,
+)
 from .uzawa import uzawa
 
 
@@ -58,7 +66,7 @@ def solve_scene(scene: Scene, level: int | None = None,
     problem = assemble(scene, mesh)
     problem.level = scene.geometry.level if level is None else level
     check_unknowns(problem)
-    solution = solve_problem(problem, progress)
+    solution = solve_problem(problem, solver_settings(scene), progress)
     solution.timings["total"] = time.perf_counter() - start
     return solution
 
@@ -85,30 +93,29 @@ def check_unknowns(problem: DiscreteProblem) -> None:
                                                 "choose hhat_factor = 1 or a finer level")
 
 
-def solve_problem(problem: DiscreteProblem,
+def solve_problem(problem: DiscreteProblem, settings: Settings | None = None,
                   progress: Callable[[int, float], None] | None = None) -> Solution:
-    """Run the algorithm the scene of an assembled ``problem`` calls for (any mesh).
+    """Run the algorithm ``settings`` describe on an assembled ``problem`` (any mesh).
 
-    A solution with a non-finite value or residual is never returned as a solution:
-    it raises :class:`ngdual.solvers.result.ConvergenceError` with the history.
+    ``settings`` (:mod:`ngdual.solvers.settings`) defaults to those of the problem's scene,
+    :func:`~ngdual.solvers.settings.solver_settings`: the one place where a solve reads
+    the scene. A solution with a non-finite value or residual is never returned as a
+    solution: it raises :class:`ngdual.solvers.result.ConvergenceError` with the history.
     """
-    scene = problem.scene
-    if scene.solver.method in ("auto", "active-set"):
-        solution = active_set_solve(problem, max_iter=scene.solver.max_iter,
-                                    metric=scene.solver.metric, progress=progress)
-    elif not scene.has_contact:
+    if settings is None:
+        settings = solver_settings(problem.scene)
+    if isinstance(settings, ActiveSetSettings):
+        solution = active_set_solve(problem, settings, progress=progress)
+    elif isinstance(settings, LinearSettings):
         solution = solve_linear(problem)
-    elif not scene.has_friction:
-        s = scene.solver
-        solution = uzawa(problem, rho=s.rho, eps=s.eps, max_iter=s.max_iter, metric=s.metric,
-                         progress=progress)
+    elif isinstance(settings, UzawaSettings):
+        solution = uzawa(problem, settings, progress=progress)
+    elif isinstance(settings, NestedUzawaSettings):
+        solution = nested_uzawa(problem, settings, progress=progress)
     else:
-        s = scene.solver
-        solution = nested_uzawa(problem, scene.friction.law, mu_f=scene.friction.mu,
-                                rho1=s.rho1, rho2=s.rho2, eps1=s.eps1, eps2=s.eps2,
-                                max_iter=s.max_iter, metric=s.metric, loop_order=s.loop_order,
-                                friction_metric=s.friction_metric,
-                                progress=progress)
+        raise TypeError(f"settings must be one of the settings of ngdual.solvers.settings, "
+                        f"got {type(settings).__name__}")
+    solution.settings = settings
     _check_finite(solution)
     return solution
 

@@ -41,6 +41,8 @@ import scipy.sparse as sp
 
 from .. import peers
 from ..forms import DiscreteProblem, boundary_regex
+from .linear import to_scipy
+from .settings import Model
 
 
 @dataclass
@@ -126,14 +128,16 @@ class HybridSystem:
     ----------
     problem : DiscreteProblem
         The assembled problem (its mesh, spaces, prolongations and phi right-hand side).
+    model : Model
+        Lamé's constants and the labels of Gamma_D, Gamma_N, Gamma_C.
     """
 
-    def __init__(self, problem: DiscreteProblem):
+    def __init__(self, problem: DiscreteProblem, model: Model):
         start = time.perf_counter()
         self.problem = problem
-        scene, mesh = problem.scene, problem.fes.mesh
+        mesh = problem.fes.mesh
         self.mesh = mesh
-        lam, mu = scene.material.lame
+        lam, mu = model.lame
         rt = ngs.HDiv(mesh, order=0, discontinuous=True)
         bubble, p0 = peers.cubic_bubbles(mesh), ngs.L2(mesh, order=0)
         facet = ngs.FacetFESpace(mesh, order=0)
@@ -180,31 +184,29 @@ class HybridSystem:
         self.assemble_seconds = time.perf_counter() - start
 
         start = time.perf_counter()
-        self._reduction(scene, facet, condensed.FV().NumPy())
+        self._reduction(model, facet, condensed.FV().NumPy())
         self.reduce_seconds = time.perf_counter() - start
 
-    def _reduction(self, scene, facet: ngs.FESpace, r_cond: np.ndarray) -> None:
+    def _reduction(self, model: Model, facet: ngs.FESpace, r_cond: np.ndarray) -> None:
         """Build c = T w + c0 (coupling values from the reduced unknowns), H and r."""
         pb, mesh, fes = self.problem, self.mesh, self.fes
         ranges = {name: fes.Range(i) for i, name in enumerate(self.names)}
         m1, m2, eta = ranges["m1"].start, ranges["m2"].start, ranges["eta"]
         hdiv = pb.spaces.components["r1"]
         labelled = _boundary_edges(mesh, facet, hdiv)
-        fluxes = _normal_fluxes(hdiv, mesh, scene.labels("dirichlet") + scene.labels("contact"))
+        fluxes = _normal_fluxes(hdiv, mesh, model.labels("dirichlet") + model.labels("contact"))
         F1 = pb.rhs[pb.blocks["r1"]]
         F2 = pb.rhs[pb.blocks["r2"]]
 
         def edges_of(role):
-            rows = [labelled[lab] for lab in scene.labels(role) if lab in labelled]
+            rows = [labelled[lab] for lab in model.labels(role) if lab in labelled]
             return np.vstack(rows) if rows else np.zeros((0, 4), dtype=int)
 
         dirichlet, neumann = edges_of("dirichlet"), edges_of("neumann")
-        coo = self.form.mat.COO()
-        K = sp.csr_matrix((np.asarray(coo[2]), (np.asarray(coo[0]), np.asarray(coo[1]))),
-                          shape=(fes.ndof, fes.ndof))
+        K = to_scipy(self.form.mat)
         interior = np.setdiff1d(np.arange(facet.ndof),
                                 np.concatenate([e[:, 0] for e in labelled.values()]))
-        self.contact = self._contact_edges(scene, labelled, fluxes, F1, F2)
+        self.contact = self._contact_edges(model, labelled, fluxes, F1, F2)
         n_int, n_v = len(interior), ranges["eta"].stop - ranges["eta"].start
         n_phi = pb.spaces.coarse_ndof("phi1") if "phi1" in pb.blocks else 0
         n_c = len(self.contact)
@@ -257,7 +259,7 @@ class HybridSystem:
         self._continuous = peers.raviart_thomas(mesh)
         self._convert = ngs.ConvertOperator(self.rt, self._continuous)
 
-    def _contact_edges(self, scene, labelled: dict, fluxes: np.ndarray, F1: np.ndarray,
+    def _contact_edges(self, model: Model, labelled: dict, fluxes: np.ndarray, F1: np.ndarray,
                        F2: np.ndarray) -> ContactEdges:
         """Fine Gamma_C edges; mean_e(g) from F = int_e g n.tau n ds, the right-hand side of g."""
         pb = self.problem
@@ -266,7 +268,7 @@ class HybridSystem:
             return ContactEdges(np.zeros(0, dtype=int), np.zeros(0), np.zeros((0, 2)),
                                 sp.csr_matrix((0, 0)), np.zeros(0), np.zeros(0))
         edge_of = {}
-        for lab in scene.labels("contact"):
+        for lab in model.labels("contact"):
             for row in labelled.get(lab, []):
                 edge_of[frozenset(int(v) for v in row[2:])] = row[:2]
         gamma_c = pb.spaces.gamma_c

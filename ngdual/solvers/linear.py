@@ -2,13 +2,8 @@
 the linear solve of a problem without contact.
 
 The matrix [[A, B], [B^T, 0]] of Algorithms 3.38/3.41 never changes during the
-iteration, so it is factorised once (NGSolve's UMFPACK by default, SciPy's
-SuperLU as an alternative) and every Uzawa step costs one forward/back solve.
-
-UMFPACK runs with one BLAS thread: its BLAS calls go to NGSolve's threaded OpenBLAS,
-with which the factorisation of Example 3.46, level 6 (247k unknowns) took 64 s of CPU
-on 2 cores against 4.4 s with one thread (small dense updates dominated by thread
-synchronisation).
+iteration, so it is factorised once (NGSolve's UMFPACK) and every Uzawa step costs one
+forward/back solve. UMFPACK runs with ``BLAS_THREADS`` (:mod:`ngdual.tolerances`).
 """
 
 from __future__ import annotations
@@ -18,39 +13,43 @@ import time
 import ngsolve as ngs
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 from threadpoolctl import threadpool_limits
 
 from ..forms import DiscreteProblem
+from ..tolerances import BLAS_THREADS
 from .result import Solution
 
-BACKENDS = ("umfpack", "superlu")
-BLAS_THREADS = 1
+
+def to_scipy(matrix) -> sp.csr_matrix:
+    """An assembled NGSolve sparse matrix as a SciPy CSR matrix (from its COO triplets)."""
+    rows, cols, vals = matrix.COO()
+    return sp.csr_matrix((np.asarray(vals), (np.asarray(rows), np.asarray(cols))),
+                         shape=(matrix.height, matrix.width))
+
+
+def to_ngsolve(matrix: sp.spmatrix) -> ngs.la.SparseMatrixd:
+    """A SciPy sparse matrix as an NGSolve one (for NGSolve's direct solvers)."""
+    coo = matrix.tocoo()
+    return ngs.la.SparseMatrixd.CreateFromCOO(
+        coo.row.astype(np.int64).tolist(), coo.col.astype(np.int64).tolist(),
+        coo.data.tolist(), matrix.shape[0], matrix.shape[1])
 
 
 class Factorization:
-    """LU factors of a square sparse matrix.
+    """LU factors of a square sparse matrix (UMFPACK).
 
     >>> import scipy.sparse as sp
     >>> Factorization(sp.identity(3, format="csr")).solve(np.ones(3))
     array([1., 1., 1.])
     """
 
-    def __init__(self, matrix: sp.spmatrix, backend: str = "umfpack"):
-        if backend not in BACKENDS:
-            raise ValueError(f"unknown backend {backend!r}; use one of {BACKENDS}")
+    def __init__(self, matrix: sp.spmatrix):
         start = time.perf_counter()
-        self.backend, self.shape = backend, matrix.shape
-        if backend == "umfpack":
-            coo = matrix.tocoo()
-            self._mat = ngs.la.SparseMatrixd.CreateFromCOO(
-                coo.row.astype(np.int64).tolist(), coo.col.astype(np.int64).tolist(),
-                coo.data.tolist(), matrix.shape[0], matrix.shape[1])
-            with threadpool_limits(limits=BLAS_THREADS, user_api="blas"):
-                self._inv = self._mat.Inverse(inverse="umfpack")
-            self._rhs, self._sol = self._mat.CreateColVector(), self._mat.CreateColVector()
-        else:
-            self._lu = spla.splu(matrix.tocsc())
+        self.shape = matrix.shape
+        self._mat = to_ngsolve(matrix)
+        with threadpool_limits(limits=BLAS_THREADS, user_api="blas"):
+            self._inv = self._mat.Inverse(inverse="umfpack")
+        self._rhs, self._sol = self._mat.CreateColVector(), self._mat.CreateColVector()
         self.seconds = time.perf_counter() - start
 
     def solve_many(self, rhs: np.ndarray) -> np.ndarray:
@@ -58,15 +57,11 @@ class Factorization:
         rhs = np.asarray(rhs, dtype=float)
         if rhs.shape[1] == 0:
             return np.zeros(rhs.shape)
-        if self.backend == "superlu":
-            return self._lu.solve(rhs)
         with threadpool_limits(limits=BLAS_THREADS, user_api="blas"):
             return np.column_stack([self._umfpack_solve(col) for col in rhs.T])
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
         """Solve with the stored factors."""
-        if self.backend == "superlu":
-            return self._lu.solve(np.asarray(rhs, dtype=float))
         with threadpool_limits(limits=BLAS_THREADS, user_api="blas"):
             return self._umfpack_solve(rhs)
 
@@ -76,10 +71,10 @@ class Factorization:
         return self._sol.FV().NumPy().copy()
 
 
-def solve_linear(problem: DiscreteProblem, backend: str = "umfpack") -> Solution:
+def solve_linear(problem: DiscreteProblem) -> Solution:
     """One saddle-point solve: the whole problem when there is no contact boundary."""
     saddle = problem.saddle
-    fact = Factorization(problem.block(saddle, saddle), backend)
+    fact = Factorization(problem.block(saddle, saddle))
     start = time.perf_counter()
     x = np.zeros(problem.K.shape[0])
     x[saddle] = fact.solve(problem.rhs[saddle])

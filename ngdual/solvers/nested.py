@@ -39,8 +39,10 @@ import scipy.sparse as sp
 
 from ..forms import DiscreteProblem
 from ..friction import FrictionForms, build_friction_forms, tresca_bound
+from ..tolerances import CLARABEL_TOLERANCES, DIVERGENCE_FACTOR, friction_vanishes
 from .condensed import CondensedResponse
 from .result import ConvergenceError, Solution
+from .settings import Model, NestedUzawaSettings
 from .uzawa import ContactLoop
 
 
@@ -49,7 +51,8 @@ def box_projection_qp(c: np.ndarray, mass: np.ndarray) -> np.ndarray:
     psi = cp.Variable(len(c))
     scale = float(mass.max())
     objective = 0.5 * cp.sum(cp.multiply(mass / scale, cp.square(psi))) - (c / scale) @ psi
-    cp.Problem(cp.Minimize(objective), [cp.abs(psi) <= 1]).solve(solver=cp.CLARABEL)
+    cp.Problem(cp.Minimize(objective), [cp.abs(psi) <= 1]).solve(solver=cp.CLARABEL,
+                                                               **CLARABEL_TOLERANCES)
     return np.clip(np.asarray(psi.value, dtype=float), -1.0, 1.0)
 
 
@@ -73,30 +76,36 @@ def sign_residual(Q: sp.spmatrix, nu: np.ndarray, lam_t: np.ndarray) -> float:
     return float(np.sum(np.abs(q) - nu * q) / work) if work > 0 else 0.0
 
 
-def friction_residuals(forms: FrictionForms, x: np.ndarray, problem: DiscreteProblem,
-                       nu: np.ndarray, F: np.ndarray) -> dict:
+def friction_residuals(forms: FrictionForms, problem: DiscreteProblem, x: np.ndarray,
+                       nu: np.ndarray, bound: np.ndarray, traction_scale: float = 0.0) -> dict:
     """Residuals of (3.62)_5,7 and of |sigma_t| <= F on Gamma_C (relative, 0 = exact).
 
     ``nu_sign``: q(kappa - nu, lambda_t) <= 0 for all kappa in Lambda_h^
     (:func:`sign_residual`).
+    ``nu_bound``: |nu_j| <= 1.
     ``tangential``: the equation C_t^T sigma = Q_F^T nu of (3.62)_5.
     ``sigma_t_bound``: |int sigma_t mu_i| <= int F mu_i for every h~ hat mu_i (the
     discrete form of |sigma_t| <= F, Proposition 3.25).
-    (Pointwise on the fine edges |sigma_t| <= F is not part of the discrete problem:
-    only the hat moments of sigma_t are constrained, and sigma_t oscillates at the
-    fine scale, also where F = 0.)
+    The tangential residuals are relative to the tractions on Gamma_C,
+    max(|C_n^T sigma|, |C_t^T sigma|, int F mu_i, ``traction_scale``), not to the bound
+    alone, which may vanish (no contact: F = mu_f |sigma_n| = 0) while the tractions do
+    not. (Pointwise on the fine edges |sigma_t| <= F is not part of the discrete problem:
+    only the hat moments of sigma_t are constrained, and sigma_t oscillates at the fine
+    scale, also where F = 0.)
     """
-    Q = forms.q_matrix(F)
-    sigma = x[problem.sigma]
+    Q = forms.q_matrix(bound)
+    sigma, lam_t = x[problem.sigma], x[problem.index("lam_t")]
     tangential = problem.block(problem.sigma, problem.index("lam_t")).T @ sigma
-    load = Q.T @ nu
-    bound = Q.T @ np.ones(forms.n_nu)
-    scale = np.max(bound, initial=0.0) or 1.0
+    normal = problem.block(problem.sigma, problem.lam_n).T @ sigma
+    hat_bound = Q.T @ np.ones(forms.n_nu)
+    scale = max(np.max(np.abs(tangential), initial=0.0), np.max(np.abs(normal), initial=0.0),
+                np.max(hat_bound, initial=0.0), traction_scale) or 1.0
     return {
-        "nu_sign": sign_residual(Q, nu, x[problem.index("lam_t")]),
+        "nu_sign": sign_residual(Q, nu, lam_t),
         "nu_bound": float(max(0.0, np.abs(nu).max(initial=0.0) - 1.0)),
-        "tangential": float(np.max(np.abs(tangential - load), initial=0.0) / scale),
-        "sigma_t_bound": float(max(0.0, np.max(np.abs(tangential) - bound, initial=0.0)) / scale),
+        "tangential": float(np.max(np.abs(tangential - Q.T @ nu), initial=0.0) / scale),
+        "sigma_t_bound": float(max(0.0, np.max(np.abs(tangential) - hat_bound, initial=0.0))
+                               / scale),
     }
 
 
@@ -113,22 +122,26 @@ class FrictionStep:
     s = rho_2 / lambda_max(H) makes rho_2 dimensionless: the gradient-projection
     iteration contracts for 0 < rho_2 < 2 (Theorem 3.42's bound, computed
     instead of estimated), independently of E, the load scale and the level.
-    For Coulomb friction H changes with F, so s is recomputed with F.
+    For Coulomb friction H changes with the bound F, so s is recomputed with it.
     """
 
-    def __init__(self, forms: FrictionForms, S_t: np.ndarray, rho2: float, metric: str = "mass"):
+    def __init__(self, forms: FrictionForms, S_t: np.ndarray, rho2: float, metric: str):
         self.forms, self.S_t, self.rho2, self.metric = forms, S_t, rho2, metric
         self.mass = forms.hat_lengths
-        self.F = None
+        self.bound = None
 
-    def set_bound(self, F: np.ndarray) -> None:
-        self.F, self.Q = F, self.forms.q_matrix(F)
+    def set_bound(self, bound: np.ndarray) -> None:
+        """Take the friction bound F (per fine edge): Q_F, the metric and the step."""
+        self.bound, self.Q = bound, self.forms.q_matrix(bound)
         if self.metric == "jacobi":
             diag = np.einsum("ij,jk,ik->i", self.Q.toarray(), self.S_t, self.Q.toarray())
-            self.mass = np.where(diag > 1e-14 * diag.max(initial=0.0), diag,
-                                 max(diag.max(initial=0.0), 1e-300))
+            # the diagonal is quadratic in F: the edges without friction (tolerances
+            # module) get the largest weight, so that their nu stays where it is
+            no_friction = friction_vanishes(np.sqrt(np.maximum(diag, 0.0)))
+            self.mass = np.where(no_friction, max(diag.max(initial=0.0), 1e-300), diag)
         QM = (self.Q.T / np.sqrt(self.mass)).T
-        lam_max = float(np.linalg.eigvalsh(QM @ self.S_t @ QM.T)[-1]) if F.max() > 0 else 0.0
+        lam_max = (float(np.linalg.eigvalsh(QM @ self.S_t @ QM.T)[-1]) if bound.max() > 0
+                   else 0.0)
         self.step = self.rho2 / lam_max if lam_max > 0 else 0.0
 
     def __call__(self, nu: np.ndarray, lam_t: np.ndarray) -> np.ndarray:
@@ -139,43 +152,35 @@ class FrictionStep:
         return self.Q.T @ nu
 
 
-def _stagnation_message(problem: DiscreteProblem, outer: int, law: str, what: str) -> str:
+def _stagnation_message(model: Model, outer: int, what: str) -> str:
     remedies = ["a smaller solver.rho2"]
-    if problem.scene.contact.hhat_factor == 1:
+    if model.hhat_factor == 1:
         remedies.insert(0, "contact.hhat_factor = 2 (with h^ = h~ the inf-sup condition "
                            "(3.74) for nu fails where the contact zone reaches the end of "
                            "Gamma_C, and nu is not unique)")
-    if law == "coulomb":
-        remedies.append("a smaller friction.mu (the Coulomb fixed point F = mu |sigma_n| "
+    if model.law == "coulomb":
+        remedies.append("a smaller friction.mu (the Coulomb fixed point F = mu_f |sigma_n| "
                         "need not contract for large mu)")
     return f"nested Uzawa {what} (outer step {outer}); try " + ", or ".join(remedies)
 
 
-def nested_uzawa(problem: DiscreteProblem, law: str, mu_f: float = 0.0, rho1: float = 1.0,
-                 rho2: float = 1.0, eps1: float = 1e-8, eps2: float = 1e-6,
-                 max_iter: int = 2000, metric: str = "h12", loop_order: str = "friction-outer",
-                 friction_metric: str = "jacobi", backend: str = "umfpack",
+def nested_uzawa(problem: DiscreteProblem, settings: NestedUzawaSettings,
                  condensed: bool = True,
                  progress: Callable[[int, float], None] | None = None) -> Solution:
     """Solve (3.62) with Tresca (Algorithm 3.41) or Coulomb (Remark 3.45) friction.
 
     Parameters
     ----------
-    law : {"tresca", "coulomb"}
-    mu_f : float
-        Coulomb friction coefficient (ignored for Tresca, whose F is the scene's bound).
-    rho1 : float
-        Dimensionless step of the lambda_n update (the metric W carries E*).
-    rho2 : float in (0, 2)
-        Step of the nu update relative to its stability bound (:class:`FrictionStep`).
-    eps1, eps2 : float
-        Tolerances of the inner loop and of the outer increments (nu, F, lambda_n).
-    max_iter : int
-        Bound on the outer iterations (and on the inner ones per outer step).
-    loop_order : {"friction-outer", "contact-outer"}
-        Algorithm 3.41 (nu outside, lambda_n inside) or Remark 3.43 (exchanged).
-    friction_metric : {"jacobi", "mass"}
-        Diagonal metric of P^Lambda (:class:`FrictionStep`).
+    settings : NestedUzawaSettings
+        The friction law ("tresca": the given bound of the assembled problem;
+        "coulomb": mu_f) in ``settings.model``, and: ``rho1``, the dimensionless step of
+        the lambda_n update (the metric W carries E*); ``rho2`` in (0, 2), the step of
+        the nu update relative to its stability bound (:class:`FrictionStep`); ``eps1``,
+        ``eps2``, the tolerances of the inner loop and of the outer increments (nu, F,
+        lambda_n); ``max_iter``, the bound on the outer iterations (and on the inner
+        ones per outer step); ``loop_order``, "friction-outer" (Algorithm 3.41: nu
+        outside, lambda_n inside) or "contact-outer" (Remark 3.43); ``friction_metric``,
+        "jacobi" or "mass", the diagonal metric of P^Lambda (:class:`FrictionStep`).
     condensed : bool
         Iterate on the Gamma_C response from one factorisation
         (:mod:`ngdual.solvers.condensed`) instead of one sparse solve per step;
@@ -191,22 +196,26 @@ def nested_uzawa(problem: DiscreteProblem, law: str, mu_f: float = 0.0, rho1: fl
     Raises
     ------
     ConvergenceError
-        When the residual becomes NaN, grows by 1e6, does not halve within
+        When the residual becomes NaN, grows by ``DIVERGENCE_FACTOR``, does not halve within
         ``STAGNATION_WINDOW`` outer steps, or is not below eps2 after
         ``max_iter`` outer steps (the message names the remedies).
     """
-    if loop_order not in ("friction-outer", "contact-outer"):
-        raise ValueError(f"unknown loop_order {loop_order!r}")
+    s, model = settings, settings.model
+    law, mu_f, rho1, eps1, max_iter = model.law, model.mu_f, s.rho1, s.eps1, s.max_iter
+    if law not in ("tresca", "coulomb"):
+        raise ValueError(f"nested Uzawa solves Tresca or Coulomb friction, not law {law!r}")
+    if s.loop_order not in ("friction-outer", "contact-outer"):
+        raise ValueError(f"unknown loop_order {s.loop_order!r}")
     start_all = time.perf_counter()
     forms = build_friction_forms(problem)
-    loop = ContactLoop(problem, metric, backend, condensed,
+    loop = ContactLoop(problem, s.metric, model.plane_strain_modulus, condensed,
                        extra_outputs=forms.T_n[:, problem.saddle])
     n_c = loop.n_c
     if loop.response is not None:
         S_t = -loop.response.G[n_c:2 * n_c, n_c:]
     else:
         S_t = -CondensedResponse(loop.fact, loop.r0, loop.E_t, loop.E_t.T, gram=False).G
-    friction = FrictionStep(forms, 0.5 * (S_t + S_t.T), rho2, friction_metric)
+    friction = FrictionStep(forms, 0.5 * (S_t + S_t.T), s.rho2, s.friction_metric)
     start = time.perf_counter()
 
     lam = np.zeros(n_c)
@@ -222,14 +231,14 @@ def nested_uzawa(problem: DiscreteProblem, law: str, mu_f: float = 0.0, rho1: fl
     def coulomb_update(state) -> float:                                       # step 8'
         if law != "coulomb":
             return 0.0
-        F_new = forms.coulomb_bound_of(state.extra, mu_f)
-        change = _relative(F_new, friction.F)
-        friction.set_bound(F_new)
+        bound = forms.coulomb_bound_of(state.extra, mu_f)
+        change = _relative(bound, friction.bound)
+        friction.set_bound(bound)
         return change
 
     history, converged, best, best_at = [], False, np.inf, 0
     for outer in range(1, max_iter + 1):
-        if loop_order == "friction-outer":
+        if s.loop_order == "friction-outer":
             state, inner, _, inner_ok = loop.run(lam, rho1, eps1, max_iter,   # steps 3-7
                                                  tau=friction.load(nu))
             lam = state.lam
@@ -255,21 +264,21 @@ def nested_uzawa(problem: DiscreteProblem, law: str, mu_f: float = 0.0, rho1: fl
         history.append(change)
         if progress:
             progress(outer, change)
-        if not np.isfinite(change) or change > 1e6 * max(history[0], 1e-300):
+        if not np.isfinite(change) or change > DIVERGENCE_FACTOR * max(history[0], 1e-300):
             raise ConvergenceError(f"nested Uzawa diverged at outer step {outer} "
-                                   f"(rho1 = {rho1}, rho2 = {rho2})", history)
-        if inner_ok and change <= eps2:                                      # step 9 / 9'
+                                   f"(rho1 = {rho1}, rho2 = {s.rho2})", history)
+        if inner_ok and change <= s.eps2:                                      # step 9 / 9'
             converged = True
             break
         if change < 0.5 * best:
             best, best_at = change, outer
         elif outer - best_at > STAGNATION_WINDOW:
-            raise ConvergenceError(_stagnation_message(problem, outer, law, "stagnated: the "
+            raise ConvergenceError(_stagnation_message(model, outer, "stagnated: the "
                                    f"residual did not halve in {STAGNATION_WINDOW} outer steps"),
                                    history)
     else:
         raise ConvergenceError(_stagnation_message(
-            problem, outer, law, f"did not converge in solver.max_iter = {max_iter} steps"),
+            model, outer, f"did not converge in solver.max_iter = {max_iter} steps"),
             history)
     # one last inner solve so that (sigma, lambda) match the final nu and F exactly
     state, inner, _, inner_ok = loop.run(lam, rho1, eps1, max_iter, tau=friction.load(nu))
@@ -277,16 +286,16 @@ def nested_uzawa(problem: DiscreteProblem, law: str, mu_f: float = 0.0, rho1: fl
     converged = converged and inner_ok
     x = np.zeros(problem.K.shape[0])
     x[problem.saddle], x[problem.lam_n] = loop.solution(state), state.lam
-    F = friction.F
-    return Solution(problem, x, converged, f"nested-uzawa-{law}-{metric}-{loop_order}",
+    bound = friction.bound
+    return Solution(problem, x, converged, f"nested-uzawa-{law}-{s.metric}-{s.loop_order}",
                     iterations={"outer": outer, "inner": inner_total},
                     residuals={"outer_increment": history[-1], **loop.residuals(state),
-                               **friction_residuals(forms, x, problem, nu, F)},
+                               **friction_residuals(forms, problem, x, nu, bound)},
                     history=history,
                     timings={"assemble": problem.assemble_seconds,
                              "factorize": loop.fact.seconds,
                              "condense": loop.condense_seconds,
                              "solve": time.perf_counter() - start,
                              "total_solver": time.perf_counter() - start_all},
-                    nu=nu, friction_bound=F,
-                    nu_l2=forms.l2_norm_nu(nu, forms.per_hat_edge(F) > 0))
+                    nu=nu, friction_bound=bound, friction_forms=forms,
+                    nu_l2=forms.l2_norm_nu(nu, forms.per_hat_edge(bound) > 0))

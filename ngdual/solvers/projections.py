@@ -31,6 +31,7 @@ import scipy.linalg as sla
 import scipy.optimize as spo
 
 from ..boundary import CoarseMesh
+from ..tolerances import CLARABEL_TOLERANCES
 
 
 def metric_matrix(contact: CoarseMesh, modulus: float, kind: str) -> np.ndarray:
@@ -93,8 +94,7 @@ class NonnegativeProjection:
             rhs = sla.solve_triangular(self._root, c / self._scale, trans="T")
             return spo.nnls(self._root, rhs, maxiter=50 * len(c))[0]
         self._c.value = c / self._scale
-        self._problem.solve(solver=cp.CLARABEL, tol_gap_abs=1e-12, tol_gap_rel=1e-12,
-                            tol_feas=1e-12)
+        self._problem.solve(solver=cp.CLARABEL, **CLARABEL_TOLERANCES)
         chi = np.maximum(np.asarray(self._chi.value, dtype=float), 0.0)
         return self._polish(chi, c)
 

@@ -31,19 +31,23 @@ import scipy.sparse.linalg as spla
 
 from ..forms import DiscreteProblem
 from ..friction import build_friction_forms, tresca_bound
+from ..tolerances import CLARABEL_REFERENCE
 from .result import ConvergenceError, Solution
+from .settings import Model
 
-CLARABEL_TOLERANCES = {"tol_gap_abs": 1e-12, "tol_gap_rel": 1e-12, "tol_feas": 1e-12,
-                       "tol_ktratio": 1e-10, "max_iter": 500}
-FEASIBILITY_TOL = 1e-10
-
-
-def solve_qp(problem: DiscreteProblem) -> Solution:
-    """Solve the frictionless problem (3.103); see :func:`_solve_qp`."""
-    return _solve_qp(problem)
+FEASIBILITY_TOL = 1e-10  # the polished active set is accepted up to this relative violation
 
 
-def _solve_qp(problem: DiscreteProblem, Q: sp.spmatrix | None = None) -> Solution:
+def solve_qp(problem: DiscreteProblem, model: Model) -> Solution:
+    """Solve the frictionless problem (3.103); see :func:`_solve_qp`.
+
+    ``model`` gives E*, the scale of the QP's variables.
+    """
+    return _solve_qp(problem, model.plane_strain_modulus)
+
+
+def _solve_qp(problem: DiscreteProblem, modulus: float,
+              Q: sp.spmatrix | None = None) -> Solution:
     """Solve (3.103), the algebraic form of (3.68), as one convex QP in sigma (Clarabel via cvxpy).
 
     The QP is posed in scaled variables so that its numbers are O(1): the
@@ -69,7 +73,6 @@ def _solve_qp(problem: DiscreteProblem, Q: sp.spmatrix | None = None) -> Solutio
     B = problem.block(i_sigma, i_mult)
     C_n = problem.block(i_sigma, i_lam)
     g, b = problem.rhs[i_sigma], problem.rhs[i_mult]
-    modulus = problem.scene.material.plane_strain_modulus
     stress = max(np.max(np.abs(b), initial=0.0), modulus * np.max(np.abs(g), initial=0.0)) or 1.0
     A_s, g_s, b_s = modulus * A, modulus / stress * g, b / stress
 
@@ -86,7 +89,7 @@ def _solve_qp(problem: DiscreteProblem, Q: sp.spmatrix | None = None) -> Solutio
     equality, contact = lhs == b_s, C_n.T @ z <= 0
     qp = cp.Problem(cp.Minimize(0.5 * cp.quad_form(z, A_s, assume_PSD=True) - g_s @ z),
                     [equality, contact, *constraints])
-    qp.solve(solver=cp.CLARABEL, **CLARABEL_TOLERANCES)
+    qp.solve(solver=cp.CLARABEL, **CLARABEL_REFERENCE)
     if z.value is None:
         raise RuntimeError(f"Clarabel returned no solution (status {qp.status!r})")
     # cvxpy's Lagrangian is f + y^T (B^T z - b) + lambda^T C_n^T z, the sign of (3.103)
@@ -114,10 +117,11 @@ def _solve_qp(problem: DiscreteProblem, Q: sp.spmatrix | None = None) -> Solutio
                     nu=nu_v)
 
 
-def solve_qp_friction(problem: DiscreteProblem, law: str, mu_f: float = 0.0,
-                      tol: float = 1e-10, max_iter: int = 200) -> Solution:
+def solve_qp_friction(problem: DiscreteProblem, model: Model, tol: float = 1e-10,
+                      max_iter: int = 200) -> Solution:
     """Tresca or Coulomb friction by the QP in (sigma, nu), iterated on F for Coulomb.
 
+    ``model`` gives the law, mu_f and E*.
     Tresca: one QP with the given bound. Coulomb: F^0 = mu_f |sigma_n| of the
     frictionless QP, then F^{k+1} = mu_f |sigma_n(sigma^k)| (3.123) until the
     relative change of F is <= ``tol`` (successive substitution: no Uzawa step,
@@ -128,25 +132,30 @@ def solve_qp_friction(problem: DiscreteProblem, law: str, mu_f: float = 0.0,
     ConvergenceError
         If the fixed point on F does not converge in ``max_iter`` QPs.
     """
+    law, mu_f, modulus = model.law, model.mu_f, model.plane_strain_modulus
+    if law not in ("tresca", "coulomb"):
+        raise ValueError(f"the friction QP solves Tresca or Coulomb friction, not law {law!r}")
     forms = build_friction_forms(problem)
     start = time.perf_counter()
     if law == "tresca":
-        F, history = tresca_bound(forms, problem), [0.0]
-        sol = _solve_qp(problem, forms.q_matrix(F))
+        bound, history = tresca_bound(forms, problem), [0.0]
+        sol = _solve_qp(problem, modulus, forms.q_matrix(bound))
     else:
-        sol = _solve_qp(problem)
+        sol = _solve_qp(problem, modulus)
         history = []
         while len(history) < max_iter:
-            F = forms.coulomb_bound(sol.x, mu_f)
-            sol = _solve_qp(problem, forms.q_matrix(F))
-            F_new = forms.coulomb_bound(sol.x, mu_f)
-            history.append(float(np.linalg.norm(F_new - F) / (np.linalg.norm(F_new) or 1.0)))
+            bound = forms.coulomb_bound(sol.x, mu_f)
+            sol = _solve_qp(problem, modulus, forms.q_matrix(bound))
+            mapped = forms.coulomb_bound(sol.x, mu_f)
+            history.append(float(np.linalg.norm(mapped - bound)
+                                 / (np.linalg.norm(mapped) or 1.0)))
             if history[-1] <= tol:
                 break
         else:
             raise ConvergenceError(f"the fixed point on F did not converge in {max_iter} QPs",
                                    history)
-    sol.friction_bound, sol.method, sol.history = F, f"reference-qp-{law}", history
+    sol.friction_bound, sol.friction_forms = bound, forms
+    sol.method, sol.history = f"reference-qp-{law}", history
     sol.iterations = {"outer": len(history), "inner": 0}
     sol.timings["solve"] = time.perf_counter() - start
     return sol

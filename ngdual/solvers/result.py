@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..forms import DiscreteProblem
+from ..friction import FrictionForms
 
 
 class ConvergenceError(RuntimeError):
@@ -22,8 +23,11 @@ class Solution:
     """A discrete solution of (3.62) with its iteration record.
 
     ``x`` is ordered like ``problem.K``: (sigma, u, eta, phi, lambda_t, lambda_n).
-    With friction, ``nu`` holds the h^ values of nu and ``friction_bound`` the
-    final F per fine Gamma_C edge.
+    With friction, ``nu`` holds the h^ values of nu, ``friction_bound`` the final bound
+    F per fine Gamma_C edge and ``friction_forms`` the fine-edge operators on Gamma_C the
+    solver built (:class:`ngdual.friction.FrictionForms`: sigma_n, sigma_t per edge, Q_F of
+    (3.95)), for post-processing to reuse rather than assemble again. ``settings`` are
+    those the solution was computed with (:mod:`ngdual.solvers.settings`).
     """
 
     problem: DiscreteProblem
@@ -37,6 +41,8 @@ class Solution:
     nu: np.ndarray | None = None
     friction_bound: np.ndarray | None = None
     nu_l2: float | None = None
+    friction_forms: FrictionForms | None = None
+    settings: object | None = None
 
     def part(self, *names: str) -> np.ndarray:
         return self.x[self.problem.index(*names)]

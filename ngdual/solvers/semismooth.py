@@ -68,11 +68,11 @@ import scipy.linalg.lapack as lapack
 import scipy.optimize as spo
 import scipy.sparse as sp
 
+from ..tolerances import CLARABEL_TOLERANCES, friction_vanishes
 from .result import ConvergenceError
 
 EPS = float(np.finfo(float).eps)
 SAFETY = 100.0  # a tolerance is SAFETY times the round-off level it has to accommodate
-NEGLIGIBLE_F = 1e-10  # rows of Q_F this small relative to the largest carry no friction
 PATIENCE = 8  # full steps without a new smallest merit before damping
 MAX_ESCAPES = 3  # full steps after a failed line search
 ARMIJO = 1e-4
@@ -205,7 +205,7 @@ def _scales(G: np.ndarray, Q: np.ndarray, n_c: int) -> tuple[np.ndarray, np.ndar
     c_n = 1.0 / d[:n_c]
     qq = (Q**2) @ (1.0 / d[n_c:])
     c_t = np.where(qq > 0, 1.0 / np.where(qq > 0, qq, 1.0), 0.0)
-    c_t[qq <= NEGLIGIBLE_F**2 * np.max(qq, initial=0.0)] = 0.0
+    c_t[friction_vanishes(np.sqrt(qq))] = 0.0  # qq is quadratic in F
     return c_n, c_t
 
 
@@ -285,8 +285,7 @@ def semismooth_newton(G: np.ndarray, b: np.ndarray, n_c: int, Q: np.ndarray | No
     """
     Q = np.zeros((0, n_c)) if Q is None else np.asarray(Q, dtype=float)
     tol = kkt_tolerance(G) if tol is None else tol
-    weight = np.abs(Q).sum(axis=1)
-    has_friction = weight > NEGLIGIBLE_F * np.max(weight, initial=0.0)
+    has_friction = ~friction_vanishes(np.abs(Q).sum(axis=1))  # the rows of Q_F scale with F
     if start is not None and len(start.nu) == Q.shape[0]:
         z, nu = np.concatenate([start.lam_n, start.lam_t]), start.nu.copy()
     else:
@@ -407,7 +406,7 @@ def _qp_fallback(G, b, Q, n_c):
         warnings.simplefilter("ignore", UserWarning)
         try:
             cp.Problem(cp.Minimize(objective), constraints).solve(
-                solver=cp.CLARABEL, tol_gap_abs=1e-12, tol_gap_rel=1e-12, tol_feas=1e-12)
+                solver=cp.CLARABEL, **CLARABEL_TOLERANCES)
         except cp.error.SolverError:
             return None
     if y.value is None:

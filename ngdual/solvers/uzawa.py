@@ -23,12 +23,12 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as sla_sparse
 
 from ..forms import DiscreteProblem
+from ..tolerances import DIVERGENCE_FACTOR
 from .condensed import CondensedResponse
 from .linear import Factorization
 from .projections import NonnegativeProjection, metric_matrix
 from .result import ConvergenceError, Solution
-
-DIVERGENCE_FACTOR = 1e6
+from .settings import UzawaSettings
 
 
 def contact_residuals(lam: np.ndarray, traction: np.ndarray,
@@ -90,17 +90,17 @@ class ContactLoop:
     come from the same solves, or from 2 N_C more where the responses do not fit in
     memory; then small dense products): the same iterates and
     the same stopping rule at a fraction of the cost when there are many steps.
+    ``modulus`` is E* (it scales the metric, so that rho is dimensionless);
     ``extra_outputs`` (k x saddle, sparse) are further functionals of y to observe.
     """
 
-    def __init__(self, problem: DiscreteProblem, metric: str, backend: str = "umfpack",
+    def __init__(self, problem: DiscreteProblem, metric: str, modulus: float,
                  condensed: bool = False, extra_outputs: sp.spmatrix | None = None):
         self.problem = problem
         self.saddle, self.n_sigma = problem.saddle, len(problem.sigma)
         n = len(self.saddle)
-        self.fact = Factorization(problem.block(self.saddle, self.saddle), backend)
+        self.fact = Factorization(problem.block(self.saddle, self.saddle))
         self.C_n = problem.block(problem.sigma, problem.lam_n)
-        modulus = problem.scene.material.plane_strain_modulus
         self.projection = NonnegativeProjection(
             metric_matrix(problem.spaces.contact, modulus, metric))
         self.g = problem.rhs[problem.sigma]
@@ -218,19 +218,16 @@ class ContactLoop:
                                  np.max(np.abs(self.b0), initial=0.0))
 
 
-def uzawa(problem: DiscreteProblem, rho: float = 1.0, eps: float = 1e-8, max_iter: int = 2000,
-          metric: str = "h12", backend: str = "umfpack", condensed: bool = False,
+def uzawa(problem: DiscreteProblem, settings: UzawaSettings, condensed: bool = False,
           progress: Callable[[int, float], None] | None = None) -> Solution:
     """Algorithm 3.38 for the frictionless contact problem (3.68).
 
     Parameters
     ----------
-    rho : float
-        Dimensionless step length (the metric carries the elastic modulus).
-    eps : float
-        Tolerance on the relative increment of step 5.
-    metric : {"h12", "euclidean"}
-        Metric W of the projection P^+ (see :mod:`ngdual.solvers.projections`).
+    settings : UzawaSettings
+        ``rho`` (dimensionless step: the metric carries the elastic modulus), ``eps``
+        (tolerance on the relative increment of step 5), ``max_iter``, ``metric`` (of the
+        projection P^+, :mod:`ngdual.solvers.projections`), and the model (E*).
     condensed : bool
         Iterate on the Gamma_C response (:class:`ContactLoop`); pays off when the
         number of steps exceeds about 2 N_C solves' worth.
@@ -240,16 +237,17 @@ def uzawa(problem: DiscreteProblem, rho: float = 1.0, eps: float = 1e-8, max_ite
     Raises
     ------
     ConvergenceError
-        If the increments grow by a factor 1e6 (rho too large) or become NaN.
+        If the increments grow by ``DIVERGENCE_FACTOR`` (rho too large) or become NaN.
     """
-    loop = ContactLoop(problem, metric, backend, condensed)
+    s = settings
+    loop = ContactLoop(problem, s.metric, s.model.plane_strain_modulus, condensed)
     start = time.perf_counter()
-    state, its, history, converged = loop.run(np.zeros(len(problem.lam_n)), rho, eps, max_iter,
-                                              progress=progress)
+    state, its, history, converged = loop.run(np.zeros(len(problem.lam_n)), s.rho, s.eps,
+                                              s.max_iter, progress=progress)
     x = np.zeros(problem.K.shape[0])
     x[problem.saddle], x[problem.lam_n] = loop.solution(state), state.lam
     residuals = {"increment": history[-1], **loop.residuals(state)}
-    return Solution(problem, x, converged, f"uzawa-{metric}",
+    return Solution(problem, x, converged, f"uzawa-{s.metric}",
                     iterations={"outer": its, "inner": 0}, residuals=residuals,
                     history=history,
                     timings={"assemble": problem.assemble_seconds,

@@ -1,0 +1,69 @@
+"""The numerical constants of the solvers, each in one place, and the rule for "F is zero here".
+
+Every other tolerance of the solvers is derived from the problem at hand (the round-off level
+of :mod:`ngdual.solvers.active_set`, the KKT tolerance of :mod:`ngdual.solvers.semismooth`)
+or is a scene setting (``solver.eps`` and friends, defaults in :mod:`ngdual.scene`).
+
+When is the friction bound zero?
+--------------------------------
+The bound F of (3.95) (given for Tresca, F = mu_f |sigma_n| of (3.123) for Coulomb) decides
+where friction acts at all: an h^ edge with F = 0 has no friction condition, its nu is
+arbitrary (Lemma 3.29). Computed values are never exactly zero where the body separates,
+so one rule says when F, and the normal stress it is made of, count as zero:
+
+    F is zero where |F| <= max(F_ZERO * max_{Gamma_C} |F|, noise),
+
+relative to the largest value of the same quantity along Gamma_C (so it is independent of
+units, load and mesh), F_ZERO = 1e-6. Why 1e-6: an iterative contact solve (Algorithms
+3.38/3.41, stopped at relative increments eps = 1e-8) leaves hat moments of sigma_n of the
+size of its tolerance, amplified by the condition of the contact problem, on separated
+edges: up to about 1e-7 of the largest; the bounds of edges in contact are above 1e-4 of the
+largest on every shipped scene (the last edge of a contact zone included); a direct solve
+leaves 1e-13 and less. 1e-6 lies between, two decades from each. ``noise`` is the round-off
+level of a vanishing value where a solver knows it (the active-set solver: SAFETY delta_0
+mu_f times its stress scale): it decides when even the largest value is round-off, on a
+Gamma_C that is separated everywhere. The same rule applies to quantities proportional to F
+(rows of Q_F) and, through their square root, to those proportional to F^2 (the diagonal of
+the nu operator).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+# The sparse factorisations (UMFPACK through NGSolve, CHOLMOD through cvxopt) bind to the
+# first OpenBLAS in the process, NGSolve's, which is threaded. Measured on 2 shared cores:
+# UMFPACK on Example 3.46, level 6 (247k unknowns), 64 s of CPU with threaded BLAS against
+# 4.4 s with one thread; CHOLMOD, level 7, 8.7 s with two threads against 1.5 s with one
+# (small dense updates dominated by spin-waiting threads when other processes compete).
+# The dense work on Gamma_C (at most a few thousand unknowns) is as fast with one thread.
+BLAS_THREADS = 1
+
+# An iteration whose increment grows by this factor over its first one diverges (a step
+# rho beyond the stability bound grows geometrically; a converging one never does).
+DIVERGENCE_FACTOR = 1e6
+
+# Clarabel (interior point, through cvxpy) to the accuracy of double precision: the QPs
+# either are the reference the iterative solvers are checked against to 1e-8 and below,
+# or start a polish on the active set they find.
+CLARABEL_TOLERANCES = {"tol_gap_abs": 1e-12, "tol_gap_rel": 1e-12, "tol_feas": 1e-12}
+# the reference QP of the whole discrete problem: also the KKT ratio and a step bound
+CLARABEL_REFERENCE = {**CLARABEL_TOLERANCES, "tol_ktratio": 1e-10, "max_iter": 500}
+
+# Relative change of F at which the Coulomb fixed point of the active-set solver stops
+# (it also stops where the change stagnates at its round-off level).
+COULOMB_FIXED_POINT_TOL = 1e-12
+
+F_ZERO = 1e-6  # F is zero where it is at most this fraction of its largest value (above)
+
+
+def friction_vanishes(values: np.ndarray, noise: float = 0.0) -> np.ndarray:
+    """Where a friction bound (or a quantity proportional to it) is zero (module docstring).
+
+    >>> friction_vanishes(np.array([1.0, 1e-7, 1e-3, 0.0])).tolist()
+    [False, True, False, True]
+    >>> friction_vanishes(np.array([1e-17, 2e-17]), noise=1e-15).tolist()
+    [True, True]
+    """
+    size = np.abs(values)
+    return size <= max(F_ZERO * np.max(size, initial=0.0), noise)
