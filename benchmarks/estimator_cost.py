@@ -44,7 +44,7 @@ def one_level(scene_name: str, level: int, repeat: int) -> dict:
 
 
 def main() -> None:
-    from ngdual.post import versions
+    from ngdual.io import versions
 
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--scene", default="thesis-3.46-frictionless")

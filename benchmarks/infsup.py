@@ -27,8 +27,8 @@ import scipy.sparse.linalg as spla
 
 from ngdual import peers
 from ngdual.forms import Spaces, assemble
+from ngdual.io import versions
 from ngdual.mesh import build_mesh
-from ngdual.post import versions
 from ngdual.scene import load_scene
 
 DEFAULT_SCENES = ("thesis-3.46-frictionless", "hertz-cylinder", "flat-punch", "wedge")

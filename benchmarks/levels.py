@@ -17,7 +17,8 @@ import sys
 
 
 def one_level(scene_name: str, level: int, overrides: list[str]) -> dict:
-    from ngdual.post import norms, versions
+    from ngdual.io import versions
+    from ngdual.post import norms
     from ngdual.scene import load_scene
     from ngdual.solvers import solve_scene
 

@@ -1,6 +1,6 @@
 """Limit ratio of every contact solver: contact-solve time / (factorisation + one solve).
 
-The same as ``ngdual bench`` (see :mod:`ngdual.bench`): Example 3.46 without friction and
+The same as ``ngdual bench`` (see :mod:`ngdual.studies.bench`): Example 3.46 without friction and
 with Coulomb friction, per level and solver (Uzawa, Uzawa with tuned steps, active set),
 one JSON record each with DOFs, times, iterations, peak memory and package versions.
 

@@ -15,8 +15,8 @@ shaded; the blunt wedge, p = (E* s / pi) arccosh(a / |x|)).
 import numpy as np
 
 from ngdual import plot
-from ngdual.figures import script_main, solve
 from ngdual.scene import load_scene
+from ngdual.studies.figures import script_main, solve
 from ngdual.verification import analytic
 
 THESIS = "Beyond the thesis: contact scenes"

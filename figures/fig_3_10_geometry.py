@@ -10,9 +10,9 @@ import numpy as np
 
 from ngdual import plot
 from ngdual.expr import Expression
-from ngdual.figures import script_main
 from ngdual.mesh import mesh_arrays, thesis_mesh
 from ngdual.scene import load_scene
+from ngdual.studies.figures import script_main
 
 THESIS = "Fig. 3.10"
 STUDIES = ()

@@ -6,9 +6,10 @@ away from the corners (|x_1| <= 3): the corner singularities would wash out the 
 """
 
 import numpy as np
+from _common import element_rows, field_summary
 
 from ngdual import plot
-from ngdual.figures import element_rows, field_summary, script_main
+from ngdual.studies.figures import script_main
 
 THESIS = "Fig. 3.11"
 STUDIES = ("uniform-frictionless", "uniform-coulomb")

@@ -1,9 +1,10 @@
 """Fig. 3.12: displacement u_1^h in Omega (piecewise constant), mu_f = 0 and mu_f = 0.5."""
 
 import numpy as np
+from _common import element_rows
 
 from ngdual import plot
-from ngdual.figures import element_rows, script_main
+from ngdual.studies.figures import script_main
 
 THESIS = "Fig. 3.12"
 STUDIES = ("uniform-frictionless", "uniform-coulomb")

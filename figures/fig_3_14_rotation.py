@@ -6,9 +6,10 @@ body starts to slide; the extrema lie on the boundary.
 """
 
 import numpy as np
+from _common import element_rows
 
 from ngdual import plot
-from ngdual.figures import element_rows, script_main
+from ngdual.studies.figures import script_main
 
 THESIS = "Fig. 3.14"
 STUDIES = ("uniform-frictionless", "uniform-coulomb")

@@ -4,7 +4,9 @@ The thesis: no difference between the two cases (same traction t_0); by Theorem 
 sign of phi is opposite to that of u on Gamma_N.
 """
 
-from ngdual.figures import neumann_multiplier, script_main
+from _common import neumann_multiplier
+
+from ngdual.studies.figures import script_main
 
 THESIS = "Fig. 3.15"
 STUDIES = ("uniform-frictionless", "uniform-coulomb")

@@ -5,9 +5,10 @@ but with friction the contact zone is larger (ten more vertices in contact on le
 """
 
 import numpy as np
+from _common import curve_rows
 
 from ngdual import plot
-from ngdual.figures import PROBLEM_TITLES, curve_rows, script_main
+from ngdual.studies.figures import PROBLEM_TITLES, script_main
 
 THESIS = "Fig. 3.17"
 STUDIES = ("uniform-frictionless", "uniform-coulomb")

@@ -6,7 +6,9 @@ with friction (kinks where the body changes between slip and stick); F_abs is la
 friction.
 """
 
-from ngdual.figures import PROBLEM_TITLES, gamma_c_stress, script_main
+from _common import gamma_c_stress
+
+from ngdual.studies.figures import PROBLEM_TITLES, script_main
 
 THESIS = "Fig. 3.18"
 STUDIES = ("uniform-frictionless", "uniform-coulomb")

@@ -5,9 +5,10 @@ With friction, the h~ nodes in contact are marked stick (green) or slip (red) as
 """
 
 import numpy as np
+from _common import curve_rows
 
 from ngdual import plot
-from ngdual.figures import PROBLEM_TITLES, curve_rows, script_main
+from ngdual.studies.figures import PROBLEM_TITLES, script_main
 
 THESIS = "Fig. 3.19"
 STUDIES = ("uniform-frictionless", "uniform-coulomb")

@@ -4,7 +4,9 @@ The thesis: zero without friction (free sliding); with friction the friction for
 tangentially, with the sign of lambda_t.
 """
 
-from ngdual.figures import gamma_c_stress, script_main
+from _common import gamma_c_stress
+
+from ngdual.studies.figures import script_main
 
 THESIS = "Fig. 3.20"
 STUDIES = ("uniform-frictionless", "uniform-coulomb")

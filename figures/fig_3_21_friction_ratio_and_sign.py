@@ -11,7 +11,7 @@ sticks (the thesis: nu = sigma_t / (mu_f |sigma_n|) on all of A_C, Remark 3.15).
 import numpy as np
 
 from ngdual import plot
-from ngdual.figures import script_main
+from ngdual.studies.figures import script_main
 
 THESIS = "Fig. 3.21"
 STUDIES = ("uniform-coulomb",)

@@ -5,10 +5,9 @@ level K is left out: it is part of its own reference); the thesis' slope -1/5 is
 through the second level of the frictionless curve.
 """
 
-import math
-
 from ngdual import plot
-from ngdual.figures import PROBLEM_TITLES, errors, script_main
+from ngdual.rates import observed_rates
+from ngdual.studies.figures import PROBLEM_TITLES, errors, script_main
 
 THESIS = "Fig. 3.22"
 STUDIES = ("uniform-frictionless", "uniform-coulomb")
@@ -48,8 +47,8 @@ def run(ctx):
     ctx.entry(THESIS, "Convergence of the total error", [*figs, data],
               {**{f"e_tot at level {lv}, {PROBLEM_TITLES[p]}": e for p, pts in series.items()
                   for _, e, lv in pts[-2:]},
-               **{f"slope of the last two points, {PROBLEM_TITLES[p]}":
-                  math.log(pts[-1][1] / pts[-2][1]) / math.log(pts[-1][0] / pts[-2][0])
+               **{f"alpha (ngdual.rates) of the last two points, {PROBLEM_TITLES[p]}":
+                  observed_rates([n for n, _, _ in pts[-2:]], [e for _, e, _ in pts[-2:]])[1]
                   for p, pts in series.items() if len(pts) >= 2}},
               thesis_says="slope -1/5 against the DOFs (alpha about 0.45).",
               notes="level K is left out: the reference is extrapolated from it.")

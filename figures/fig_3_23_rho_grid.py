@@ -7,7 +7,7 @@ crossed cells did not converge (ConvergenceError or max_iter).
 import numpy as np
 
 from ngdual import plot
-from ngdual.figures import best, rho_tasks, script_main
+from ngdual.studies.figures import best, rho_tasks, script_main
 
 THESIS = "Fig. 3.23"
 STUDIES = ("rho-coulomb",)

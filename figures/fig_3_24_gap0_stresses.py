@@ -8,7 +8,7 @@ kinks of sigma_t mark the change between slip and stick.
 import numpy as np
 
 from ngdual import plot
-from ngdual.figures import gap_tasks, outcome, require, script_main
+from ngdual.studies.figures import gap_tasks, outcome, require, script_main
 
 THESIS = "Fig. 3.24"
 STUDIES = ("gaps",)

@@ -10,7 +10,7 @@ also requires the residual of nu lambda_t = |lambda_t| to be below eps_2.
 import numpy as np
 
 from ngdual import plot
-from ngdual.figures import gap_tasks, outcome, require, script_main
+from ngdual.studies.figures import gap_tasks, outcome, require, script_main
 
 THESIS = "Fig. 3.25"
 STUDIES = ("gaps",)

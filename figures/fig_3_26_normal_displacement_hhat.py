@@ -9,9 +9,10 @@ Plan.uzawa_gap_level) is listed in the index. A case that did not converge is na
 """
 
 import numpy as np
+from _common import HHAT_CASES, HHAT_STYLE, hhat_numbers, hhat_solutions
 
 from ngdual import plot
-from ngdual.figures import HHAT_CASES, HHAT_STYLE, hhat_numbers, hhat_solutions, script_main
+from ngdual.studies.figures import script_main
 
 THESIS = "Fig. 3.26"
 STUDIES = ("gaps",)

@@ -2,9 +2,10 @@
 (a) g = |x_1|, (b) g of (3.125), mu_f = 0.5."""
 
 import numpy as np
+from _common import HHAT_CASES, HHAT_STYLE, hhat_numbers, hhat_solutions
 
 from ngdual import plot
-from ngdual.figures import HHAT_CASES, HHAT_STYLE, hhat_numbers, hhat_solutions, script_main
+from ngdual.studies.figures import script_main
 
 THESIS = "Fig. 3.27"
 STUDIES = ("gaps",)

@@ -6,7 +6,7 @@ triangles marked for the next refinement. One file per thesis figure (fig_4_01 .
 """
 
 from ngdual import plot
-from ngdual.figures import adapt_task, require, script_main
+from ngdual.studies.figures import adaptive_task, require, script_main
 
 THESIS = "Figs. 4.1-4.8"
 STUDIES = ("adaptive",)
@@ -14,7 +14,7 @@ STUDIES = ("adaptive",)
 
 def run(ctx):
     # COMPUTE: the adaptive run (shared with Tables 4.1 and 4.2)
-    task = adapt_task(ctx.plan, "coulomb", "max")
+    task = adaptive_task(ctx.plan, "coulomb", "max")
     run_record = require(ctx.record(task), task.label)
     arrays = ctx.arrays(task)
     steps = {r["step"]: r for r in run_record["history"]}

@@ -6,7 +6,7 @@ for the next refinement. One file per thesis figure (fig_4_09 ... fig_4_13).
 """
 
 from ngdual import plot
-from ngdual.figures import adapt_task, require, script_main
+from ngdual.studies.figures import adaptive_task, require, script_main
 
 THESIS = "Figs. 4.9-4.13"
 STUDIES = ("adaptive",)
@@ -14,7 +14,7 @@ STUDIES = ("adaptive",)
 
 def run(ctx):
     # COMPUTE: the adaptive run (shared with Tables 4.3 and 4.4)
-    task = adapt_task(ctx.plan, "coulomb", "fraction")
+    task = adaptive_task(ctx.plan, "coulomb", "fraction")
     run_record = require(ctx.record(task), task.label)
     arrays = ctx.arrays(task)
     steps = {r["step"]: r for r in run_record["history"]}

@@ -5,7 +5,7 @@ h~ mesh of Gamma_N, C: lambda_n (and lambda_t) on the h~ mesh of Gamma_C, L: nu 
 h^ = 2h~ mesh. Counted without assembling; compared with the thesis numbers.
 """
 
-from ngdual.figures import markdown_table, script_main
+from ngdual.studies.figures import markdown_table, script_main
 
 THESIS = "Table 3.1"
 STUDIES = ("dofs",)

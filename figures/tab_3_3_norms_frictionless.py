@@ -4,7 +4,9 @@
 levels, the reference of the total error (3.124).
 """
 
-from ngdual.figures import NORM_KEYS, norms_table, script_main
+from _common import NORM_KEYS, norms_table
+
+from ngdual.studies.figures import script_main
 
 THESIS = "Table 3.3"
 STUDIES = ("uniform-frictionless",)

@@ -7,7 +7,7 @@ assembly and factorisation. Sweep tasks run two at a time, so times carry that n
 Last columns: the default active-set solver (semismooth Newton steps, no parameter).
 """
 
-from ngdual.figures import best, markdown_table, rho_tasks, script_main, solve
+from ngdual.studies.figures import best, markdown_table, rho_tasks, script_main, solve
 
 THESIS = "Table 3.5"
 STUDIES = ("rho-frictionless", "uniform-frictionless")

@@ -8,7 +8,7 @@ is the condensation onto Gamma_C plus the iteration; sweep tasks run two at a ti
 Last columns: the default active-set solver (Coulomb fixed-point / Newton steps).
 """
 
-from ngdual.figures import best, markdown_table, rho_tasks, script_main, solve
+from ngdual.studies.figures import best, markdown_table, rho_tasks, script_main, solve
 
 THESIS = "Table 3.6"
 STUDIES = ("rho-coulomb", "uniform-coulomb")

@@ -1,7 +1,9 @@
 """Table 4.1: norms and DOFs per step of the adaptive algorithm with max marking (theta = 0.5),
 mu_f = 0.5; compare with the uniform levels of Table 3.2."""
 
-from ngdual.figures import NORM_KEYS, NORM_LABELS, adapt_task, markdown_table, require, script_main
+from _common import NORM_KEYS, NORM_LABELS
+
+from ngdual.studies.figures import adaptive_task, markdown_table, require, script_main
 
 THESIS = "Table 4.1"
 STUDIES = ("adaptive",)
@@ -9,7 +11,7 @@ STUDIES = ("adaptive",)
 
 def run(ctx):
     # COMPUTE: the adaptive run (shared with Figs. 4.1-4.8)
-    task = adapt_task(ctx.plan, "coulomb", "max")
+    task = adaptive_task(ctx.plan, "coulomb", "max")
     history = require(ctx.record(task), task.label)["history"]
     rows = [{"step": r["step"], **{k: r["norms"][k] for k in NORM_KEYS},
              "dofs": r["dofs"]["total"], "elements": r["elements"]} for r in history]

@@ -1,7 +1,7 @@
 """Table 4.2: the largest asymmetry indicator eta_as^max with as(sigma_h) in L^2 and in H(div),
 and the share q_as of triangles with eta_as,T >= 0.1 eta_as^max, per step of max marking."""
 
-from ngdual.figures import adapt_task, markdown_table, require, script_main
+from ngdual.studies.figures import adaptive_task, markdown_table, require, script_main
 
 THESIS = "Table 4.2"
 STUDIES = ("adaptive",)
@@ -9,7 +9,7 @@ STUDIES = ("adaptive",)
 
 def run(ctx):
     # COMPUTE: the adaptive run (shared with Figs. 4.1-4.8)
-    task = adapt_task(ctx.plan, "coulomb", "max")
+    task = adaptive_task(ctx.plan, "coulomb", "max")
     history = require(ctx.record(task), task.label)["history"]
     rows = [{"step": r["step"], "max_l2": r["eta_as"]["l2"]["max"], "q_l2": r["eta_as"]["l2"]["q"],
              "max_hdiv": r["eta_as"]["hdiv"]["max"], "q_hdiv": r["eta_as"]["hdiv"]["q"],

@@ -6,13 +6,8 @@ e_tot against the Aitken limits of the uniform levels (Table 3.2), so it is mean
 while it is well above the error of that reference (about the error of level K).
 """
 
-from ngdual.figures import (
-    adapt_task,
-    errors,
-    markdown_table,
-    require,
-    script_main,
-)
+from ngdual.studies.figures import adaptive_task, errors, markdown_table, require, script_main
+from ngdual.studies.sweep import estimator
 
 THESIS = "Table 4.4"
 STUDIES = ("adaptive", "uniform-coulomb")
@@ -20,16 +15,16 @@ STUDIES = ("adaptive", "uniform-coulomb")
 
 def run(ctx):
     # COMPUTE: the adaptive run and the reference norms of the uniform levels
-    task = adapt_task(ctx.plan, "coulomb", "fraction")
+    task = adaptive_task(ctx.plan, "coulomb", "fraction")
     history = require(ctx.record(task), task.label)["history"]
     errs = errors(history, ctx.reference("coulomb"))
     rows = []
     for r, e in zip(history, errs):
         e_tot = e["e_tot"] if e else None
         rows.append({"step": r["step"], "e_tot": e_tot, "dofs": r["dofs"]["total"],
-                     "eta_sum": r["eta_sum"], "eta": r["eta"],
-                     "effectivity": r["eta_sum"] / e_tot if e_tot else None,
-                     "effectivity_l2": r["eta"] / e_tot if e_tot else None})
+                     "eta_sum": estimator(r, "sum"), "eta": estimator(r),
+                     "effectivity": estimator(r, "sum") / e_tot if e_tot else None,
+                     "effectivity_l2": estimator(r) / e_tot if e_tot else None})
     # WRITE
     data = ctx.write_csv("tab_4_4_effectivity.csv", rows,
                          "e_tot, DOFs and effectivity per step, fraction marking theta = 0.2")

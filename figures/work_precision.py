@@ -1,6 +1,6 @@
 """What accuracy costs in time: true errors against wall time and unknowns, every method.
 
-Problems (ngdual.figures.TRUTH_PROBLEMS): Example 3.46 without friction and with Coulomb
+Problems (ngdual.studies.figures.TRUTH_PROBLEMS): Example 3.46 without friction and with Coulomb
 friction mu_f = 0.5, both with consistent end values at the clamped sides (the thesis'
 lambda = 0 there contradicts u = 0 on Gamma_D and leaves sigma ~ 1/r, not in L2: no error
 is finite), and the rigid flat punch.
@@ -18,7 +18,7 @@ sigma panel is the one to read.
 Methods: uniform refinement with the default active-set solver and with the thesis' Uzawa
 iterations; adaptive refinement (default solver) with max marking (theta = 0.5, 0.25) and
 Doerfler marking (theta = 0.5, 0.3) from level 1 up to the triangles of the finest uniform
-level; the primal peer benchmarks/primal_peer.py (P1 and P2 displacements, Nitsche
+level; the primal peer ngdual.studies.primal_peer (P1 and P2 displacements, Nitsche
 contact, semismooth Newton) on the same uniform meshes and one level beyond.
 
 Time: uniform and peer -- the wall time of one solve (mesh, assembly, solve; not the
@@ -30,12 +30,7 @@ of the fastest ngdual method to the fastest peer.
 import os
 
 from ngdual import plot
-from ngdual.figures import (
-    TRUTH_PROBLEMS,
-    markdown_table,
-    script_main,
-    true_error_study,
-)
+from ngdual.studies.figures import TRUTH_PROBLEMS, markdown_table, script_main, true_error_study
 
 THESIS = "Work-precision (beyond the thesis)"
 STUDIES = ("truth",)

@@ -9,7 +9,7 @@ runs the adaptive loop and writes ``DIR/history.json`` plus a mesh (.vol, .png) 
 ``ngdual tutorials [--notebooks DIR] [--solutions]`` lists the lecture tutorials or
 writes them as Jupyter notebooks.
 ``ngdual bench [--levels ...] [--json FILE]`` times the contact solvers against one
-linear solve of the same matrix (the limit ratio, :mod:`ngdual.bench`).
+linear solve of the same matrix (the limit ratio, :mod:`ngdual.studies.bench`).
 ``ngdual verify [--quick] [--json FILE]`` prints the errors against exact solutions with
 observed orders (:mod:`ngdual.verification.report`).
 Exit status: 0 solved and converged, 1 not converged, 2 bad input (one message naming
@@ -165,9 +165,8 @@ def cmd_adapt(args) -> int:
 
     from . import budget, plot
     from .afem import adapt, reference_norms
-    from .io import check_output_dir, write_json
+    from .io import check_output_dir, versions, write_json
     from .mesh import mesh_arrays
-    from .post import versions
     from .solvers.result import ConvergenceError
 
     level = check_level(args.level, "--level", optional=True)
@@ -225,9 +224,9 @@ def cmd_adapt(args) -> int:
 def cmd_figures(args) -> int:
     """Regenerate the figures and tables of Sections 3.4 and 4.2 into DIR (see figures/)."""
     from . import budget
-    from .figures import DEFAULT_MAX_LEVEL, THESIS_MAX_LEVEL, run_figures
     from .io import check_output_dir
     from .scene import Geometry
+    from .studies.figures import DEFAULT_MAX_LEVEL, THESIS_MAX_LEVEL, run_figures
 
     max_level = DEFAULT_MAX_LEVEL if args.max_level is None else args.max_level
     _number(max_level, "--max-level", 2, THESIS_MAX_LEVEL, integer=True)
@@ -250,7 +249,7 @@ def cmd_figures(args) -> int:
     for stem, info in failed.items():
         print(f"ngdual: figure script {stem}: {info['status']}", file=sys.stderr)
     if args.gallery:
-        from .figures import write_gallery
+        from .studies.figures import write_gallery
 
         for path in write_gallery(args.out, args.gallery):
             print(f"wrote {path}")
@@ -258,11 +257,12 @@ def cmd_figures(args) -> int:
 
 
 def cmd_bench(args) -> int:
-    """Limit ratios of the contact solvers (ngdual.bench): table on stdout, JSON with --json."""
+    """Limit ratios of the contact solvers (ngdual.studies.bench): table on stdout, JSON
+    with --json."""
     from . import budget
-    from .bench import CASES, SOLVERS, bench, summary_rows
     from .io import check_output_file, write_json
     from .scene import Geometry
+    from .studies.bench import CASES, SOLVERS, bench, summary_rows
 
     for flag, values, known in (("--cases", args.cases, CASES), ("--solvers", args.solvers,
                                                                   SOLVERS)):
@@ -319,7 +319,7 @@ def cmd_verify(args) -> int:
 def cmd_tutorials(args) -> int:
     """List the tutorials; with --notebooks DIR write them (and their solutions) as notebooks."""
     from .io import check_output_dir
-    from .tutorials import list_tutorials, write_notebooks
+    from .studies.tutorials import list_tutorials, write_notebooks
 
     if args.notebooks:
         check_output_dir(args.notebooks, "--notebooks")

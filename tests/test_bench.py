@@ -2,8 +2,8 @@
 
 import json
 
-from ngdual.bench import CASES, SOLVERS
 from ngdual.cli import main
+from ngdual.studies.bench import CASES, SOLVERS
 
 RECORD_KEYS = {"case", "scene", "level", "solver", "method", "ndof", "dofs", "converged",
                "iterations", "seconds_assemble", "seconds_total", "seconds_parts",

@@ -30,8 +30,9 @@ from pathlib import Path
 import pytest
 
 from ngdual.cli import main
-from ngdual.figures import Plan, best, errors, markdown_table, rates, reference_norms
-from ngdual.sweep import Task, execute, load_record, run_task
+from ngdual.rates import extrapolated_norms, observed_rates
+from ngdual.studies.figures import Plan, best, errors, markdown_table
+from ngdual.studies.sweep import Task, estimator, execute, load_record, run_task
 
 SMOKE = "3"     # the smoke run of every script
 COARSE = "2"    # the sweep that is killed and resumed
@@ -270,11 +271,11 @@ def test_error_helpers():
     records = [{"norms": {"u": 1.5, "nu": None}, "ndof": 10},
                {"norms": {"u": 1.25, "nu": None}, "ndof": 40},
                {"norms": {"u": 1.125, "nu": None}, "ndof": 160}]
-    reference = reference_norms(records)
+    reference = extrapolated_norms([r["norms"] for r in records])
     assert reference["u"] == pytest.approx(1.0) and reference["nu"] is None
     e = [r["e_tot"] for r in errors(records, reference)]
     assert e[0] == pytest.approx(math.sqrt(1.5**2 - 1))
-    alpha = rates([10, 40, 160], e)
+    alpha = observed_rates([10, 40, 160], e)
     assert alpha[0] is None and alpha[1] == pytest.approx(
         -2 * math.log(e[0] / e[1]) / math.log(10 / 40))
     ok = {"a": {"status": "ok", "iterations": {"outer": 9, "inner": 50},
@@ -284,3 +285,15 @@ def test_error_helpers():
           "c": {"status": "failed"}}
     assert best(ok) == "a"
     assert "| 1 | - |" in markdown_table([{"a": 1}], {"a": "A", "b": "B"})
+
+
+def test_records_of_the_last_release_still_give_their_estimator():
+    """The estimator is ``estimator`` in this release's records; ``eta`` (the rotation's
+    name) in older ones, which stay readable."""
+    new_solve = {"estimator": {"total": 2.0, "sum": 5.0, "seconds": 0.1}}
+    old_solve = {"estimator": {"eta": 2.0, "eta_sum": 5.0, "seconds": 0.1}}
+    new_step = {"estimator": 2.0, "estimator_sum": 5.0, "norms": {"eta": 7.0}}
+    old_step = {"eta": 2.0, "eta_sum": 5.0, "norms": {"eta": 7.0}}
+    for record in (new_solve, old_solve, new_step, old_step):
+        assert (estimator(record), estimator(record, "sum")) == (2.0, 5.0), record
+    assert estimator({"status": "ok", "ndof": 3}) is None  # the primal peer has none

@@ -1,20 +1,13 @@
 """The primal peer (P1/P2 displacements, Nitsche contact, semismooth Newton) against Hertz
-and Cattaneo-Mindlin (benchmarks/primal_peer.py)."""
+and Cattaneo-Mindlin (ngdual.studies.primal_peer)."""
 
 import math
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 from ngdual.mesh import polygon_mesh
-
-ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:  # benchmarks/ is not an installed package
-    sys.path.insert(0, str(ROOT))
-
-from benchmarks.primal_peer import (  # noqa: E402
+from ngdual.studies.primal_peer import (
     NewtonError,
     cattaneo_mindlin_case,
     hertz_case,

@@ -25,7 +25,7 @@ import numpy as np
 import pytest
 
 from ngdual.cli import main
-from ngdual.tutorials import (
+from ngdual.studies.tutorials import (
     Tutorial,
     in_notebook,
     list_tutorials,

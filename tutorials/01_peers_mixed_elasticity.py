@@ -45,7 +45,7 @@ from ngdual.forms import assemble
 from ngdual.mesh import build_mesh
 from ngdual.scene import Geometry, Loads, Material, Scene, load_scene, validate
 from ngdual.solvers import solve_scene
-from ngdual.tutorials import draw, output_dir, quick_mode, save_figure, save_results
+from ngdual.studies.tutorials import draw, output_dir, quick_mode, save_figure, save_results
 
 # %% [markdown]
 # ## Parameters

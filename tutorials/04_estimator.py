@@ -49,7 +49,7 @@ from ngdual.post import fields
 from ngdual.rates import observed_rates
 from ngdual.scene import Geometry, Loads, Material, Scene, load_scene, validate
 from ngdual.solvers import solve_scene
-from ngdual.tutorials import draw, output_dir, quick_mode, save_figure, save_results
+from ngdual.studies.tutorials import draw, output_dir, quick_mode, save_figure, save_results
 
 # %% [markdown]
 # ## Parameters

@@ -19,7 +19,8 @@ one scale.
 
 Solver variants: ``uzawa`` (Algorithm 3.38 / nested Uzawa 3.41 with Remark 3.45, the
 scene's default steps rho = rho1 = rho2 = 1), ``uzawa-tuned`` (the steps of ``TUNED``),
-``active-set`` (:mod:`ngdual.solvers.active_set`). Functions return records; printing and file
+``active-set`` (:mod:`ngdual.solvers.active_set`), as spelled in
+:data:`ngdual.studies.variants.VARIANTS`. Functions return records; printing and file
 writing are in :mod:`ngdual.cli`.
 """
 
@@ -32,18 +33,14 @@ import resource
 import subprocess
 import sys
 import time
-from importlib import metadata
 
 from threadpoolctl import threadpool_limits
 
+from ..io import versions
+from .variants import TUNED, VARIANTS
+
 CASES = {"thesis-3.46": "thesis-3.46-frictionless", "thesis-3.46-coulomb": "thesis-3.46-coulomb"}
 SOLVERS = ("uzawa", "uzawa-tuned", "active-set")
-# The steps with the fewest iterations in a scan of Example 3.46 on levels 3-5 (rho in
-# 0.8..1.9, rho1 in 0.8..1.5, rho2 in 1..1.9): rho = 1.1 (h12 metric, Algorithm 3.38:
-# 14 steps instead of 16), rho1 = 1.2 and rho2 = 1.8 (nested Uzawa, rho2 relative to the
-# computed stability bound of the nu step, which must stay below 2: 54 outer steps instead
-# of 102 on level 4, the count still growing with the level).
-TUNED = {"rho": 1.1, "rho1": 1.2, "rho2": 1.8}
 ISOLATE_FROM_LEVEL = 4
 # UMFPACK and CHOLMOD call the first OpenBLAS in the process (NGSolve's, threaded); on 2
 # cores shared with other processes its spin-waiting threads made the same UMFPACK
@@ -53,13 +50,9 @@ _WARM: set = set()
 
 
 def _overrides(solver: str) -> list[str]:
-    if solver == "active-set":
-        return ["solver.method=active-set"]
-    if solver == "uzawa":
-        return ["solver.method=uzawa"]
-    if solver == "uzawa-tuned":
-        return ["solver.method=uzawa"] + [f"solver.{k}={v}" for k, v in TUNED.items()]
-    raise ValueError(f"unknown solver {solver!r}; use one of {SOLVERS}")
+    if solver not in SOLVERS:
+        raise ValueError(f"unknown solver {solver!r}; use one of {SOLVERS}")
+    return list(VARIANTS[solver].overrides)
 
 
 def linear_seconds(problem, backend: str) -> dict:
@@ -69,19 +62,20 @@ def linear_seconds(problem, backend: str) -> dict:
     ``"hybrid-cholesky"`` (hybridisation, static condensation, CHOLMOD, one solve and the
     recovery of sigma and u). Returns the times and, for Cholesky, the factor's nonzeros.
     """
-    from .solvers.cholesky import SchurCholesky
-    from .solvers.hybrid import HybridSystem
-    from .solvers.linear import Factorization
+    from ..solvers.cholesky import SchurCholesky
+    from ..solvers.hybrid import HybridSystem
+    from ..solvers.linear import Factorization
+    from ..solvers.settings import Model
 
     start = time.perf_counter()
     if backend == "umfpack":
         saddle = problem.saddle
-        fact = Factorization(problem.block(saddle, saddle), "umfpack")
+        fact = Factorization(problem.block(saddle, saddle))
         factorized = time.perf_counter()
-        fact.solve(problem.F[saddle])
+        fact.solve(problem.rhs[saddle])
         nnz = None
     elif backend == "hybrid-cholesky":
-        hybrid = HybridSystem(problem)
+        hybrid = HybridSystem(problem, Model.of(problem.scene))
         chol = SchurCholesky(hybrid.H, hybrid.contact_index)
         factorized = time.perf_counter()
         hybrid.unknowns(chol.solve(hybrid.r))
@@ -95,19 +89,6 @@ def linear_seconds(problem, backend: str) -> dict:
 
 def _peak_rss_mb() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
-
-
-def versions() -> dict:
-    """Package versions (those of every result record, plus the linear-algebra packages)."""
-    from .post import versions as base
-
-    out = base()
-    for pkg in ("cvxopt", "pymetis"):
-        try:
-            out[pkg] = metadata.version(pkg)
-        except metadata.PackageNotFoundError:
-            out[pkg] = None
-    return out
 
 
 def machine() -> dict:
@@ -125,7 +106,7 @@ def run_one(case: str, level: int, solver: str, blas_threads: int | None = BLAS_
     ``warm_up`` the same record is computed on level 1 first, so that one-time costs
     (imports, code generation) fall on no measurement (once per process).
     """
-    from . import forms, solve  # noqa: F401  (loads NGSolve and its BLAS before the limit)
+    from .. import forms, solvers  # noqa: F401  (loads NGSolve and its BLAS before the limit)
 
     with threadpool_limits(limits=blas_threads, user_api="blas"):
         if warm_up and (case, solver) not in _WARM:
@@ -138,12 +119,12 @@ def run_one(case: str, level: int, solver: str, blas_threads: int | None = BLAS_
 
 
 def _measure(case: str, level: int, solver: str) -> dict:
-    from .forms import assemble
-    from .mesh import build_mesh
-    from .post import norms
-    from .scene import load_scene
-    from .solvers import solve_problem
-    from .solvers.result import ConvergenceError
+    from ..forms import assemble
+    from ..mesh import build_mesh
+    from ..post import norms
+    from ..scene import load_scene
+    from ..solvers import solve_problem
+    from ..solvers.result import ConvergenceError
 
     scene = load_scene(CASES[case], _overrides(solver))
     start = time.perf_counter()
@@ -189,7 +170,8 @@ def _measure(case: str, level: int, solver: str) -> dict:
 def _run_isolated(case: str, level: int, solver: str, timeout: float | None,
                   blas_threads: int | None) -> dict:
     """:func:`run_one` in a fresh process, so that its peak memory is its own."""
-    cmd = [sys.executable, "-m", "ngdual.bench", case, str(level), solver, str(blas_threads)]
+    cmd = [sys.executable, "-m", "ngdual.studies.bench", case, str(level), solver,
+           str(blas_threads)]
     try:
         out = subprocess.run(cmd, check=True, capture_output=True, text=True, timeout=timeout)
     except subprocess.TimeoutExpired:

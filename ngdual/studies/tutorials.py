@@ -26,7 +26,7 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
-from .io import write_json
+from ..io import write_json
 
 QUICK_ENV = "NGDUAL_QUICK"
 OUT_ENV = "NGDUAL_TUTORIAL_OUT"
@@ -125,7 +125,7 @@ def tutorials_dir() -> Path:
     package folder: the source checkout of an editable install.
     """
     env = os.environ.get(SOURCE_ENV)
-    folder = Path(env) if env else Path(__file__).resolve().parent.parent / "tutorials"
+    folder = Path(env) if env else Path(__file__).resolve().parents[2] / "tutorials"
     if not folder.is_dir():
         raise FileNotFoundError(
             f"no tutorials folder at {folder}: the tutorials ship with the source checkout "

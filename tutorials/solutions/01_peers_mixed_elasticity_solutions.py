@@ -14,7 +14,7 @@ from ngdual.expr import Expression
 from ngdual.forms import Spaces, assemble
 from ngdual.mesh import build_mesh, polygon_mesh
 from ngdual.scene import Material, load_scene
-from ngdual.tutorials import output_dir, quick_mode, save_results
+from ngdual.studies.tutorials import output_dir, quick_mode, save_results
 
 QUICK = quick_mode()
 LEVELS = [1, 2] if QUICK else [1, 2, 3, 4]

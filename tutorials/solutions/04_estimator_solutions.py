@@ -12,7 +12,7 @@ import numpy as np
 from ngdual.estimator import SIGMA_TERMS, U_TERMS, estimate
 from ngdual.scene import Geometry, Loads, Material, Scene, load_scene, validate
 from ngdual.solvers import solve_scene
-from ngdual.tutorials import output_dir, quick_mode, save_results
+from ngdual.studies.tutorials import output_dir, quick_mode, save_results
 
 QUICK = quick_mode()
 LEVELS = [1, 2, 3] if QUICK else [1, 2, 3, 4]

@@ -9,7 +9,7 @@ import numpy as np
 from ngdual import post
 from ngdual.scene import SceneError, load_scene
 from ngdual.solvers import solve_scene
-from ngdual.tutorials import output_dir, quick_mode, save_results
+from ngdual.studies.tutorials import output_dir, quick_mode, save_results
 
 QUICK = quick_mode()
 LEVELS = [1, 2, 3] if QUICK else [1, 2, 3, 4]

@@ -1,0 +1,181 @@
+"""The studies of ``ngdual figures``: named lists of sweep tasks derived from a :class:`Plan`.
+
+A figure script declares the studies it reads (``STUDIES``); :func:`studies` lists every
+one. The tasks are :class:`~ngdual.studies.sweep.Task` of the kinds of
+:mod:`ngdual.studies.sweep.work`; the same solve has the same id wherever it is asked
+for, so the tables and the figures share it.
+"""
+
+from __future__ import annotations
+
+from ..sweep import Task
+from ..variants import UZAWA, setting
+from .plan import (
+    ADAPTIVE_RUNS,
+    GAP_CASES,
+    MANUFACTURED_CASES,
+    PEER_ORDERS,
+    SCENES,
+    TRUTH_ADAPTIVE,
+    TRUTH_PROBLEMS,
+    Plan,
+)
+
+
+def _cost(level: int, friction: bool) -> float:
+    return (4.0 if friction else 1.5) ** level / 50
+
+
+def solve(plan: Plan, problem_or_scene: str, level: int, overrides=(), fields: bool | None = None
+          ) -> Task:
+    """The task solving a scene (a problem key of :data:`SCENES` or a scene name) on ``level``.
+
+    Without overrides, the solve on :attr:`Plan.field_level` keeps the field arrays,
+    so that the tables and the figures share one solve.
+    """
+    scene = SCENES.get(problem_or_scene, problem_or_scene)
+    overrides = list(overrides)
+    if fields is None:
+        fields = not overrides and level == plan.field_level
+    label = f"{scene} L{level}" + (" " + " ".join(overrides) if overrides else "")
+    return Task("solve", {"scene": scene, "level": level, "overrides": overrides,
+                          "fields": bool(fields)}, label,
+                _cost(level, "frictionless" not in scene))
+
+
+def _uzawa(**steps: float) -> list[str]:
+    """The thesis' Uzawa iterations with the steps (rho, rho1, rho2) that differ from 1."""
+    return [UZAWA, *(setting(f"solver.{k}", v) for k, v in steps.items() if v != 1.0)]
+
+
+def rho_tasks(plan: Plan) -> dict[str, dict]:
+    """The rho searches of the Uzawa algorithms: ``frictionless[(level, rho)]`` and
+    ``coulomb[(level, rho1, rho2)]``."""
+    fl = {(lv, r): solve(plan, "frictionless", lv, _uzawa(rho=r))
+          for lv in plan.levels for r in plan.rho_grid}
+    co = {}
+    for lv in plan.levels:
+        pairs = ([(r1, r2) for r1 in plan.rho1_grid for r2 in plan.rho2_grid]
+                 if lv <= plan.rho_level else [(1.0, 1.0), *plan.rho_cross])
+        for r1, r2 in pairs:
+            co[(lv, r1, r2)] = solve(plan, "coulomb", lv, _uzawa(rho1=r1, rho2=r2))
+    return {"frictionless": fl, "coulomb": co}
+
+
+def gap_tasks(plan: Plan) -> dict[str, Task]:
+    """Figs. 3.24-3.28: every case of :data:`GAP_CASES` with both solvers, and
+    ``uzawa-gap0-eps8``: nested Uzawa with eps_2 = 1e-8 (Fig. 3.25)."""
+    out = {}
+    for key, (scene, overrides) in GAP_CASES.items():
+        out[key] = solve(plan, scene, plan.gap_level, overrides, fields=True)
+        out[f"uzawa-{key}"] = solve(plan, scene, plan.uzawa_gap_level, [UZAWA, *overrides],
+                                    fields=True)
+    out["uzawa-gap0-eps8"] = solve(plan, "thesis-3.46-coulomb-gap0", plan.uzawa_gap_level,
+                                   [UZAWA, setting("solver.eps2", 1e-8)], fields=True)
+    return out
+
+
+def adaptive_task(plan: Plan, problem: str, strategy: str) -> Task:
+    """An adaptive run of Section 4.2 (:data:`ADAPTIVE_RUNS`) with its snapshots."""
+    marking, theta, level = ADAPTIVE_RUNS[strategy]
+    refinements = {"max": plan.max_marking_refinements, "fraction": plan.fraction_refinements,
+                   "dorfler": plan.dorfler_refinements}[strategy]
+    snapshots = {"max": plan.max_marking_snapshots,
+                 "fraction": plan.fraction_snapshots}.get(strategy, [])
+    scene = SCENES[problem]
+    return Task("adapt", {"scene": scene, "marking": marking, "theta": theta,
+                          "steps": refinements + 1, "level": level, "overrides": [],
+                          "snapshots": list(snapshots)},
+                f"{scene} {marking} theta={theta}", 4.0 * refinements)
+
+
+def truth_solve(plan: Plan, problem: str, level: int, uzawa: bool = False) -> Task:
+    """A uniform solve of a :data:`TRUTH_PROBLEMS` scene that keeps its sample arrays."""
+    tp = TRUTH_PROBLEMS[problem]
+    overrides = [*tp.overrides, *([UZAWA] if uzawa else [])]
+    return Task("solve", {"scene": tp.scene, "level": level, "overrides": overrides,
+                          "fields": False, "samples": True},
+                f"{tp.scene} L{level} samples" + (" uzawa" if uzawa else ""),
+                _cost(level + 1, problem == "coulomb"))
+
+
+def truth_adapt(plan: Plan, problem: str, strategy: str) -> Task:
+    """An adaptive run of a :data:`TRUTH_PROBLEMS` scene keeping every step's samples, up to
+    the triangles of its finest uniform level."""
+    tp = TRUTH_PROBLEMS[problem]
+    marking, theta = TRUTH_ADAPTIVE[strategy]
+    finest = plan.truth_levels(problem)[-1]
+    return Task("adapt", {"scene": tp.scene, "marking": marking, "theta": theta, "steps": 60,
+                          "level": 1, "overrides": list(tp.overrides), "snapshots": [],
+                          "samples": True, "max_elements": tp.level1_elements * 4 ** (finest - 1)},
+                f"{tp.scene} {strategy} samples", 2.0 * finest)
+
+
+def peer_solve(plan: Plan, problem: str, level: int, order: int) -> Task:
+    """The primal peer on a :data:`TRUTH_PROBLEMS` scene, pressure samples fine enough for
+    the overkill's Gamma_C edges."""
+    tp = TRUTH_PROBLEMS[problem]
+    return Task("peer", {"scene": tp.scene, "level": level, "order": order,
+                         "overrides": list(tp.overrides),
+                         "subdivisions": 2 ** max(plan.overkill_level(problem) - level, 0)},
+                f"{tp.scene} L{level} peer P{order}", _cost(level, False))
+
+
+def peer_levels(plan: Plan, problem: str) -> list[int]:
+    """The peer's levels: those of ngdual and one beyond (an independent check of the
+    overkill)."""
+    levels = plan.truth_levels(problem)
+    return [*levels, levels[-1] + 1]
+
+
+def truth_tasks(plan: Plan, problem: str) -> dict[str, list[Task]]:
+    """Every task of the true-error study of one problem, by method."""
+    levels = plan.truth_levels(problem)
+    out = {"uniform, active set": [truth_solve(plan, problem, lv) for lv in levels],
+           "uniform, Uzawa": [truth_solve(plan, problem, lv, True) for lv in levels]}
+    for strategy in TRUTH_ADAPTIVE:
+        out[f"adaptive {strategy}"] = [truth_adapt(plan, problem, strategy)]
+    for order in PEER_ORDERS:
+        out[f"primal P{order}"] = [peer_solve(plan, problem, lv, order)
+                                   for lv in peer_levels(plan, problem)]
+    return out
+
+
+def reference_tasks(plan: Plan, problem: str) -> list[Task]:
+    """The overkill and the level below it (the Richardson check)."""
+    level = plan.overkill_level(problem)
+    return [truth_solve(plan, problem, level - 1), truth_solve(plan, problem, level)]
+
+
+def manufactured_tasks(plan: Plan) -> dict[str, Task]:
+    """Manufactured cases (exact errors) on uniform levels 1..K-1 and Doerfler theta = 0.5
+    from level 1 (2K steps): the estimator against the truth."""
+    levels = list(range(1, plan.max_level))
+    out = {f"{case}, uniform L{lv}": Task("manufactured", {"case": case, "level": lv},
+                                           f"manufactured {case} L{lv}", 1.5 ** lv / 20)
+           for case in MANUFACTURED_CASES for lv in levels}
+    for case in MANUFACTURED_CASES:
+        out[f"{case}, adaptive"] = Task(
+            "manufactured", {"case": case, "level": 1, "marking": "dorfler", "theta": 0.5,
+                             "steps": 2 * plan.max_level}, f"manufactured {case} dorfler", 5.0)
+    return out
+
+
+def studies(plan: Plan) -> dict[str, list[Task]]:
+    """Every study a script may declare in ``STUDIES``, as lists of tasks."""
+    rho = rho_tasks(plan)
+    out = {
+        "dofs": [Task("dofs", {"scene": SCENES["coulomb"], "level": lv}, f"dofs L{lv}", 0.1)
+                 for lv in plan.levels],
+        "rho-frictionless": list(rho["frictionless"].values()),
+        "rho-coulomb": list(rho["coulomb"].values()),
+        "gaps": list(gap_tasks(plan).values()),
+        "adaptive": [adaptive_task(plan, p, s) for p in SCENES for s in ADAPTIVE_RUNS],
+    }
+    for problem in SCENES:
+        out[f"uniform-{problem}"] = [solve(plan, problem, lv) for lv in plan.levels]
+    out["manufactured"] = list(manufactured_tasks(plan).values())
+    out["truth"] = [t for problem in TRUTH_PROBLEMS for t in
+                    [*reference_tasks(plan, problem),
+                     *(t for ts in truth_tasks(plan, problem).values() for t in ts)]]
+    return out

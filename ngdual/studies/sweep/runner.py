@@ -1,0 +1,138 @@
+"""Running sweeps on a dask.distributed cluster, each task leaving its record on disk.
+
+:class:`Runner` submits the tasks whose record is missing (:func:`~ngdual.studies.sweep.
+records.load_record`) to a ``dask.distributed`` cluster (a ``LocalCluster`` by default,
+any running scheduler by address), longest first, and shows a progress bar; re-running a
+sweep skips every finished task. A worker runs :func:`run_task`: it computes the task
+(:func:`~ngdual.studies.sweep.work.execute`) and writes its record.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterable
+from pathlib import Path
+
+from ..variants import VARIANTS
+from .records import Task, load_record, record_path, remove_stale_temporaries, write_record
+from .work import execute, load_scene_with
+
+WORKER_ENV = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1",
+              "MPLBACKEND": "Agg"}
+
+
+def run_task(task: Task, folder: str) -> tuple[dict, dict]:
+    """Compute ``task`` and write its record into ``folder`` (the function dask runs)."""
+    record, arrays = execute(task)
+    write_record(folder, task, record, arrays)
+    return record, arrays
+
+
+def warm_up() -> None:
+    """Solve a tiny scene with each solver once, so that the first timed task of a worker does
+    not pay for imports and NGSolve's first-call set-up."""
+    from ...solvers import solve_scene
+
+    for variant in ("default", "uzawa"):
+        solve_scene(load_scene_with("thesis-3.46-coulomb", VARIANTS[variant].overrides), 1)
+
+
+class Runner:
+    """Runs sweeps on a dask.distributed cluster, skipping the tasks already on disk.
+
+    Parameters
+    ----------
+    scheduler : str, optional
+        Address of a running scheduler (``tcp://host:8786``); its workers must
+        see the output folder (a shared file system) -- if they do not, the
+        records come back with the results and are written here.
+    workers : int, optional
+        Workers of the LocalCluster started otherwise (default: the CPU count).
+    processes : bool
+        Worker processes (default), or one worker thread in this process
+        (quick to start, what the tests use; one task at a time: netgen and
+        NGSolve must not mesh or assemble in two threads at once).
+    """
+
+    def __init__(self, scheduler: str | None = None, workers: int | None = None,
+                 processes: bool = True, progress: bool | None = None):
+        self.scheduler, self.processes = scheduler, processes
+        self.workers = workers or os.cpu_count() or 1
+        self.progress = progress
+        self._client = self._cluster = None
+        self.failed: dict[str, dict] = {}
+        self.computed = 0
+
+    def client(self):
+        if self._client is None:
+            from dask.distributed import Client, LocalCluster
+
+            if self.scheduler:
+                self._client = Client(self.scheduler)
+            else:
+                self._cluster = LocalCluster(
+                    n_workers=self.workers if self.processes else 1, threads_per_worker=1,
+                    processes=self.processes, dashboard_address=None, memory_limit=0,
+                    **({"env": WORKER_ENV} if self.processes else {}))
+                self._client = Client(self._cluster)
+            self._client.run(warm_up)
+        return self._client
+
+    def close(self) -> None:
+        """Close the client and stop our LocalCluster (a cluster given by address keeps
+        running); connection noise of the shutdown is not logged."""
+        import logging
+
+        quiet = logging.getLogger("distributed")
+        level = quiet.level
+        quiet.setLevel(logging.CRITICAL)
+        try:
+            if self._client is not None:
+                self._client.close()
+            if self._cluster is not None:
+                self._cluster.close()
+        finally:
+            quiet.setLevel(level)
+        self._client = self._cluster = None
+
+    def __enter__(self) -> Runner:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def run(self, tasks: Iterable[Task], folder: str | Path, desc: str = "sweep"
+            ) -> list[dict | None]:
+        """Records of ``tasks`` (None where a task could not finish), computing the missing."""
+        from dask.distributed import as_completed
+        from tqdm import tqdm
+
+        tasks = list(tasks)
+        folder = Path(folder)
+        folder.mkdir(parents=True, exist_ok=True)
+        remove_stale_temporaries(folder)
+        unique = {t.id: t for t in tasks}
+        todo = [t for t in unique.values() if load_record(folder, t) is None]
+        if todo:
+            client = self.client()
+            todo.sort(key=lambda t: -t.cost)
+            futures = {client.submit(run_task, t, str(folder), pure=False,
+                                     priority=len(todo) - i): t for i, t in enumerate(todo)}
+            disable = None if self.progress is None else not self.progress
+            with tqdm(total=len(todo), desc=desc, unit="task", disable=disable) as bar:
+                for future in as_completed(futures):
+                    task = futures[future]
+                    try:
+                        record, arrays = future.result()
+                    except Exception as err:  # noqa: BLE001 - e.g. a worker killed by the OS
+                        record, arrays = {"status": "error", "message": repr(err)}, {}
+                    else:
+                        if not record_path(folder, task).is_file():
+                            write_record(folder, task, record, arrays)
+                    self.computed += 1
+                    if record.get("status") not in ("ok",):
+                        self.failed[task.id] = {"label": task.label, "status": record["status"],
+                                                "message": record.get("message", "")}
+                    bar.set_postfix_str(task.label[:40])
+                    bar.update()
+        return [load_record(folder, t) for t in tasks]
