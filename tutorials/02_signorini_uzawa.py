@@ -39,7 +39,14 @@ from ngdual.solvers.linear import solve_linear
 from ngdual.solvers.projections import NonnegativeProjection, metric_matrix
 from ngdual.solvers.reference import solve_qp
 from ngdual.solvers.uzawa import uzawa
-from ngdual.tutorials import draw, output_dir, quick_mode, save_figure, save_results, show_file
+from ngdual.studies.tutorials import (
+    draw,
+    output_dir,
+    quick_mode,
+    save_figure,
+    save_results,
+    show_file,
+)
 
 # %% [markdown]
 # ## Parameters

@@ -46,7 +46,13 @@ from ngdual.solvers.nested import box_projection, box_projection_qp, nested_uzaw
 from ngdual.solvers.projections import metric_matrix
 from ngdual.solvers.reference import solve_qp_friction
 from ngdual.solvers.result import ConvergenceError
-from ngdual.tutorials import draw, output_dir, quick_mode, save_figure, save_results
+from ngdual.studies.tutorials import (
+    draw,
+    output_dir,
+    quick_mode,
+    save_figure,
+    save_results,
+)
 
 # %% [markdown]
 # ## Parameters

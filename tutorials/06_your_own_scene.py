@@ -31,7 +31,13 @@ from ngdual.cli import main as ngdual_cli
 from ngdual.mesh import mesh_size
 from ngdual.scene import SceneError, load_scene
 from ngdual.solvers import solve_scene
-from ngdual.tutorials import draw, output_dir, quick_mode, save_results, show_file
+from ngdual.studies.tutorials import (
+    draw,
+    output_dir,
+    quick_mode,
+    save_results,
+    show_file,
+)
 
 # %% [markdown]
 # ## Parameters

@@ -14,7 +14,7 @@ from ngdual.scene import load_scene
 from ngdual.solvers.projections import NonnegativeProjection, metric_matrix
 from ngdual.solvers.reference import solve_qp
 from ngdual.solvers.uzawa import uzawa
-from ngdual.tutorials import output_dir, quick_mode, save_results
+from ngdual.studies.tutorials import output_dir, quick_mode, save_results
 
 QUICK = quick_mode()
 LEVELS = [1, 2] if QUICK else [1, 2, 3, 4]

@@ -14,7 +14,7 @@ from ngdual.scene import load_scene
 from ngdual.solvers.nested import nested_uzawa
 from ngdual.solvers.result import ConvergenceError
 from ngdual.solvers.uzawa import uzawa
-from ngdual.tutorials import output_dir, quick_mode, save_results
+from ngdual.studies.tutorials import output_dir, quick_mode, save_results
 
 QUICK = quick_mode()
 LEVEL = 3                                             # the first level with a stick zone
