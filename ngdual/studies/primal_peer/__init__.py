@@ -7,18 +7,10 @@ solver of the work-precision study (``ngdual figures``) and of ``benchmarks/prim
 :mod:`~.cases` (Hertz and Cattaneo-Mindlin against their half-plane solutions).
 """
 
-from .cases import (
-           CattaneoRow,
-           HertzRow,
-           cattaneo_mindlin_case,
-           hertz_case,
-           hertz_mesh,
-           hertz_pressure,
-)
+from .cases import cattaneo_mindlin_case, hertz_case, hertz_mesh, hertz_pressure
 from .nitsche import NewtonError, solve_primal
 from .result import PrimalResult
 from .scenes import primal_samples, solve_scene_primal
 
-__all__ = ["CattaneoRow", "HertzRow", "NewtonError", "PrimalResult", "cattaneo_mindlin_case",
-           "hertz_case", "hertz_mesh", "hertz_pressure", "primal_samples", "solve_primal",
-           "solve_scene_primal"]
+__all__ = ["NewtonError", "PrimalResult", "cattaneo_mindlin_case", "hertz_case", "hertz_mesh",
+           "hertz_pressure", "primal_samples", "solve_primal", "solve_scene_primal"]
