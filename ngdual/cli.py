@@ -342,7 +342,11 @@ def cmd_tutorials(args) -> int:
 
 
 def parser() -> argparse.ArgumentParser:
+    from . import __version__
+
     p = argparse.ArgumentParser(prog="ngdual", description=__doc__.splitlines()[0])
+    p.add_argument("--version", action="version", version=f"ngdual {__version__}",
+                   help="print the version of ngdual and exit")
     p.add_argument("--debug", action="store_true",
                    help="show the Python traceback of any error (for developers)")
     # --debug after the subcommand too; SUPPRESS keeps a value given before it

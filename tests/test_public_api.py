@@ -72,3 +72,9 @@ def test_the_readme_example_solves_example_3_46_with_coulomb_friction():
     force = nd.force_balance(solution, traces).multiplier_force  # on the h~ hats, n = (0, -1)
     assert force[1] > 0 and abs(force[0]) < 1e-9 * force[1]    # the foundation pushes up
     assert traces.lam_n.min() >= -1e-12                      # lambda_n >= 0 (3.62)
+
+
+def test_the_command_line_prints_the_version():
+    out = subprocess.run([sys.executable, "-m", "ngdual", "--version"], capture_output=True,
+                         text=True, check=True).stdout
+    assert out.strip() == f"ngdual {nd.__version__}"
