@@ -22,10 +22,10 @@ import math
 
 import ngsolve as ngs
 
-from .expr import Expression
-from .post import fields
-from .scene import Geometry, Loads, Material, Scene, validate
-from .solvers.result import Solution
+from ..expr import Expression
+from ..post import fields
+from ..scene import Geometry, Loads, Material, Scene, validate
+from ..solvers.result import Solution
 
 OMEGA = 3 * math.pi / 4  # half the interior angle at the re-entrant corner
 POINTS = [(-1, -1), (0, -1), (0, 0), (1, 0), (1, 1), (-1, 1)]
