@@ -25,6 +25,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import os
+import re
 import shutil
 from pathlib import Path
 
@@ -388,6 +389,26 @@ class ApiReference(_GeneratedRst):
         return api_reference_rst()
 
 
+# --- notebook outputs -----------------------------------------------------------------------------
+
+WEBGUI_REPR = re.compile(r"^<?(netgen\.webgui\.)?WebGuiWidget")
+
+
+def drop_webgui_placeholders(app, doctree) -> None:
+    """Remove the text that stands for NGSolve's interactive webgui view in a static page.
+
+    The view needs a live kernel; the tutorials save the same fields as figures, which the
+    pages show. What is left of ``Draw`` in an executed notebook is a placeholder text
+    ("<netgen.webgui.WebGuiWidget>: Run `pip install anywidget` ...").
+    """
+    for block in list(doctree.findall(nodes.literal_block)):
+        if "output" in block["classes"] and WEBGUI_REPR.match(block.astext().strip()):
+            parent = block.parent
+            parent.remove(block)
+            if not parent.children and "cell_output" in parent.get("classes", []):
+                parent.parent.remove(parent)
+
+
 # --- docstrings ----------------------------------------------------------------------------------
 
 def _escape_bars(text: str) -> str:
@@ -445,5 +466,6 @@ def setup(app):
     app.add_directive("ngdual-api-reference", ApiReference)
     app.connect("builder-inited", check_mathjax)
     app.connect("autodoc-process-docstring", escape_docstring_bars)
+    app.connect("doctree-read", drop_webgui_placeholders)
     app.connect("build-finished", copy_mathjax)
     return {"version": "1.0", "parallel_read_safe": True, "parallel_write_safe": True}
