@@ -106,7 +106,7 @@ def _chains(mesh: ngs.Mesh, labels: list[str]) -> list[Chain]:
     for a, b in segments:
         neighbours.setdefault(a, []).append(b)
         neighbours.setdefault(b, []).append(a)
-    coords = {v.nr: v.point for v in mesh.vertices}
+    coords = mesh.ngmesh.Coordinates()  # (nv, 2), in the vertex numbers of NGSolve
     unvisited, chains = set(neighbours), []
     while unvisited:
         ends = sorted(v for v in unvisited if len(neighbours[v]) == 1)
@@ -123,7 +123,7 @@ def _chains(mesh: ngs.Mesh, labels: list[str]) -> list[Chain]:
         closed = not ends
         verts = np.array(order)
         ccw = (order[0], order[1]) in directed
-        chains.append(Chain(verts, np.array([coords[v] for v in verts]), closed, ccw))
+        chains.append(Chain(verts, coords[verts], closed, ccw))
     return chains
 
 

@@ -26,8 +26,15 @@ from .boundary import BoundaryMeshes, CoarseMesh
 from .contact import ContactBoundary, gap_coefficient, trace_space
 from .expr import Expression
 from .scene import Scene
+from .sparse import to_scipy
 
 TRACE_BONUS_ORDER = 6
+# The volume integrands of a~, b and s are polynomials of degree <= 4 on every (affine)
+# triangle: sigma, tau are RT_0 (degree 1) plus Curl of a cubic bubble (degree 2), u is
+# constant, eta linear. The 6-point rule of degree 4 integrates them exactly; NGSolve's
+# default (degree 6, twice the order 3 of the bubble space) gives the same matrix to
+# round-off with twice the points.
+EXACT_VOLUME_RULES = {ngs.TRIG: ngs.IntegrationRule(ngs.TRIG, 4)}
 
 
 def boundary_regex(labels: list[str]) -> str:
@@ -40,9 +47,17 @@ def _trace_space(mesh: ngs.Mesh, labels: list[str]) -> ngs.FESpace:
 
 
 def _vertex_dof(space: ngs.FESpace):
-    def dof(v: int) -> int:
-        return space.GetDofNrs(ngs.NodeId(ngs.VERTEX, v))[0]
-    return dof
+    """The map fine vertex -> its dof in the P1 trace ``space`` of a boundary part.
+
+    Read once from the boundary elements by ``ElementId``: ``GetDofNrs`` of a compressed
+    space per vertex ``NodeId`` costs 0.1-0.3 ms a call, seconds on level 8.
+    """
+    dofs = {}
+    for el in space.mesh.Elements(ngs.BND):
+        for v, d in zip(el.vertices, space.GetDofNrs(ngs.ElementId(ngs.BND, el.nr))):
+            if d >= 0:
+                dofs[v.nr] = d
+    return dofs.__getitem__
 
 
 @dataclass
@@ -72,10 +87,11 @@ class Spaces:
             neumann = coarse.neumann
             space = _trace_space(mesh, scene.labels("neumann"))
             comps["phi1"] = comps["phi2"] = space
-            prolong["phi1"] = prolong["phi2"] = neumann.p1_prolongation(_vertex_dof(space),
+            dof_of_vertex = _vertex_dof(space)
+            prolong["phi1"] = prolong["phi2"] = neumann.p1_prolongation(dof_of_vertex,
                                                                         space.ndof)
             end_hats["phi1"] = end_hats["phi2"] = neumann.p1_prolongation(
-                _vertex_dof(space), space.ndof, ends=True)
+                dof_of_vertex, space.ndof, ends=True)
         gamma_c = None
         if scene.has_contact:
             contact = coarse.contact
@@ -184,9 +200,10 @@ def _forms(scene: Scene, fes: ngs.FESpace, names: list[str]):
     sig, div_sig, trac_sig, u, eta = parts(trial)
     tau, div_tau, trac_tau, v, xi = parts(test)
     a = ngs.BilinearForm(fes)
-    a += ngs.InnerProduct(peers.compliance(sig, lam, mu), tau) * ngs.dx      # a~(sigma, tau)
-    a += (u * div_tau + v * div_sig) * ngs.dx                                 # b(u, tau)
-    a += (eta * peers.asym(tau) + xi * peers.asym(sig)) * ngs.dx              # s(eta, tau)
+    dx = ngs.dx(intrules=EXACT_VOLUME_RULES)
+    a += ngs.InnerProduct(peers.compliance(sig, lam, mu), tau).Compile() * dx  # a~(sigma, tau)
+    a += (u * div_tau + v * div_sig).Compile() * dx                            # b(u, tau)
+    a += (eta * peers.asym(tau) + xi * peers.asym(sig)).Compile() * dx         # s(eta, tau)
     rhs = ngs.LinearForm(fes)
     f = ngs.CF(tuple(Expression(e).coefficient() for e in scene.loads.body_force))
     rhs += -f * v * ngs.dx                                                    # -f(v)
@@ -210,12 +227,6 @@ def _forms(scene: Scene, fes: ngs.FESpace, names: list[str]):
     return a, rhs
 
 
-def _to_scipy(mat) -> sp.csr_matrix:
-    rows, cols, vals = mat.COO()
-    return sp.csr_matrix((np.asarray(vals), (np.asarray(rows), np.asarray(cols))),
-                         shape=(mat.height, mat.width))
-
-
 def assemble(scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes | None = None
              ) -> DiscreteProblem:
     """Assemble the block system of (3.62) for ``scene`` on ``mesh`` (``coarse``: see Spaces)."""
@@ -235,13 +246,33 @@ def assemble(scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes | None = None
         blocks[name] = slice(offset, offset + p.shape[1])
         offset += p.shape[1]
     P = sp.block_diag(blocks_p, format="csr")
-    K_fine = _to_scipy(a.mat)
-    K = (P.T @ K_fine @ P).tocsr()
+    K_fine = to_scipy(a.mat)
+    prolonged = [spaces.prolongations[c] for c in names if c in spaces.prolongations]
+    if prolonged:  # the prolonged multipliers come last (Spaces.build)
+        K = galerkin_restriction(K_fine, sp.block_diag(prolonged, format="csr"),
+                                 fes.ndof - sum(p.shape[0] for p in prolonged))
+    else:
+        K = K_fine.copy()
     K.eliminate_zeros()
     lift = _end_lift(scene, spaces, fes, names)
     F = P.T @ (rhs.vec.FV().NumPy() - K_fine @ lift)
     return DiscreteProblem(scene, spaces, fes, names, P, K, F, blocks, lift,
                            time.perf_counter() - start)
+
+
+def galerkin_restriction(K_fine: sp.csr_matrix, P_R: sp.csr_matrix, n: int) -> sp.csr_matrix:
+    """P^T K_fine P for P = diag(I_n, P_R): the first ``n`` unknowns are not prolonged.
+
+    Only the multipliers on the boundary (O(N^{1/2}) fine dofs, after the PEERS unknowns)
+    are prolonged; their rows and columns go through sparse products while the PEERS block
+    K_fine[:n, :n] (nearly all the nonzeros) is kept as it is. A product with the whole
+    prolongation would multiply all of K_fine twice.
+    """
+    coupling = K_fine[:n, n:] @ P_R
+    bottom = P_R.T @ K_fine[n:]
+    bottom = sp.hstack([bottom[:, :n], bottom[:, n:] @ P_R], format="csr")
+    top = sp.hstack([K_fine[:n, :n], coupling], format="csr")
+    return sp.vstack([top, bottom], format="csr")
 
 
 def _end_lift(scene: Scene, spaces: Spaces, fes: ngs.FESpace, names: list[str]) -> np.ndarray:

@@ -13,7 +13,7 @@ from __future__ import annotations
 import ngsolve as ngs
 import numpy as np
 from netgen.geom2d import SplineGeometry
-from netgen.meshing import Element1D, Element2D, FaceDescriptor, MeshPoint, Pnt
+from netgen.meshing import Element1D, FaceDescriptor
 from netgen.meshing import Mesh as NetgenMesh
 
 from . import geometry
@@ -34,21 +34,27 @@ def thesis_mesh(level: int) -> ngs.Mesh:
     nx, ny = 8 * k, 2 * k
     xs, ys = np.linspace(-4, 4, nx + 1), np.linspace(-1, 1, ny + 1)
     m = NetgenMesh(dim=2)
-    pid = [[m.Add(MeshPoint(Pnt(xs[i], ys[j], 0))) for j in range(ny + 1)] for i in range(nx + 1)]
+    # points column by column (x outer, y inner) and two triangles per square in the same
+    # order, added as arrays: a Python loop over the 1.6e6 triangles of level 8 takes seconds
+    x, y = np.meshgrid(xs, ys, indexing="ij")
+    m.AddPoints(np.column_stack([x.ravel(), y.ravel(), np.zeros(x.size)]))
     m.Add(FaceDescriptor(surfnr=1, domin=1, domout=0, bc=1))
     m.SetMaterial(1, "body")
-    for i in range(nx):
-        for j in range(ny):
-            a, b, c, d = pid[i][j], pid[i + 1][j], pid[i + 1][j + 1], pid[i][j + 1]
-            m.Add(Element2D(1, [a, b, c]))
-            m.Add(Element2D(1, [a, c, d]))
+    corner = np.arange(x.size).reshape(nx + 1, ny + 1)
+    a, b, c, d = corner[:-1, :-1], corner[1:, :-1], corner[1:, 1:], corner[:-1, 1:]
+    triangles = np.stack([np.stack([a, b, c], axis=-1), np.stack([a, c, d], axis=-1)], axis=2)
+    m.AddElements(dim=2, index=1, data=triangles.reshape(-1, 3).astype(np.int32), base=0)
+
+    def pid(i: int, j: int) -> int:
+        return int(corner[i, j]) + 1  # netgen numbers points from 1
+
     # counter-clockwise segments, so the body lies to their left
     for i in range(nx):
-        m.Add(Element1D([pid[i][0], pid[i + 1][0]], index=1))
-        m.Add(Element1D([pid[i + 1][ny], pid[i][ny]], index=3))
+        m.Add(Element1D([pid(i, 0), pid(i + 1, 0)], index=1))
+        m.Add(Element1D([pid(i + 1, ny), pid(i, ny)], index=3))
     for j in range(ny):
-        m.Add(Element1D([pid[nx][j], pid[nx][j + 1]], index=2))
-        m.Add(Element1D([pid[0][j + 1], pid[0][j]], index=4))
+        m.Add(Element1D([pid(nx, j), pid(nx, j + 1)], index=2))
+        m.Add(Element1D([pid(0, j + 1), pid(0, j)], index=4))
     for index, label in enumerate(THESIS_LABELS, start=1):
         m.SetBCName(index - 1, label)
     return ngs.Mesh(m)
