@@ -152,9 +152,9 @@ plot_meshes([(level2, marked_sets[s], f"{s}, theta = {examples[s]}: {marked_sets
 # σ ∈ H^{α−ε}: uniform refinement gives e ~ h^α ~ N^{−α/2}.
 
 # %%
-# The exact solution is in `ngdual.verification.corner` (read its source: Williams' formulas written as
-# scene expressions in x and y), with the scene and the exact error of PEERS,
-# (‖σ − σ_h‖² + ‖div σ_h‖² + ‖u − u_h‖² + ‖η − η_h‖²)^{1/2}.
+# The exact solution is in `ngdual.verification.corner` (read its source: Williams'
+# formulas written as scene expressions in x and y), with the scene and the exact error of
+# PEERS, (‖σ − σ_h‖² + ‖div σ_h‖² + ‖u − u_h‖² + ‖η − η_h‖²)^{1/2}.
 
 # %%
 l_shape = corner.l_shape_scene()

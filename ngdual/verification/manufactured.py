@@ -59,6 +59,7 @@ from ..expr import Expression
 from ..friction import hat_projection
 from ..mesh import mesh_size
 from ..post import contact_traces, fields, friction_diagnostics
+from ..rates import observed_rates
 from ..scene import Contact, Friction, Geometry, Loads, Material, Scene, Solver, validate
 from ..solvers import solve_scene
 from ..solvers.result import Solution
@@ -484,16 +485,10 @@ def manufactured_study(case: ManufacturedCase | str, levels=(1, 2, 3, 4, 5),
 
 
 def convergence_orders(rows: list[dict], key: str) -> list[float | None]:
-    """Observed orders log(e_{k-1}/e_k) / log(h_{k-1}/h_k) of ``key``; None for the first
-    row and where an error is zero or missing."""
-    out: list[float | None] = [None]
-    for prev, row in zip(rows, rows[1:]):
-        e0, e1 = prev.get(key), row.get(key)
-        if not e0 or not e1:
-            out.append(None)
-        else:
-            out.append(math.log(e0 / e1) / math.log(prev["h"] / row["h"]))
-    return out
+    """Observed orders of ``key`` between consecutive rows: the one rate of ngdual,
+    :func:`ngdual.rates.observed_rates` (the order in h_N = N^{-1/2}, N = ``ndof``); None for
+    the first row and where an error is zero or missing."""
+    return observed_rates([row["ndof"] for row in rows], [row.get(key) for row in rows])
 
 
 def format_study(rows: list[dict], quantities=QUANTITIES) -> str:

@@ -10,6 +10,7 @@ import subprocess
 from pathlib import Path
 
 from ngdual import post
+from ngdual.io import versions
 from ngdual.scene import load_scene, shipped_scenes
 from ngdual.solvers import solve_scene
 
@@ -19,7 +20,7 @@ LEVELS = (1, 2, 3, 4)
 def main() -> None:
     commit = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True,
                             cwd=Path(__file__).parent).stdout.strip()
-    out = {"commit": commit, "versions": post.versions(), "norms": {}}
+    out = {"commit": commit, "versions": versions(), "norms": {}}
     for name in shipped_scenes():
         for level in LEVELS:
             solution = solve_scene(load_scene(name), level)
