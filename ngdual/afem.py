@@ -185,8 +185,11 @@ def step_record(step: int, solution: Solution, indicators: Estimate,
                 reference: dict | None = None) -> dict:
     """The history entry of one adaptive step (plain JSON-serialisable data).
 
-    ``eta_terms[k]`` is (sum_T term_k,T)^{1/2}, so ``eta``^2 is the sum of their
-    squares; ``eta_sum`` is sum_T eta_{tot,T} (the eta_tot of Table 4.4).
+    ``estimator`` is eta = (sum_T eta_{tot,T}^2)^{1/2} of (4.50); ``estimator_terms[k]`` is
+    (sum_T term_k,T)^{1/2}, so ``estimator``^2 is the sum of their squares;
+    ``estimator_sum`` is sum_T eta_{tot,T} (the eta_tot of Table 4.4). (The records of
+    ngdual < 0.2 called these ``eta``, ``eta_sum``, ...; ``eta`` is the rotation's name in
+    ``norms``. :func:`ngdual.studies.sweep.records.estimator` reads both.)
     """
     pb = solution.problem
     mesh = pb.fes.mesh
@@ -200,10 +203,10 @@ def step_record(step: int, solution: Solution, indicators: Estimate,
         "dofs": {**dofs, "total": int(sum(dofs.values()))},
         "converged": bool(solution.converged),
         "iterations": {k: int(v) for k, v in solution.iterations.items()},
-        "eta": indicators.total,
-        "eta_sum": indicators.total_sum,
-        "eta_max": float(indicators.eta.max()),
-        "eta_terms": {k: float(np.sqrt(v)) for k, v in indicators.summed().items()},
+        "estimator": indicators.total,
+        "estimator_sum": indicators.total_sum,
+        "estimator_max": float(indicators.eta.max()),
+        "estimator_terms": {k: float(np.sqrt(v)) for k, v in indicators.summed().items()},
         "asymmetry_norm": indicators.asymmetry,
         "norms": norms(solution),
         "marked": 0,

@@ -207,7 +207,7 @@ def cmd_adapt(args) -> int:
         write_json(run, out / "history.json")
         effectivity = record.get("effectivity")
         print(f"step {record['step']:3d}  dofs {record['dofs']['total']:8d}  "
-              f"eta {record['eta']:.4e}" + (f"  e_tot {record['e_tot']:.4e}  eta/e_tot "
+              f"estimator {record['estimator']:.4e}" + (f"  e_tot {record['e_tot']:.4e}  eta/e_tot "
                                            f"{effectivity:.3f}" if effectivity else "")
               + f"  marked {record['marked']}")
 

@@ -155,7 +155,8 @@ def l_shape_runs():
         rows = []
 
         def on_step(record, solution, estimate, marked, rows=rows):
-            rows.append((record["dofs"]["total"], exact_error(solution, exact), record["eta"]))
+            rows.append((record["dofs"]["total"], exact_error(solution, exact),
+                         record["estimator"]))
 
         adapt(scene, marking, theta, steps, level=1, asymmetry="l2", on_step=on_step)
         runs[name] = rows
@@ -227,9 +228,9 @@ def test_thesis_strategies_run_on_example_3_46_coulomb(marking, theta, level):
     for record, (eta, marked, tilde, hat) in zip(history, captured):
         assert record["converged"]
         assert record["e_tot"] > 0 and record["effectivity"] == pytest.approx(
-            record["eta"] / record["e_tot"])
-        assert record["eta"] == pytest.approx(math.sqrt(sum(v**2 for v in
-                                                            record["eta_terms"].values())))
+            record["estimator"] / record["e_tot"])
+        assert record["estimator"] == pytest.approx(math.sqrt(sum(v**2 for v in
+                                                            record["estimator_terms"].values())))
         assert set(record["timings_s"]) == {"assemble", "solve", "estimate", "mark", "refine"}
         assert hat <= tilde
         if marked is not None:

@@ -159,7 +159,7 @@ def check_adaptivity(r: dict) -> None:
     assert max(dorfler) / min(dorfler) <= 3, dorfler
     for name, history in r["thesis"].items():
         assert all(step["converged"] for step in history), name
-        assert history[-1]["eta"] < history[0]["eta"], name
+        assert history[-1]["estimator"] < history[0]["estimator"], name
         assert all(b["elements"] > a["elements"] for a, b in zip(history, history[1:])), name
         assert all(step["e_tot"] > 0 for step in history), name
 

@@ -38,6 +38,7 @@ from ngdual.scene import load_scene
 from ngdual.solvers.linear import solve_linear
 from ngdual.solvers.projections import NonnegativeProjection, metric_matrix
 from ngdual.solvers.reference import solve_qp
+from ngdual.solvers.settings import Model, UzawaSettings
 from ngdual.solvers.uzawa import uzawa
 from ngdual.studies.tutorials import (
     draw,
@@ -149,7 +150,8 @@ for key, value in projection_check.items():
 runs = {}
 for metric in METRICS:
     for rho in RHOS:
-        solution = uzawa(problem, rho=rho, eps=EPS, metric=metric, max_iter=MAX_ITER)
+        solution = uzawa(problem, UzawaSettings.from_scene(scene, rho=rho, eps=EPS, metric=metric,
+                                                           max_iter=MAX_ITER))
         runs[(metric, rho)] = solution
         print(f"metric {metric:9s} rho = {rho:4.2f}: {solution.iterations['outer']:4d} "
               f"iterations, converged {solution.converged}")
@@ -174,7 +176,8 @@ save_figure(fig, OUT / "uzawa_histories.png")
 # answer. Where "too large" begins depends on the mesh: on level 4, ρ = 2 already stalls.
 
 # %%
-overshoot = uzawa(problem, rho=TOO_LARGE_RHO, eps=EPS, metric="h12", max_iter=200)
+overshoot = uzawa(problem, UzawaSettings.from_scene(scene, rho=TOO_LARGE_RHO, eps=EPS, metric="h12",
+                                                    max_iter=200))
 print(f"rho = {TOO_LARGE_RHO}: converged {overshoot.converged} after "
       f"{overshoot.iterations['outer']} iterations, last increment {overshoot.history[-1]:.1e}")
 
@@ -192,7 +195,8 @@ by_level = {metric: [] for metric in METRICS}
 for level in REFINEMENT_LEVELS:
     refined = assemble(scene, build_mesh(scene.geometry, level))
     for metric in METRICS:
-        by_level[metric].append(uzawa(refined, rho=1.0, eps=EPS, metric=metric)
+        by_level[metric].append(uzawa(refined, UzawaSettings.from_scene(scene, rho=1.0, eps=EPS,
+                                                                        metric=metric))
                                 .iterations["outer"])
     print(f"level {level}: iterations h12 {by_level['h12'][-1]:4d}, "
           f"euclidean {by_level['euclidean'][-1]:4d}")
@@ -215,8 +219,8 @@ save_figure(fig, OUT / "iterations_per_level.png")
 # cvxpy and shares nothing with the Uzawa loop but the matrices. Both must agree.
 
 # %%
-tight = uzawa(problem, rho=1.0, eps=EPS_COMPARE, metric="h12")
-reference = solve_qp(problem)
+tight = uzawa(problem, UzawaSettings.from_scene(scene, rho=1.0, eps=EPS_COMPARE, metric="h12"))
+reference = solve_qp(problem, Model.of(scene))
 
 
 def relative_difference(a, b):

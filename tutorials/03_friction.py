@@ -46,13 +46,8 @@ from ngdual.solvers.nested import box_projection, box_projection_qp, nested_uzaw
 from ngdual.solvers.projections import metric_matrix
 from ngdual.solvers.reference import solve_qp_friction
 from ngdual.solvers.result import ConvergenceError
-from ngdual.studies.tutorials import (
-    draw,
-    output_dir,
-    quick_mode,
-    save_figure,
-    save_results,
-)
+from ngdual.solvers.settings import Model, NestedUzawaSettings
+from ngdual.studies.tutorials import draw, output_dir, quick_mode, save_figure, save_results
 
 # %% [markdown]
 # ## Parameters
@@ -122,7 +117,8 @@ print(f"P^Lambda: |cvxpy QP - clip(b / M, -1, 1)| = {box_qp_difference:.1e}")
 # It stops only when the increments *and* the residual of ν λ_t = |λ_t| are below ε₂.
 
 # %%
-tresca_runs = {order: nested_uzawa(problem_t, "tresca", eps1=EPS1, eps2=EPS2, loop_order=order)
+tresca_runs = {order: nested_uzawa(problem_t, NestedUzawaSettings.from_scene(
+                   tresca, eps1=EPS1, eps2=EPS2, loop_order=order))
                for order in LOOP_ORDERS}
 for order, solution in tresca_runs.items():
     print(f"Tresca, {order:14s}: {solution.iterations['outer']:4d} outer, "
@@ -168,7 +164,7 @@ def compare(nested, qp) -> dict:
             "nu": float(np.max(np.abs(nested.nu - qp.nu)[relevant]))}
 
 
-qp_tresca = solve_qp_friction(problem_t, "tresca")
+qp_tresca = solve_qp_friction(problem_t, Model.of(tresca))
 agreement = {"tresca": compare(tresca_runs["friction-outer"], qp_tresca)}
 print("nested Uzawa vs QP, Tresca:", {k: f"{v:.1e}" for k, v in agreement["tresca"].items()})
 
@@ -185,8 +181,8 @@ print("nested Uzawa vs QP, Tresca:", {k: f"{v:.1e}" for k, v in agreement["tresc
 # `ngdual.scene.Friction.normal_stress`.)
 
 # %%
-coulomb_runs = {order: nested_uzawa(problem_c, "coulomb", mu_f=mu_f, eps1=EPS1, eps2=EPS2,
-                                    loop_order=order)
+coulomb_runs = {order: nested_uzawa(problem_c, NestedUzawaSettings.from_scene(
+                    coulomb, eps1=EPS1, eps2=EPS2, loop_order=order))
                 for order in LOOP_ORDERS}
 for order, solution in coulomb_runs.items():
     print(f"Coulomb mu_f = {mu_f}, {order:14s}: {solution.iterations['outer']:4d} outer, "
@@ -212,7 +208,7 @@ print(f"max |F(sigma_n) - F| / max F = {fixed_point_residual:.1e}")
 # a genuinely *third* loop. Its history shows how fast the fixed point contracts.
 
 # %%
-qp_coulomb = solve_qp_friction(problem_c, "coulomb", mu_f)
+qp_coulomb = solve_qp_friction(problem_c, Model.of(coulomb))
 agreement["coulomb"] = compare(coulomb_solution, qp_coulomb)
 print(f"QP fixed point: {len(qp_coulomb.history)} QPs, changes of F: "
       f"{np.array2string(np.array(qp_coulomb.history), precision=1)}")
@@ -441,7 +437,7 @@ for level in GAP0_LEVELS:
     for factor, scene in gap0.items():
         problem = assemble(scene, build_mesh(scene.geometry, level))
         try:
-            solution = nested_uzawa(problem, "coulomb", mu_f=scene.friction.mu)
+            solution = nested_uzawa(problem, NestedUzawaSettings.from_scene(scene))
             gap0_runs[factor].append({"level": level, "outer": solution.iterations["outer"],
                                       "inner": solution.iterations["inner"],
                                       "converged": solution.converged})

@@ -192,7 +192,7 @@ l_runs = {name: run(l_shape, marking, theta, steps, error=exact_error)
 l_rates = {}
 for name, kept in l_runs.items():
     ndofs = [r["dofs"]["total"] for r in kept["history"]]
-    etas = [r["eta"] for r in kept["history"]]
+    etas = [r["estimator"] for r in kept["history"]]
     l_rates[name] = {"error": fitted_rate(ndofs[-3:], kept["errors"][-3:]),
                      "eta": fitted_rate(ndofs[-3:], etas[-3:])}
     print(f"{name:8s}: {len(ndofs)} steps, N = {ndofs[0]} .. {ndofs[-1]}, error "
@@ -211,7 +211,7 @@ fig, ax = plt.subplots(figsize=(7, 5))
 for (name, kept), colour in zip(l_runs.items(), ("k", "tab:blue", "tab:orange", "tab:green")):
     ndofs = [r["dofs"]["total"] for r in kept["history"]]
     ax.loglog(ndofs, kept["errors"], "o-", color=colour, label=f"error, {name}")
-    ax.loglog(ndofs, [r["eta"] for r in kept["history"]], "s--", color=colour, ms=4,
+    ax.loglog(ndofs, [r["estimator"] for r in kept["history"]], "s--", color=colour, ms=4,
               label=f"η, {name}")
 n_ref = np.array([l_runs["uniform"]["history"][0]["dofs"]["total"], 2e4])
 e_ref = l_runs["uniform"]["errors"][0]
@@ -225,7 +225,7 @@ ax.grid(True, which="both", alpha=0.3)
 ax.legend(fontsize=7, ncol=2)
 save_figure(fig, OUT / "l_shape_convergence.png")
 
-effectivity_l = {name: [r["eta"] / e for r, e in zip(kept["history"], kept["errors"])]
+effectivity_l = {name: [r["estimator"] / e for r, e in zip(kept["history"], kept["errors"])]
                  for name, kept in l_runs.items()}
 for name, values in effectivity_l.items():
     print(f"{name:8s} effectivity eta/e: [{min(values):.2f}, {max(values):.2f}]")
@@ -259,7 +259,7 @@ print(f"{'run':9s} {'step':>4} {'elements':>8} {'Dof':>6} {'eta':>10} {'e_tot':>
 for name, kept in thesis_runs.items():
     for r in kept["history"]:
         print(f"{name:9s} {r['step']:4d} {r['elements']:8d} {r['dofs']['total']:6d} "
-              f"{r['eta']:10.3e} {r['e_tot']:10.3e} {r['effectivity']:9.3f} {r['marked']:6d}")
+              f"{r['estimator']:10.3e} {r['e_tot']:10.3e} {r['effectivity']:9.3f} {r['marked']:6d}")
 
 # %% [markdown]
 # e_tot jumps up and down from step to step: a difference of norms can be small by
@@ -270,7 +270,7 @@ for name, kept in thesis_runs.items():
 
 # %%
 for name, kept in thesis_runs.items():
-    terms = kept["history"][-1]["eta_terms"]
+    terms = kept["history"][-1]["estimator_terms"]
     total = sum(v**2 for v in terms.values())
     leading = sorted(terms, key=lambda k: -terms[k])[:3]
     print(f"{name:9s}: " + ", ".join(f"{k} {100 * terms[k] ** 2 / total:.0f} %" for k in leading))
@@ -287,7 +287,8 @@ plot_meshes(panels, OUT / "thesis_meshes.png",
 fig, ax = plt.subplots(figsize=(7, 4.5))
 for (name, kept), colour in zip(thesis_runs.items(), ("tab:blue", "tab:orange", "tab:green")):
     ndofs = [r["dofs"]["total"] for r in kept["history"]]
-    ax.loglog(ndofs, [r["eta"] for r in kept["history"]], "s-", color=colour, label=f"η, {name}")
+    ax.loglog(ndofs, [r["estimator"] for r in kept["history"]], "s-", color=colour,
+              label=f"η, {name}")
     ax.loglog(ndofs, [r["e_tot"] for r in kept["history"]], "o:", color=colour,
               label=f"e_tot (3.124), {name}")
 ax.set_xlabel("degrees of freedom N")
@@ -322,7 +323,7 @@ results = {
     "marking_share": {s: float(np.sum(eta[m] ** 2) / np.sum(eta**2))
                       for s, m in marked_sets.items()},
     "l_shape": {name: {"ndofs": [r["dofs"]["total"] for r in kept["history"]],
-                       "errors": kept["errors"], "etas": [r["eta"] for r in kept["history"]],
+                       "errors": kept["errors"], "etas": [r["estimator"] for r in kept["history"]],
                        "rates": l_rates[name], "effectivity": effectivity_l[name]}
                 for name, kept in l_runs.items()},
     "thesis": {name: [{k: r[k] for k in ("step", "elements", "eta", "e_tot", "effectivity",

@@ -31,13 +31,7 @@ from ngdual.cli import main as ngdual_cli
 from ngdual.mesh import mesh_size
 from ngdual.scene import SceneError, load_scene
 from ngdual.solvers import solve_scene
-from ngdual.studies.tutorials import (
-    draw,
-    output_dir,
-    quick_mode,
-    save_results,
-    show_file,
-)
+from ngdual.studies.tutorials import draw, output_dir, quick_mode, save_results, show_file
 
 # %% [markdown]
 # ## Parameters
@@ -87,7 +81,6 @@ gap = "0.001 + 0.05*x*x"                 # a convex foundation below the base
 
 [solver]
 metric = "h12"
-rho = 1.0
 """
 scene_file = OUT / "stamp.toml"
 scene_file.write_text(SCENE)

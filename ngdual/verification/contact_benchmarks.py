@@ -213,7 +213,7 @@ def adaptive_study(name: str, steps: int = 4, level: int = 1, theta: float = 0.5
         row = ROWS[name](solution)
         # graded meshes: orders against N^(-1/2), the mesh size of a uniform mesh with N dofs
         rows.append({"benchmark": name, "level": record["step"], **row,
-                     "h": row["ndof"] ** -0.5, "eta": record["eta"],
+                     "h": row["ndof"] ** -0.5, "estimator": record["estimator"],
                      "seconds": float(sum(record["timings_s"].values()))})
 
     adapt(BENCHMARKS[name].load(), marking="dorfler", theta=theta, steps=steps, level=level,

@@ -13,6 +13,7 @@ from ngdual.mesh import build_mesh
 from ngdual.scene import load_scene
 from ngdual.solvers.projections import NonnegativeProjection, metric_matrix
 from ngdual.solvers.reference import solve_qp
+from ngdual.solvers.settings import Model, UzawaSettings
 from ngdual.solvers.uzawa import uzawa
 from ngdual.studies.tutorials import output_dir, quick_mode, save_results
 
@@ -36,7 +37,8 @@ for metric in ("h12", "euclidean"):
     for level, problem in problems.items():
         counts = {}
         for rho in RHOS:
-            solution = uzawa(problem, rho=float(rho), eps=1e-8, metric=metric, max_iter=500)
+            solution = uzawa(problem, UzawaSettings.from_scene(
+                scene, rho=float(rho), eps=1e-8, metric=metric, max_iter=500))
             counts[float(rho)] = solution.iterations["outer"] if solution.converged else np.inf
         best = min(counts, key=counts.get)
         optimal[f"{metric}-{level}"] = {"rho": best, "iterations": int(counts[best])}
@@ -83,7 +85,8 @@ for level, problem in problems.items():
     modulus = problem.scene.material.plane_strain_modulus
     its, converged = uzawa_by_hand(problem, modulus / 2 * mass / contact.edge_lengths().mean())
     check, _ = uzawa_by_hand(problem, metric_matrix(contact, modulus, "h12"))
-    h12 = uzawa(problem, rho=1.0, eps=1e-8, metric="h12").iterations["outer"]
+    h12 = uzawa(problem, UzawaSettings.from_scene(scene, rho=1.0, eps=1e-8, metric="h12")
+                ).iterations["outer"]
     mass_iterations.append(its)
     hand_vs_ngdual.append((check, h12))
     print(f"level {level}: mass metric {its} iterations (converged {converged}); h12 {h12} "
@@ -103,7 +106,8 @@ for gap in ("abs(x)", "0.005 + 0.002*x*x"):
     variant = load_scene("thesis-3.46-frictionless", [f"contact.gap='{gap}'"])
     problem = assemble(variant, build_mesh(variant.geometry, 3 if QUICK else 4))
     nodes = [post.contact_summary(s)["nodes_in_contact"]
-             for s in (uzawa(problem, eps=1e-10), solve_qp(problem))]
+             for s in (uzawa(problem, UzawaSettings.from_scene(variant, eps=1e-10)),
+                       solve_qp(problem, Model.of(variant)))]
     gaps[gap] = nodes
     print(f"g = {gap:18s}: nodes in contact, Uzawa {nodes[0]}, QP {nodes[1]}")
 

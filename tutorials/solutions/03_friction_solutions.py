@@ -13,6 +13,7 @@ from ngdual.mesh import build_mesh
 from ngdual.scene import load_scene
 from ngdual.solvers.nested import nested_uzawa
 from ngdual.solvers.result import ConvergenceError
+from ngdual.solvers.settings import NestedUzawaSettings, UzawaSettings
 from ngdual.solvers.uzawa import uzawa
 from ngdual.studies.tutorials import output_dir, quick_mode, save_results
 
@@ -31,7 +32,7 @@ problem = assemble(coulomb, build_mesh(coulomb.geometry, LEVEL))
 def attempt(**options):
     """(outer, inner, converged) of one nested Uzawa run; ConvergenceError counts as failed."""
     try:
-        solution = nested_uzawa(problem, "coulomb", mu_f=coulomb.friction.mu, **options)
+        solution = nested_uzawa(problem, NestedUzawaSettings.from_scene(coulomb, **options))
         return solution.iterations["outer"], solution.iterations["inner"], solution.converged
     except ConvergenceError as error:
         return len(error.history), None, False
@@ -80,7 +81,7 @@ gap_abs = {}
 for factor in (1, 2):
     scene = load_scene("thesis-3.46-coulomb-gap-abs", [f"contact.hhat_factor={factor}"])
     gap_abs[factor] = nested_uzawa(assemble(scene, build_mesh(scene.geometry, GAP_ABS_LEVEL)),
-                                   "coulomb", mu_f=scene.friction.mu, eps2=1e-8)
+                                   NestedUzawaSettings.from_scene(scene, eps2=1e-8))
 a, b = gap_abs[1], gap_abs[2]
 scale = max(np.linalg.norm(b.part("lam_n")), np.linalg.norm(b.part("lam_t")))
 gap_abs_difference = {name: float(np.linalg.norm(a.part(name) - b.part(name)) / scale)
@@ -103,10 +104,12 @@ print(f"difference of the multipliers (relative): {gap_abs_difference}")
 
 # %%
 frictionless = load_scene("thesis-3.46-frictionless")
-reference = uzawa(assemble(frictionless, build_mesh(frictionless.geometry, LEVEL)), eps=1e-10)
+reference = uzawa(assemble(frictionless, build_mesh(frictionless.geometry, LEVEL)),
+                  UzawaSettings.from_scene(frictionless, eps=1e-10))
 by_mu = {}
 for mu in MUS:
-    solution = nested_uzawa(problem, "coulomb", mu_f=mu, eps1=1e-10, eps2=1e-9)
+    solution = nested_uzawa(problem, NestedUzawaSettings.from_scene(coulomb, mu_f=mu, eps1=1e-10,
+                                                                    eps2=1e-9))
     summary = post.contact_summary(solution)
     by_mu[str(mu)] = {"converged": solution.converged, "F_abs": summary["F_abs"],
                       "nodes_in_contact": summary["nodes_in_contact"],

@@ -105,7 +105,7 @@ for indicator in ("eta", "eta_sigma"):
                              max_steps=THESIS_STEPS)
     by_indicator[indicator] = {"elements": mesh.ne, "top_edges": edges_on(mesh, "top"),
                                "bottom_edges": edges_on(mesh, "bottom"),
-                               "eta": [r["eta"] for r in rows]}
+                               "eta": [r["estimator"] for r in rows]}
     row = by_indicator[indicator]
     print(f"marking with {indicator:9s}: {row['elements']} triangles, {row['top_edges']} "
           f"edges on Gamma_N, {row['bottom_edges']} on Gamma_C; eta_tot "
@@ -131,7 +131,7 @@ for gap in ("0.01", "0"):
     scene = load_scene("thesis-3.46-frictionless", [f"contact.gap='{gap}'"])
     uniform = [estimate(solve_scene(scene, level)) for level in UNIFORM_LEVELS]
     history = adapt(scene, "dorfler", 0.5, CORNER_STEPS, level=1)
-    ndofs, etas = [r["dofs"]["total"] for r in history], [r["eta"] for r in history]
+    ndofs, etas = [r["dofs"]["total"] for r in history], [r["estimator"] for r in history]
     corners[gap] = {"uniform_eta": [e.total for e in uniform],
                     "uniform_as_max": [float(np.sqrt(e.terms["asymmetry"].max()))
                                        for e in uniform],

@@ -23,10 +23,6 @@ from ...io import versions
 from .fields import field_arrays
 from .records import Task
 
-# afem's step records call the estimator eta; the studies' records call it estimator
-ESTIMATOR_KEYS = {"eta": "estimator", "eta_sum": "estimator_sum", "eta_max": "estimator_max",
-                  "eta_terms": "estimator_terms"}
-
 
 def load_scene_with(scene: str, overrides):
     """The shipped scene ``scene`` with ``overrides`` (a sweep parameter: a list)."""
@@ -90,8 +86,7 @@ def adapt_task(scene: str, marking: str, theta: float, steps: int, level: int,
                max_elements: int | None = None) -> tuple[dict, dict]:
     """An adaptive run (:func:`ngdual.afem.adapt`): its history, with extras for Section 4.2.
 
-    Every step record of :func:`ngdual.afem.step_record`, its estimator keys renamed
-    (:data:`ESTIMATOR_KEYS`), gets ``eta_as`` (the
+    Every step record of :func:`ngdual.afem.step_record` gets ``eta_as`` (the
     largest eta_{as,T} with as(sigma_h) in L^2 and in H(div), and the share
     q_as of triangles with eta_{as,T} >= 0.1 max, Table 4.2) and ``cumulative_s``
     (the wall time from the start to this step's marks, all solves, estimates and
@@ -131,7 +126,7 @@ def adapt_task(scene: str, marking: str, theta: float, steps: int, level: int,
             from ...verification.reference import solution_samples
 
             arrays.update({f"s{k}_{n}": v for n, v in solution_samples(solution).items()})
-        history.append({ESTIMATOR_KEYS.get(k, k): v for k, v in record.items()})
+        history.append(dict(record))
         extra[0] += time.perf_counter() - t0
         if max_elements is not None and record["elements"] >= max_elements:
             raise _Budget
@@ -184,7 +179,7 @@ def manufactured_task(case: str, level: int, marking: str | None = None, theta: 
 
     def on_step(record, solution, indicators, marked):
         history.append({"step": record["step"], "ndof": record["dofs"]["total"],
-                        "elements": record["elements"], "estimator": record["eta"],
+                        "elements": record["elements"], "estimator": record["estimator"],
                         "converged": record["converged"],
                         "errors": volume_errors(mc, solution)})
 
