@@ -184,7 +184,12 @@ class DiscreteProblem:
 
 
 def _forms(scene: Scene, fes: ngs.FESpace, names: list[str]):
-    """Bilinear form of all couplings in (3.62) and the right-hand side."""
+    """The forms of (3.62): the PEERS block a~ + b + s on T_h, the couplings d_N, d_C with the
+    boundary multipliers (None without Gamma_N and Gamma_C) and the right-hand side.
+
+    Two bilinear forms, so that the large volume matrix never meets the prolongation of the
+    multipliers (:func:`assemble`).
+    """
     mesh = fes.mesh
     trial = dict(zip(names, fes.TrialFunction()))
     test = dict(zip(names, fes.TestFunction()))
@@ -200,6 +205,7 @@ def _forms(scene: Scene, fes: ngs.FESpace, names: list[str]):
     sig, div_sig, trac_sig, u, eta = parts(trial)
     tau, div_tau, trac_tau, v, xi = parts(test)
     a = ngs.BilinearForm(fes)
+    d = ngs.BilinearForm(fes) if {"phi1", "lam_n"} & set(names) else None
     dx = ngs.dx(intrules=EXACT_VOLUME_RULES)
     a += ngs.InnerProduct(peers.compliance(sig, lam, mu), tau).Compile() * dx  # a~(sigma, tau)
     a += (u * div_tau + v * div_sig).Compile() * dx                            # b(u, tau)
@@ -215,16 +221,16 @@ def _forms(scene: Scene, fes: ngs.FESpace, names: list[str]):
         ds_n = ngs.ds(definedon=mesh.Boundaries(boundary_regex(scene.labels("neumann"))),
                       bonus_intorder=TRACE_BONUS_ORDER)
         phi, psi = ngs.CF((trial["phi1"], trial["phi2"])), ngs.CF((test["phi1"], test["phi2"]))
-        a += (phi * trac_tau + psi * trac_sig) * ds_n                         # d_N(phi, tau)
+        d += (phi * trac_tau + psi * trac_sig) * ds_n                         # d_N(phi, tau)
         t0 = ngs.CF(tuple(Expression(e).coefficient() for e in scene.loads.traction))
         rhs += t0 * psi * ds_n                                                # t0(psi)
     if "lam_n" in names:
         ds_c = ngs.ds(definedon=mesh.Boundaries(boundary_regex(scene.labels("contact"))),
                       bonus_intorder=TRACE_BONUS_ORDER)
-        a += (trial["lam_t"] * (t * trac_tau) + test["lam_t"] * (t * trac_sig)) * ds_c  # d_Ct
-        a += (trial["lam_n"] * (n * trac_tau) + test["lam_n"] * (n * trac_sig)) * ds_c  # d_Cn
+        d += (trial["lam_t"] * (t * trac_tau) + test["lam_t"] * (t * trac_sig)) * ds_c  # d_Ct
+        d += (trial["lam_n"] * (n * trac_tau) + test["lam_n"] * (n * trac_sig)) * ds_c  # d_Cn
         rhs += gap_coefficient(scene) * (n * trac_tau) * ds_c                 # g(tau)
-    return a, rhs
+    return a, d, rhs
 
 
 def assemble(scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes | None = None
@@ -234,10 +240,11 @@ def assemble(scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes | None = None
     spaces = Spaces.build(scene, mesh, coarse)
     names = list(spaces.components)
     fes = ngs.FESpace([spaces.components[n] for n in names])
-    a, rhs = _forms(scene, fes, names)
+    a, d, rhs = _forms(scene, fes, names)
     with ngs.TaskManager():
-        a.Assemble()
-        rhs.Assemble()
+        for form in (a, d, rhs):
+            if form is not None:
+                form.Assemble()
     blocks_p, blocks, offset = [], {}, 0
     for name in names:
         p = spaces.prolongations.get(name)
@@ -246,33 +253,27 @@ def assemble(scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes | None = None
         blocks[name] = slice(offset, offset + p.shape[1])
         offset += p.shape[1]
     P = sp.block_diag(blocks_p, format="csr")
-    K_fine = to_scipy(a.mat)
-    prolonged = [spaces.prolongations[c] for c in names if c in spaces.prolongations]
-    if prolonged:  # the prolonged multipliers come last (Spaces.build)
-        K = galerkin_restriction(K_fine, sp.block_diag(prolonged, format="csr"),
-                                 fes.ndof - sum(p.shape[0] for p in prolonged))
-    else:
-        K = K_fine.copy()
-    K.eliminate_zeros()
+    # the PEERS unknowns come first and are not prolonged: their block is a's matrix as it is
+    n_peers = sum(spaces.components[c].ndof for c in peers.PEERS)
+    K = _leading_block(to_scipy(a.mat), n_peers, P.shape[1])
     lift = _end_lift(scene, spaces, fes, names)
-    F = P.T @ (rhs.vec.FV().NumPy() - K_fine @ lift)
+    F = P.T @ rhs.vec.FV().NumPy()
+    if d is not None:
+        D = to_scipy(d.mat)
+        K = K + P.T @ D @ P
+        F -= P.T @ (D @ lift)  # a has no entries in the multipliers' columns, where lift lives
+    K.eliminate_zeros()
     return DiscreteProblem(scene, spaces, fes, names, P, K, F, blocks, lift,
                            time.perf_counter() - start)
 
 
-def galerkin_restriction(K_fine: sp.csr_matrix, P_R: sp.csr_matrix, n: int) -> sp.csr_matrix:
-    """P^T K_fine P for P = diag(I_n, P_R): the first ``n`` unknowns are not prolonged.
-
-    Only the multipliers on the boundary (O(N^{1/2}) fine dofs, after the PEERS unknowns)
-    are prolonged; their rows and columns go through sparse products while the PEERS block
-    K_fine[:n, :n] (nearly all the nonzeros) is kept as it is. A product with the whole
-    prolongation would multiply all of K_fine twice.
-    """
-    coupling = K_fine[:n, n:] @ P_R
-    bottom = P_R.T @ K_fine[n:]
-    bottom = sp.hstack([bottom[:, :n], bottom[:, n:] @ P_R], format="csr")
-    top = sp.hstack([K_fine[:n, :n], coupling], format="csr")
-    return sp.vstack([top, bottom], format="csr")
+def _leading_block(K_fine: sp.csr_matrix, n: int, size: int) -> sp.csr_matrix:
+    """``K_fine``, whose nonzeros all lie in its leading n x n block, as a ``size`` x ``size``
+    matrix (the same arrays: the rows after n are empty)."""
+    if K_fine.indptr[n] != K_fine.nnz:
+        raise ValueError("the volume form couples unknowns after the PEERS triple")
+    indptr = np.concatenate([K_fine.indptr[:n + 1], np.full(size - n, K_fine.nnz)])
+    return sp.csr_matrix((K_fine.data, K_fine.indices, indptr), shape=(size, size))
 
 
 def _end_lift(scene: Scene, spaces: Spaces, fes: ngs.FESpace, names: list[str]) -> np.ndarray:

@@ -17,6 +17,7 @@ import ngsolve as ngs
 STRESS = ("r1", "r2", "b1", "b2")
 DISPLACEMENT = ("u1", "u2")
 ROTATION = ("eta",)
+PEERS = STRESS + DISPLACEMENT + ROTATION  # the order of the unknown vector
 
 
 def raviart_thomas(mesh: ngs.Mesh) -> ngs.FESpace:
