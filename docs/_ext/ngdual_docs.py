@@ -263,17 +263,17 @@ def scene_reference_rst() -> list[str]:
     for section, keys in sections.items():
         title = section if section.startswith("(") else f"[{section}]"
         lines += [title, "-" * len(title), "",
-                  ".. list-table::", "   :header-rows: 1", "   :widths: 18 14 14 54",
+                  ".. list-table::", "   :header-rows: 1", "   :widths: 20 12 14 54",
                   "   :class: ngdual-scene-keys", "",
                   "   * - key", "     - type", "     - default", "     - meaning"]
         for k in keys:
-            meaning = k.meaning
+            meaning = _rst_code(k.meaning)
             if k.choices:
                 meaning += " One of: " + ", ".join(f"``{c}``" for c in k.choices) + "."
             anchor = "scene-key-" + k.key.replace(".", "-").replace("_", "-")
             lines += [f"   * - .. _{anchor}:", "", f"       ``{k.key}``",
                       f"     - {_cell(k.type)}", f"     - ``{k.default}``",
-                      f"     - {_cell(_rst_code(meaning))}"]
+                      f"     - {_cell(meaning)}"]
         lines.append("")
     return lines
 
