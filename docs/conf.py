@@ -27,7 +27,7 @@ ngdual_docs.prepare_kernel_environment(DOCS / "_build", QUICK)
 
 project = "ngdual"
 author = "the ngdual developers"
-copyright = "2025, the ngdual developers"
+copyright = "2026, the ngdual developers"
 release = version = ngdual.__version__
 
 extensions = [
@@ -39,8 +39,7 @@ extensions = [
     "ngdual_docs",
 ]
 
-exclude_patterns = ["_build", "_ext", "conf.py", "**/.ipynb_checkpoints", "tutorials/*.json"]
-templates_path = []
+exclude_patterns = ["_build", "_ext", "conf.py", "**/.ipynb_checkpoints"]
 html_static_path = ["_static"]
 html_css_files = ["ngdual.css"]
 
@@ -88,9 +87,6 @@ html_favicon = "_static/favicon.svg"
 html_context = {"default_mode": "light"}   # a fresh browser profile has no stored mode
 html_sidebars = {"index": [], "installation": []}
 html_show_sourcelink = False
-html_last_updated_fmt = None
 
-nitpicky = False
-suppress_warnings = []
-
+# the kernels' debugger warns about frozen modules on stderr otherwise
 os.environ.setdefault("PYDEVD_DISABLE_FILE_VALIDATION", "1")
