@@ -18,7 +18,7 @@ import sys
 
 def one_level(scene_name: str, level: int, overrides: list[str]) -> dict:
     from ngdual.io import versions
-    from ngdual.post import norms
+    from ngdual.quantities import norms
     from ngdual.scene import load_scene
     from ngdual.solvers import solve_scene
 

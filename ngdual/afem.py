@@ -27,8 +27,8 @@ from .estimator import Estimate, estimate
 from .forms import assemble
 from .marking import mark
 from .mesh import build_mesh
-from .post import norms
 from .quadrature_check import check_formulas
+from .quantities import norms
 from .rates import extrapolated_norms, total_error
 from .scene import Scene, SceneError, SceneTypeError, check_level, ensure_valid
 from .solvers import check_unknowns, solve_problem, solve_scene
@@ -85,7 +85,7 @@ def adapt(scene: Scene, marking: str = "dorfler", theta: float = 0.5, steps: int
     asymmetry : {"hdiv", "l2"}
         Norm of as(sigma_h) in the estimator (see :func:`ngdual.estimator.estimate`).
     reference : dict, optional
-        Norms of the exact solution (keys of :func:`ngdual.post.norms`); adds
+        Norms of the exact solution (keys of :func:`ngdual.quantities.norms`); adds
         the errors of (3.124) and the effectivity index to every record.
     on_step : callable, optional
         ``on_step(record, solution, estimate, marked)`` after MARK (``marked`` is

@@ -100,6 +100,7 @@ def _progress():
 def cmd_solve(args) -> int:
     from . import budget, plot, post
     from .io import check_output_dir, write_json
+    from .quantities import fields
     from .solvers import solve_scene
     from .solvers.result import ConvergenceError
 
@@ -121,7 +122,7 @@ def cmd_solve(args) -> int:
     if args.vtk:
         print(f"wrote {post.write_vtk(solution, str(out / 'solution'))}")
     if not args.no_plots:
-        f = post.fields(solution)
+        f = fields(solution)
         pts, tris, vm = post.element_values(solution.problem.fes.mesh,
                                             post.von_mises(f.sigma, scene.material.nu))
         written = [plot.plot_element_field(pts, tris, vm, out / "von_mises.png",

@@ -49,7 +49,7 @@ from .contact import gap_coefficient
 from .expr import Expression
 from .forms import boundary_regex
 from .mesh import element_diameters
-from .post import fields
+from .quantities import fields
 from .solvers.result import Solution
 
 SIGMA_TERMS = ("residual", "asymmetry", "curl", "jump_interior", "jump_dirichlet",

@@ -1,4 +1,6 @@
-"""Post-processing: fields, norms (Tables 3.2/3.3), traces on Gamma_C, contact counts, records.
+"""Post-processing: traces on Gamma_C, contact counts, force balance, records, VTK output.
+
+The fields of a solution and their norms (Tables 3.2/3.3) are in :mod:`ngdual.quantities`.
 
 Sign conventions (Theorem 3.10): u is the displacement, phi = -u on Gamma_N,
 lambda_n = g - u_n (so lambda_n - g = -u_n and lambda_n = 0 where the gap is
@@ -12,64 +14,11 @@ from dataclasses import dataclass
 import ngsolve as ngs
 import numpy as np
 
-from . import peers
 from .io import versions
+from .quantities import fields, norms
 from .solvers.result import Solution
 
 CONTACT_TOL = 1e-8
-
-
-@dataclass
-class Fields:
-    """NGSolve views of a solution on the fine mesh."""
-
-    gf: ngs.GridFunction
-    sigma: ngs.CoefficientFunction
-    div_sigma: ngs.CoefficientFunction
-    u: ngs.CoefficientFunction
-    eta: ngs.CoefficientFunction
-    phi: ngs.CoefficientFunction | None
-    lam_t: ngs.CoefficientFunction | None
-    lam_n: ngs.CoefficientFunction | None
-
-
-def fields(solution: Solution) -> Fields:
-    """Fine-mesh GridFunction and coefficient functions of every unknown."""
-    pb = solution.problem
-    gf = ngs.GridFunction(pb.fes)
-    gf.vec.FV().NumPy()[:] = pb.to_fine(solution.x)
-    c = dict(zip(pb.names, gf.components))
-    sigma = peers.stress(c["r1"], c["r2"], c["b1"], c["b2"])
-    div_sigma = peers.stress_divergence(c["r1"], c["r2"])
-    phi = ngs.CF((c["phi1"], c["phi2"])) if "phi1" in c else None
-    return Fields(gf, sigma, div_sigma, ngs.CF((c["u1"], c["u2"])), c["eta"], phi,
-                  c.get("lam_t"), c.get("lam_n"))
-
-
-def _boundary_integral(cf, mesh: ngs.Mesh, labels: list[str]) -> float:
-    return float(ngs.Integrate(cf, mesh, ngs.BND, definedon=mesh.Boundaries("|".join(labels))))
-
-
-def norms(solution: Solution) -> dict:
-    """Norms of Tables 3.2/3.3: ||sigma|| in H(div), the others in L^2."""
-    f = fields(solution)
-    pb = solution.problem
-    mesh, scene = pb.fes.mesh, pb.scene
-    out = {
-        "sigma_X": np.sqrt(ngs.Integrate(ngs.InnerProduct(f.sigma, f.sigma)
-                                         + f.div_sigma * f.div_sigma, mesh)),
-        "u": np.sqrt(ngs.Integrate(f.u * f.u, mesh)),
-        "eta": np.sqrt(ngs.Integrate(f.eta * f.eta, mesh)),
-        "phi": np.sqrt(_boundary_integral(f.phi * f.phi, mesh, scene.labels("neumann")))
-        if f.phi is not None else 0.0,
-        "lam_t": 0.0, "lam_n": 0.0, "nu": solution.nu_l2,
-    }
-    if f.lam_n is not None:
-        out["lam_t"] = np.sqrt(_boundary_integral(f.lam_t * f.lam_t, mesh,
-                                                  scene.labels("contact")))
-        out["lam_n"] = np.sqrt(_boundary_integral(f.lam_n * f.lam_n, mesh,
-                                                  scene.labels("contact")))
-    return {k: (float(v) if v is not None else None) for k, v in out.items()}
 
 
 def von_mises(sigma, nu: float) -> ngs.CoefficientFunction:

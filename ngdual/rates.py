@@ -68,7 +68,7 @@ def aitken_extrapolate(values) -> float:
 
 def extrapolated_norms(sequence: list[dict]) -> dict:
     """The norms of the exact solution: the Aitken limits of the last three of ``sequence``
-    (:func:`ngdual.post.norms` records of consecutive uniform levels). A quantity missing
+    (:func:`ngdual.quantities.norms` records of consecutive uniform levels). A quantity missing
     on one of them (None) stays None; with fewer than three levels, the last norms.
     """
     last = [dict(n) for n in sequence[-3:]]
@@ -81,7 +81,7 @@ def extrapolated_norms(sequence: list[dict]) -> dict:
 def total_error(norms_h: dict, reference: dict) -> tuple[dict, float]:
     """e_i(q) = | ||q_h||^2 - n_q^2 |^{1/2} per quantity and e_tot of (3.124).
 
-    ``norms_h`` is a :func:`ngdual.post.norms` record, ``reference`` the (extrapolated)
+    ``norms_h`` is a :func:`ngdual.quantities.norms` record, ``reference`` the (extrapolated)
     norms n_q of the exact solution; quantities missing or ``None`` in either
     (nu without friction) are left out.
     """

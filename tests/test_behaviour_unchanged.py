@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from ngdual import post
+from ngdual.quantities import norms
 from ngdual.scene import load_scene
 from ngdual.solvers import solve_scene
 
@@ -18,7 +18,7 @@ CASES = sorted(STORED["norms"])
 @pytest.mark.parametrize("case", CASES)
 def test_every_shipped_scene_gives_the_stored_norms_to_1e_10(case):
     name, level = case.rsplit("@", 1)
-    got = post.norms(solve_scene(load_scene(name), int(level)))
+    got = norms(solve_scene(load_scene(name), int(level)))
     want = STORED["norms"][case]
     assert got.keys() == want.keys()
     for key, value in want.items():

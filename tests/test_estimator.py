@@ -25,7 +25,7 @@ from test_manufactured_convergence import errors, manufactured, scene
 
 from ngdual import peers
 from ngdual.estimator import SIGMA_TERMS, TERMS, U_TERMS, estimate
-from ngdual.post import fields
+from ngdual.quantities import fields
 from ngdual.scene import Geometry, Loads, Material, Scene, load_scene, validate
 from ngdual.solvers import solve_scene
 

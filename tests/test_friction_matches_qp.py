@@ -11,10 +11,10 @@ from functools import cache
 import numpy as np
 import pytest
 
-from ngdual import post
 from ngdual.forms import assemble
 from ngdual.friction import build_friction_forms
 from ngdual.mesh import build_mesh
+from ngdual.quantities import norms
 from ngdual.scene import load_scene
 from ngdual.solvers import solve_problem
 from ngdual.solvers.reference import solve_qp_friction
@@ -37,7 +37,7 @@ def solutions(name, level):
 def test_norms_agree(name, level):
     _, uzawa, qp = solutions(name, level)
     assert uzawa.converged and qp.converged
-    a, b = post.norms(uzawa), post.norms(qp)
+    a, b = norms(uzawa), norms(qp)
     # lambda_n vanishes up to round-off in full contact (g = 0): measure it against the
     # displacement scale on Gamma_C, max(||lambda_n||, ||lambda_t||)
     scale = {k: abs(b[k]) for k in ("sigma_X", "lam_t")}

@@ -34,7 +34,7 @@ import pytest
 
 from ngdual.expr import Expression
 from ngdual.mesh import mesh_size
-from ngdual.post import fields
+from ngdual.quantities import fields
 from ngdual.scene import Geometry, Loads, Material, Scene, validate
 from ngdual.solvers import solve_scene
 

@@ -26,13 +26,13 @@ def test_every_public_name_resolves_and_has_a_docstring():
 
 
 def test_public_names_are_the_pipeline_functions():
-    from ngdual import afem, estimator, marking, post, scene, solvers
+    from ngdual import afem, estimator, marking, post, quantities, scene, solvers
 
     assert nd.solve is solvers.solve_scene
     assert nd.load_scene is scene.load_scene and nd.Scene is scene.Scene
     assert nd.adapt is afem.adapt and nd.estimate is estimator.estimate
     assert nd.mark is marking.mark and nd.contact_traces is post.contact_traces
-    assert nd.norms is post.norms
+    assert nd.norms is quantities.norms and nd.fields is quantities.fields
 
 
 def test_dir_lists_the_public_names_and_unknown_names_raise():
@@ -42,7 +42,7 @@ def test_dir_lists_the_public_names_and_unknown_names_raise():
 
 
 def test_submodules_are_reachable_as_attributes():
-    assert nd.post.norms is nd.norms
+    assert nd.quantities.norms is nd.norms
 
 
 def test_importing_ngdual_imports_neither_ngsolve_nor_pyplot():

@@ -14,6 +14,7 @@ import pytest
 from ngdual import peers, post
 from ngdual.forms import assemble
 from ngdual.mesh import build_mesh
+from ngdual.quantities import norms
 from ngdual.scene import load_scene
 from ngdual.solvers.reference import solve_qp
 from ngdual.solvers.settings import Model, UzawaSettings
@@ -47,7 +48,7 @@ def vector_difference(a, b):
 
 
 def assert_norms_agree(first, second):
-    n1, n2 = post.norms(first), post.norms(second)
+    n1, n2 = norms(first), norms(second)
     diffs = {k: relative_difference(n1[k], n2[k]) for k in NORMS}
     assert all(n2[k] > 0 for k in NORMS), n2
     assert max(diffs.values()) <= RTOL, diffs

@@ -39,7 +39,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ngdual import peers, post
+from ngdual import peers, post, quantities
 from ngdual.expr import Expression
 from ngdual.forms import assemble
 from ngdual.mesh import build_mesh
@@ -267,7 +267,7 @@ def errors(nu: float, level: int) -> dict:
     scene = square_scene(nu)
     solution = solve_scene(scene, level)
     mesh = solution.problem.fes.mesh
-    f = post.fields(solution)
+    f = quantities.fields(solution)
     uh, sigma_h = solve_p1(mesh, scene.material)
     return {"nu": nu, "level": level, "triangles": mesh.ne,
             "peers_u": relative_l2(f.u - u_exact, u_exact, mesh),
@@ -322,7 +322,7 @@ for row in convergence:
 
 # %%
 incompressible = solve_scene(square_scene(NUS[-1]), LOCKING_LEVELS[-1])
-draw(post.von_mises(post.fields(incompressible).sigma, NUS[-1]),
+draw(post.von_mises(quantities.fields(incompressible).sigma, NUS[-1]),
      incompressible.problem.fes.mesh, "von_mises")
 
 # %%

@@ -31,7 +31,7 @@ import cvxpy as cp
 import matplotlib.pyplot as plt
 import numpy as np
 
-from ngdual import peers, plot, post
+from ngdual import peers, plot, post, quantities
 from ngdual.forms import assemble
 from ngdual.mesh import build_mesh
 from ngdual.scene import load_scene
@@ -245,7 +245,7 @@ print("contact residuals of the Uzawa solution:",
 show_file(plot.plot_contact_traces(post.contact_traces(tight), OUT / "contact_traces.png",
                                    f"Example 3.46 without friction, level {LEVEL}"))
 mesh = problem.fes.mesh
-draw(post.von_mises(post.fields(tight).sigma, scene.material.nu), mesh, "von_mises")
+draw(post.von_mises(quantities.fields(tight).sigma, scene.material.nu), mesh, "von_mises")
 
 # %%
 results = {

@@ -36,7 +36,7 @@
 import matplotlib.pyplot as plt
 import numpy as np
 
-from ngdual import peers, post
+from ngdual import peers, post, quantities
 from ngdual.forms import assemble
 from ngdual.friction import build_friction_forms
 from ngdual.mesh import build_mesh
@@ -363,7 +363,7 @@ def plot_zones(solution, title: str, path) -> None:
 plot_zones(tresca_runs["friction-outer"], f"Tresca, F = 100, level {LEVEL}",
            OUT / "zones_tresca.png")
 plot_zones(coulomb_solution, f"Coulomb, mu_f = {mu_f}, level {LEVEL}", OUT / "zones_coulomb.png")
-draw(post.von_mises(post.fields(coulomb_solution).sigma, coulomb.material.nu),
+draw(post.von_mises(quantities.fields(coulomb_solution).sigma, coulomb.material.nu),
      problem_c.fes.mesh, "von_mises")
 
 # %% [markdown]

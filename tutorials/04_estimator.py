@@ -45,7 +45,7 @@ from matplotlib.colors import LogNorm
 
 from ngdual.estimator import OTHER_TERMS, SIGMA_TERMS, TERMS, U_TERMS, estimate
 from ngdual.expr import Expression
-from ngdual.post import fields
+from ngdual.quantities import fields
 from ngdual.rates import observed_rates
 from ngdual.scene import Geometry, Loads, Material, Scene, load_scene, validate
 from ngdual.solvers import solve_scene

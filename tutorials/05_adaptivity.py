@@ -37,7 +37,6 @@ import matplotlib.tri as mtri
 import ngsolve as ngs
 import numpy as np
 
-from ngdual import corner
 from ngdual.afem import adapt, reference_norms
 from ngdual.estimator import estimate
 from ngdual.marking import STRATEGIES, mark
@@ -45,6 +44,7 @@ from ngdual.rates import fitted_rate
 from ngdual.scene import load_scene
 from ngdual.solvers import solve_scene
 from ngdual.studies.tutorials import output_dir, quick_mode, save_figure, save_results
+from ngdual.verification import corner
 
 # %% [markdown]
 # ## Parameters

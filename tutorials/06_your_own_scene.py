@@ -26,7 +26,7 @@ import json
 
 import numpy as np
 
-from ngdual import plot, post
+from ngdual import plot, post, quantities
 from ngdual.cli import main as ngdual_cli
 from ngdual.mesh import mesh_size
 from ngdual.scene import SceneError, load_scene
@@ -161,7 +161,7 @@ for row in levels:
 # notebook also NGSolve's interactive webgui) and the traces on Γ_C.
 
 # %%
-fields = post.fields(solution)
+fields = quantities.fields(solution)
 mesh = solution.problem.fes.mesh
 von_mises = post.von_mises(fields.sigma, scene.material.nu)
 points, triangles, values = post.element_values(mesh, von_mises)

@@ -121,7 +121,7 @@ def run_one(case: str, level: int, solver: str, blas_threads: int | None = BLAS_
 def _measure(case: str, level: int, solver: str) -> dict:
     from ..forms import assemble
     from ..mesh import build_mesh
-    from ..post import norms
+    from ..quantities import norms
     from ..scene import load_scene
     from ..solvers import solve_problem
     from ..solvers.result import ConvergenceError

@@ -23,7 +23,7 @@ import math
 import ngsolve as ngs
 
 from ..expr import Expression
-from ..post import fields
+from ..quantities import fields
 from ..scene import Geometry, Loads, Material, Scene, validate
 from ..solvers.result import Solution
 

@@ -58,7 +58,8 @@ import numpy as np
 from ..expr import Expression
 from ..friction import hat_projection
 from ..mesh import mesh_size
-from ..post import contact_traces, fields, friction_diagnostics
+from ..post import contact_traces, friction_diagnostics
+from ..quantities import fields
 from ..rates import observed_rates
 from ..scene import Contact, Friction, Geometry, Loads, Material, Scene, Solver, validate
 from ..solvers import solve_scene

@@ -184,7 +184,7 @@ def solution_samples(solution) -> dict:
     """A discrete ngdual solution as arrays: :func:`element_samples` of sigma (4 components,
     row-major), u and the rotation eta, and the Gamma_C pressure (``p_nodes``, ``p``: P1 on
     the h~ mesh) when the scene has a contact boundary."""
-    from ..post import fields
+    from ..quantities import fields
     from .analytic import traction_profile
 
     f = fields(solution)

@@ -9,8 +9,8 @@ import json
 import subprocess
 from pathlib import Path
 
-from ngdual import post
 from ngdual.io import versions
+from ngdual.quantities import norms
 from ngdual.scene import load_scene, shipped_scenes
 from ngdual.solvers import solve_scene
 
@@ -24,7 +24,7 @@ def main() -> None:
     for name in shipped_scenes():
         for level in LEVELS:
             solution = solve_scene(load_scene(name), level)
-            out["norms"][f"{name}@{level}"] = post.norms(solution)
+            out["norms"][f"{name}@{level}"] = norms(solution)
             print(name, level, out["norms"][f"{name}@{level}"], flush=True)
     path = Path(__file__).with_name("behaviour_norms.json")
     path.write_text(json.dumps(out, indent=1, sort_keys=True) + "\n")

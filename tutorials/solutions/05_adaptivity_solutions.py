@@ -8,7 +8,6 @@
 import ngsolve as ngs
 import numpy as np
 
-from ngdual import corner
 from ngdual.afem import adapt, refine
 from ngdual.boundary import BoundaryMeshes
 from ngdual.estimator import estimate
@@ -19,6 +18,7 @@ from ngdual.rates import fitted_rate
 from ngdual.scene import load_scene
 from ngdual.solvers import solve_problem, solve_scene
 from ngdual.studies.tutorials import output_dir, quick_mode, save_results
+from ngdual.verification import corner
 
 QUICK = quick_mode()
 TARGET_DOFS = 1500 if QUICK else 8000       # Exercise 1: refine until N reaches this

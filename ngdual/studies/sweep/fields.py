@@ -26,11 +26,11 @@ def field_arrays(solution) -> dict[str, np.ndarray]:
     """
     import ngsolve as ngs
 
-    from ... import post
+    from ... import post, quantities
 
     pb = solution.problem
     mesh = pb.fes.mesh
-    f = post.fields(solution)
+    f = quantities.fields(solution)
     out = {}
     cfs = {"von_mises": post.von_mises(f.sigma, pb.scene.material.nu), "u1": f.u[0],
            "u2": f.u[1], "eta": f.eta}

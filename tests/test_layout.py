@@ -1,0 +1,110 @@
+"""The layout shows the architecture: data flows one way through the pipeline.
+
+scene -> mesh -> spaces (PEERS, boundary meshes, Gamma_C) -> forms -> solvers -> the fields and
+norms of a solution -> estimator ->
+marking -> adaptive loop -> post-processing -> verification; run machinery (studies, CLI)
+only calls the pipeline. Every import inside ``ngdual/`` (also those inside functions) is
+read from the source; a module may import its own stage or earlier ones, never a later one.
+"""
+
+import ast
+from pathlib import Path
+
+import pytest
+
+PACKAGE = Path(__file__).resolve().parents[1] / "ngdual"
+
+# (stage, module prefixes), in the order the data flows
+STAGES = [
+    ("foundation", ["expr", "geometry", "tolerances", "rates", "sparse"]),
+    ("scene", ["scene", "scenes"]),
+    ("mesh", ["mesh", "budget", "io"]),
+    ("spaces", ["peers", "boundary", "contact"]),
+    ("forms", ["forms", "friction", "quadrature_check"]),
+    ("solvers", ["solvers"]),
+    ("quantities", ["quantities"]),
+    ("estimator", ["estimator"]),
+    ("marking", ["marking"]),
+    ("afem", ["afem"]),
+    ("post", ["post", "plot"]),
+    ("verification", ["verification"]),
+    ("run machinery", ["studies", "cli", "__main__"]),
+]
+
+
+def stage_of(module: str) -> int:
+    """Index in STAGES of ``ngdual.<module>`` (dotted, without the package name)."""
+    head = module.split(".")[0]
+    for index, (_, prefixes) in enumerate(STAGES):
+        if head in prefixes:
+            return index
+    raise LookupError(module)
+
+
+def modules() -> dict[str, Path]:
+    out = {}
+    for path in sorted(PACKAGE.rglob("*.py")):
+        rel = path.relative_to(PACKAGE).with_suffix("")
+        parts = list(rel.parts)
+        if parts[-1] == "__init__":
+            parts = parts[:-1]
+        if parts:
+            out[".".join(parts)] = path
+    return out
+
+
+def imported(module: str, path: Path) -> set[str]:
+    """The ngdual modules ``module`` imports (relative imports resolved)."""
+    package = module.split(".") if path.name == "__init__.py" else module.split(".")[:-1]
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Import):
+            names = [a.name for a in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package[:len(package) - node.level + 1]
+                target = ".".join(base + ([node.module] if node.module else []))
+            else:
+                target = node.module or ""
+                if not target.startswith("ngdual"):
+                    continue
+                target = target[len("ngdual"):].lstrip(".")
+            # "from . import x" names a module x; "from .m import f" names m
+            names = [f"{target}.{a.name}".strip(".") if not node.module else target
+                     for a in node.names]
+        else:
+            continue
+        for name in names:
+            if name.startswith("ngdual"):
+                name = name[len("ngdual"):].lstrip(".")
+            if name:
+                found.add(name)
+    return found
+
+
+def test_every_module_of_ngdual_has_a_place_in_the_data_flow():
+    unplaced = []
+    for module in modules():
+        try:
+            stage_of(module)
+        except LookupError:
+            unplaced.append(module)
+    assert not unplaced, f"modules without a stage in tests/test_layout.py: {unplaced}"
+
+
+@pytest.mark.parametrize("module", sorted(modules()))
+def test_no_module_reaches_back_up_the_data_flow(module):
+    path = modules()[module]
+    own = stage_of(module)
+    later = {name: STAGES[stage_of(name)][0] for name in imported(module, path)
+             if name.split(".")[0] in {p for _, ps in STAGES for p in ps}
+             and stage_of(name) > own}
+    assert not later, (f"ngdual.{module} ({STAGES[own][0]}) imports later stages: {later}")
+
+
+def test_no_solver_reads_the_scene():
+    """Solvers receive explicit settings (issue 16): ``problem.scene`` appears in no solver
+    module except the dispatch that builds the settings from it."""
+    readers = [p.name for p in (PACKAGE / "solvers").glob("*.py")
+               if p.name not in ("dispatch.py", "settings.py") and ".scene" in p.read_text()]
+    assert not readers, readers
