@@ -1,0 +1,173 @@
+"""The ``ngdual`` command line.
+
+``ngdual solve SCENE [--level N] [--set key=value ...] [--out DIR] [--vtk] [--no-plots]``
+solves one scene, prints the result table and writes ``DIR/result.json``
+(atomically) plus figures. ``ngdual scenes`` lists the shipped scenes;
+``ngdual dofs SCENE --levels 1 2 3`` prints DOF counts without solving;
+``ngdual adapt SCENE --marking max|fraction|dorfler --theta T --steps N --out DIR``
+runs the adaptive loop and writes ``DIR/history.json`` plus a mesh (.vol, .png) per step.
+``ngdual tutorials [--notebooks DIR] [--solutions]`` lists the lecture tutorials or
+writes them as Jupyter notebooks.
+``ngdual bench [--levels ...] [--json FILE]`` times the contact solvers against one
+linear solve of the same matrix (the limit ratio, :mod:`ngdual.studies.bench`).
+``ngdual verify [--quick] [--json FILE]`` prints the errors against exact solutions with
+observed orders (:mod:`ngdual.verification.report`).
+Exit status: 0 solved and converged, 1 not converged, 2 bad input (one message naming
+every field or flag at fault; nothing is written), 3 an internal error (a bug: the message
+says so; ``ngdual --debug ...`` shows the traceback). Runs whose estimated size exceeds the
+memory available are refused before meshing; ``--allow-large`` runs them anyway.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from ..scene import SceneError
+from .output import EXIT_BAD_INPUT, EXIT_INTERNAL
+from .pipeline import cmd_adapt, cmd_dofs, cmd_scenes, cmd_solve
+from .studies import cmd_bench, cmd_figures, cmd_tutorials, cmd_verify
+
+
+def parser() -> argparse.ArgumentParser:
+    from .. import __version__
+
+    p = argparse.ArgumentParser(prog="ngdual", description=__doc__.splitlines()[0])
+    p.add_argument("--version", action="version", version=f"ngdual {__version__}",
+                   help="print the version of ngdual and exit")
+    p.add_argument("--debug", action="store_true",
+                   help="show the Python traceback of any error (for developers)")
+    # --debug after the subcommand too; SUPPRESS keeps a value given before it
+    common = argparse.ArgumentParser(add_help=False)
+    common.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
+                        help=argparse.SUPPRESS)
+    sized = argparse.ArgumentParser(add_help=False, parents=[common])
+    sized.add_argument("--allow-large", action="store_true",
+                       help="run even when the estimated memory exceeds what the machine has "
+                            "available (the estimate is refused otherwise)")
+    sub = p.add_subparsers(dest="command", required=True)
+    s = sub.add_parser("solve", help="solve one scene and write DIR/result.json",
+                       parents=[sized])
+    s.add_argument("scene", help="path to a TOML scene or the name of a shipped scene")
+    s.add_argument("--level", type=int, default=None, help="mesh level (default: the scene's)")
+    s.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                   help="override a scene entry, e.g. --set friction.mu=0.5")
+    s.add_argument("--out", default="out", help="output folder (default: out)")
+    s.add_argument("--vtk", action="store_true", help="also write a VTK file for ParaView")
+    s.add_argument("--no-plots", action="store_true", help="do not write PNG figures")
+    s.set_defaults(func=cmd_solve)
+    sc = sub.add_parser("scenes", help="list the shipped scenes", parents=[common])
+    sc.set_defaults(func=cmd_scenes)
+    d = sub.add_parser("dofs", help="degrees of freedom per level (Table 3.1), without solving",
+                       parents=[sized])
+    d.add_argument("scene")
+    d.add_argument("--levels", type=int, nargs="+", default=[1, 2, 3, 4])
+    d.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+    d.set_defaults(func=cmd_dofs)
+    ad = sub.add_parser("adapt", help="adaptive refinement (Chapter 4), writes DIR/history.json",
+                        parents=[sized])
+    ad.add_argument("scene")
+    ad.add_argument("--marking", choices=["max", "fraction", "dorfler"], default="dorfler")
+    ad.add_argument("--theta", type=float, default=0.5, help="marking parameter in [0, 1]")
+    ad.add_argument("--steps", type=int, default=5, help="number of solves (default 5)")
+    ad.add_argument("--level", type=int, default=None, help="initial mesh level")
+    ad.add_argument("--asymmetry", choices=["hdiv", "l2"], default="l2",
+                    help="norm of as(sigma_h) in the estimator (default: L2; 'hdiv' as printed "
+                         "in eq. 4.15 does not decrease for PEERS)")
+    ad.add_argument("--reference-levels", type=int, nargs="+", default=None, metavar="LEVEL",
+                    help="uniform levels whose norms give, by Aitken extrapolation, the "
+                         "reference for the total error (3.124) and the effectivity index")
+    ad.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+    ad.add_argument("--out", default="out-adapt", help="output folder (default: out-adapt)")
+    ad.set_defaults(func=cmd_adapt)
+    tu = sub.add_parser("tutorials", help="list the tutorials or write them as notebooks",
+                        parents=[common])
+    tu.add_argument("--notebooks", metavar="DIR", default=None,
+                    help="write the tutorials as .ipynb notebooks into DIR (needs jupytext)")
+    tu.add_argument("--solutions", action="store_true",
+                    help="with --notebooks: also write the exercise solutions to DIR/solutions")
+    tu.add_argument("--source", metavar="DIR", default=None,
+                    help="tutorials folder (default: tutorials/ of the source checkout)")
+    tu.set_defaults(func=cmd_tutorials)
+    fg = sub.add_parser("figures", help="regenerate every figure and table of Sections 3.4 "
+                                        "and 4.2 (and the work-precision study)",
+                        parents=[sized])
+    fg.add_argument("--max-level", type=int, default=None, metavar="K",
+                    help="finest uniform level; every other size follows from it "
+                         "(default 5: 8-11 min on 2 cores; 8 = the thesis scale)")
+    fg.add_argument("--out", default="figures-output", help="output folder (default: "
+                                                            "figures-output)")
+    fg.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                    help="address of a running dask scheduler (default: a LocalCluster)")
+    fg.add_argument("--workers", type=int, default=None,
+                    help="LocalCluster workers (default: one per CPU core)")
+    fg.add_argument("--threads", action="store_true",
+                    help="one LocalCluster worker thread in this process: quick to start, one "
+                         "task at a time")
+    fg.add_argument("--only", nargs="+", default=None, metavar="NAME",
+                    help="run only the scripts whose name contains one of these")
+    fg.add_argument("--source", default=None, metavar="DIR",
+                    help="figure scripts folder (default: figures/ of the source checkout)")
+    fg.add_argument("--gallery", default=None, metavar="DIR",
+                    help="also write small copies of a few figures into DIR (docs/gallery "
+                         "for the README)")
+    fg.set_defaults(func=cmd_figures)
+    be = sub.add_parser("bench", help="contact-solve time / one linear solve, per level and "
+                                      "solver (Example 3.46), JSON with --json",
+                        parents=[sized])
+    be.add_argument("--levels", type=int, nargs="+", default=[1, 2, 3, 4, 5])
+    be.add_argument("--cases", nargs="+", default=["thesis-3.46", "thesis-3.46-coulomb"])
+    be.add_argument("--solvers", nargs="+", default=["uzawa", "uzawa-tuned", "active-set"])
+    be.add_argument("--json", default=None, metavar="FILE",
+                    help="write all records (with package versions) to FILE, atomically")
+    be.add_argument("--isolate", choices=["auto", "always", "never"], default="auto",
+                    help="one process per record for its own peak memory (auto: level >= 4)")
+    be.add_argument("--timeout", type=float, default=None, metavar="S",
+                    help="bound on one isolated record (s)")
+    be.add_argument("--blas-threads", type=int, default=1, metavar="N",
+                    help="BLAS threads for every solver (default 1; 0: the libraries' own)")
+    be.set_defaults(func=cmd_bench)
+    ve = sub.add_parser("verify", help="errors against exact solutions: manufactured contact "
+                                       "problems and the Hertz, flat-punch and "
+                                       "Cattaneo-Mindlin benchmarks, with observed orders")
+    ve.add_argument("--quick", action="store_true",
+                    help="two levels of two manufactured cases and of every benchmark (~20 s)")
+    ve.add_argument("--json", default=None, metavar="FILE",
+                    help="also write every row (with package versions) to FILE, atomically")
+    ve.set_defaults(func=cmd_verify)
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the command line; returns the exit status (see the module docstring).
+
+    Users never see a traceback: bad input is one message naming the field or flag
+    (status 2), anything unexpected one line saying it is a bug (status 3);
+    ``--debug`` lets every exception through with its traceback.
+    """
+    try:
+        args = parser().parse_args(argv)
+    except SystemExit as err:  # argparse printed the usage error (or the help)
+        return err.code if isinstance(err.code, int) else EXIT_BAD_INPUT
+    if args.debug:
+        return args.func(args)
+    try:
+        return args.func(args)
+    except SceneError as err:
+        print(f"ngdual: error: {err}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except MemoryError:
+        print("ngdual: error: out of memory; choose a coarser level or maxh", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except KeyboardInterrupt:
+        print("ngdual: interrupted", file=sys.stderr)
+        return 130
+    except Exception as err:  # a bug: one line, the traceback with --debug
+        print(f"ngdual: internal error: {type(err).__name__}: {str(err)[:500]} (a bug in "
+              "ngdual: run again with --debug for the traceback and report it)",
+              file=sys.stderr)
+        return EXIT_INTERNAL
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,77 @@
+"""What the command line prints: result tables, residual histories, progress, flag checks."""
+
+from __future__ import annotations
+
+import sys
+
+from ..scene import SceneError, check_level
+
+EXIT_NOT_CONVERGED, EXIT_BAD_INPUT, EXIT_INTERNAL = 1, 2, 3
+HISTORY_ROWS = 8  # residuals shown when an iteration fails
+LARGE_MESH = 2e5  # triangles: say so before meshing
+
+
+def residual_history(err) -> str:
+    """The last residuals of a failed iteration, on one line."""
+    history = list(getattr(err, "history", None) or [])
+    if not history:
+        return ""
+    start = len(history) - min(len(history), HISTORY_ROWS)
+    rows = "  ".join(f"{start + k + 1}: {_residual(v)}" for k, v in enumerate(history[start:]))
+    return f"\nngdual: residual history, last {len(history) - start} of {len(history)} " \
+           f"steps (step: residual): {rows}"
+
+
+def _residual(value) -> str:
+    try:
+        return f"{float(value):.3e}"
+    except (TypeError, ValueError):
+        return str(value)[:40]
+
+
+def not_converged(err) -> int:
+    print(f"ngdual: not converged: {err}{residual_history(err)}", file=sys.stderr)
+    return EXIT_NOT_CONVERGED
+
+
+def number_flag(value, flag: str, low: float, high: float, integer: bool = False):
+    """``value`` if it is a (finite) number in [low, high]; a SceneError naming ``flag``."""
+    import math
+
+    kind = "an integer" if integer else "a number"
+    if value is None or not math.isfinite(value) or not low <= value <= high:
+        raise SceneError(flag, f"must be {kind} in [{low:g}, {high:g}], got {value!r}")
+    return value
+
+
+def level_flags(levels, flag: str) -> list[int]:
+    return [check_level(level, flag) for level in levels]
+
+
+def result_table(record: dict) -> str:
+    lines = [f"scene {record['scene']}  level {record['level']}  method {record['method']}  "
+             f"converged {record['converged']}"]
+    lines.append("dofs      " + "  ".join(f"{k}={v}" for k, v in record["dofs"].items()))
+    lines.append("norms     " + "  ".join(f"{k}={v:.6e}" for k, v in record["norms"].items()
+                                          if v is not None))
+    lines.append("contact   " + "  ".join(f"{k}={v:.6g}" if isinstance(v, float) else f"{k}={v}"
+                                          for k, v in record["contact"].items()))
+    lines.append("iterations " + "  ".join(f"{k}={v}" for k, v in record["iterations"].items()))
+    if record["residuals"]:
+        lines.append("residuals " + "  ".join(f"{k}={v:.2e}"
+                                              for k, v in record["residuals"].items()))
+    lines.append("time [s]  " + "  ".join(f"{k}={v:.3f}"
+                                          for k, v in record["timings_s"].items()))
+    return "\n".join(lines)
+
+
+def progress_bar():
+    from tqdm import tqdm
+
+    bar = tqdm(desc="Uzawa", unit="it", leave=False, file=sys.stderr,
+               disable=not sys.stderr.isatty())
+
+    def update(iteration: int, increment: float) -> None:
+        bar.update(1)
+        bar.set_postfix(increment=f"{increment:.1e}")
+    return update
