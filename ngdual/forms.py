@@ -28,7 +28,13 @@ from .expr import Expression
 from .scene import Scene
 from .sparse import to_scipy
 
-TRACE_BONUS_ORDER = 6
+# The data f, u_D, t0 and g may be any formula: f is integrated with the rule of degree 6 on
+# every triangle and u_D, t0, g with that of degree 12 on every edge, the rules NGSolve
+# chose for these forms when the cubic bubble element still had edge functions (twice its
+# order 3, plus 6 on the edges); quadrature_check evaluates the formulas on the same points.
+LOAD_ORDER, TRACE_ORDER = 6, 12
+LOAD_RULES = {ngs.TRIG: ngs.IntegrationRule(ngs.TRIG, LOAD_ORDER)}
+TRACE_RULES = {ngs.SEGM: ngs.IntegrationRule(ngs.SEGM, TRACE_ORDER)}
 # The volume integrands of a~, b and s are polynomials of degree <= 4 on every (affine)
 # triangle: sigma, tau are RT_0 (degree 1) plus Curl of a cubic bubble (degree 2), u is
 # constant, eta linear. The 6-point rule of degree 4 integrates them exactly; NGSolve's
@@ -212,21 +218,21 @@ def _forms(scene: Scene, fes: ngs.FESpace, names: list[str]):
     a += (eta * peers.asym(tau) + xi * peers.asym(sig)).Compile() * dx         # s(eta, tau)
     rhs = ngs.LinearForm(fes)
     f = ngs.CF(tuple(Expression(e).coefficient() for e in scene.loads.body_force))
-    rhs += -f * v * ngs.dx                                                    # -f(v)
+    rhs += -f * v * ngs.dx(intrules=LOAD_RULES)                               # -f(v)
     ds_d = ngs.ds(definedon=mesh.Boundaries(boundary_regex(scene.labels("dirichlet"))),
-                  bonus_intorder=TRACE_BONUS_ORDER)
+                  intrules=TRACE_RULES)
     u_d = ngs.CF(tuple(Expression(e).coefficient() for e in scene.loads.displacement))
     rhs += u_d * trac_tau * ds_d                                              # u = u_D on Gamma_D
     if "phi1" in names:
         ds_n = ngs.ds(definedon=mesh.Boundaries(boundary_regex(scene.labels("neumann"))),
-                      bonus_intorder=TRACE_BONUS_ORDER)
+                      intrules=TRACE_RULES)
         phi, psi = ngs.CF((trial["phi1"], trial["phi2"])), ngs.CF((test["phi1"], test["phi2"]))
         d += (phi * trac_tau + psi * trac_sig) * ds_n                         # d_N(phi, tau)
         t0 = ngs.CF(tuple(Expression(e).coefficient() for e in scene.loads.traction))
         rhs += t0 * psi * ds_n                                                # t0(psi)
     if "lam_n" in names:
         ds_c = ngs.ds(definedon=mesh.Boundaries(boundary_regex(scene.labels("contact"))),
-                      bonus_intorder=TRACE_BONUS_ORDER)
+                      intrules=TRACE_RULES)
         d += (trial["lam_t"] * (t * trac_tau) + test["lam_t"] * (t * trac_sig)) * ds_c  # d_Ct
         d += (trial["lam_n"] * (n * trac_tau) + test["lam_n"] * (n * trac_sig)) * ds_c  # d_Cn
         rhs += gap_coefficient(scene) * (n * trac_tau) * ds_c                 # g(tau)

@@ -4,7 +4,9 @@ X_h: each stress row is a lowest-order Raviart-Thomas field (NGSolve ``HDiv``
 order 0) plus the Curl of the cubic element bubble b_T. The cubic bubbles are
 exactly the ``LOCAL_DOF`` dofs of ``H1(order=3)`` (one per triangle); they are
 selected that way, never by clearing vertex and edge dofs, because after
-``mesh.Refine()`` NGSolve still counts the edges of coarser levels.
+``mesh.Refine()`` NGSolve still counts the edges of coarser levels. The edge
+functions are left out (``orderedge=1``): the element then has 4 shape functions
+instead of 10, which is what assembly pays for per triangle.
 M_h: piecewise constant displacement (two ``L2`` order 0 components).
 S_h: continuous piecewise linear rotation (``H1`` order 1).
 All spaces are compressed, so ``ndof`` is the true count of Table 3.1.
@@ -26,8 +28,8 @@ def raviart_thomas(mesh: ngs.Mesh) -> ngs.FESpace:
 
 
 def cubic_bubbles(mesh: ngs.Mesh) -> ngs.FESpace:
-    """The cubic element bubbles b_T: the LOCAL_DOF dofs of H1(order=3)."""
-    h1 = ngs.H1(mesh, order=3)
+    """The cubic element bubbles b_T: the LOCAL_DOF dofs of H1(order=3, orderedge=1)."""
+    h1 = ngs.H1(mesh, order=3, orderedge=1)
     return ngs.Compress(h1, active_dofs=~h1.FreeDofs(coupling=True))
 
 

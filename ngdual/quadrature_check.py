@@ -16,12 +16,11 @@ import ngsolve as ngs
 import numpy as np
 
 from .expr import Expression, quote
-from .forms import boundary_regex
+from .forms import LOAD_ORDER, TRACE_ORDER, boundary_regex
 from .scene import Scene, SceneError
 
-# rules at least as rich as assembly's (f against piecewise constants in the domain; traces
-# of RT0 + bubbles with bonus order 6 on the edges)
-ORDER = {ngs.TRIG: 5, ngs.SEGM: 8}
+# the rules of assembly (ngdual.forms): f on the triangles, u_D, t0, g and F on the edges
+ORDER = {ngs.TRIG: LOAD_ORDER, ngs.SEGM: TRACE_ORDER}
 
 
 def _rule(element: ngs.ET) -> ngs.IntegrationRule:
