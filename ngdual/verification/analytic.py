@@ -71,8 +71,17 @@ def _ellipse(x: np.ndarray, peak: float, half_width: float) -> np.ndarray:
     return peak * np.sqrt(np.clip(1.0 - (x / half_width) ** 2, 0.0, None))
 
 
+class _ContactZone:
+    """A contact zone |x| < a (attribute ``a``): the pressure is smooth inside and has its
+    break points at the ends only."""
+
+    @property
+    def breaks(self) -> tuple[float, ...]:
+        return (-self.a, self.a)
+
+
 @dataclass(frozen=True)
-class HertzContact:
+class HertzContact(_ContactZone):
     """Hertz contact of a cylinder (radius R) on a rigid plane, plane strain.
 
     >>> h = hertz(P=2.0, R=10.0, E=1.0, nu=0.0)
@@ -87,10 +96,6 @@ class HertzContact:
     p0: float
 
     singular = False
-
-    @property
-    def breaks(self) -> tuple[float, ...]:
-        return (-self.a, self.a)
 
     def pressure(self, x: np.ndarray) -> np.ndarray:
         """p(x) = p0 sqrt(1 - x^2/a^2) on |x| < a, 0 outside."""
@@ -119,7 +124,7 @@ def mcewen_approach(d: float, P: float, a: float, E: float, nu: float) -> float:
 
 
 @dataclass(frozen=True)
-class FlatPunch:
+class FlatPunch(_ContactZone):
     """A rigid flat punch of half-width a pressed with force P into a half-plane.
 
     >>> round(FlatPunch(3.0, 1.0).force_within(0.5), 12)
@@ -130,10 +135,6 @@ class FlatPunch:
     a: float
 
     singular = True
-
-    @property
-    def breaks(self) -> tuple[float, ...]:
-        return (-self.a, self.a)
 
     def pressure(self, x: np.ndarray) -> np.ndarray:
         """p(x) = P / (pi sqrt(a^2 - x^2)) on |x| < a, 0 outside (inf at x = +-a)."""

@@ -238,32 +238,33 @@ def tresca_case(b: float = 1.0, a: float = 2.0, d: float = 3.0, bound: float = 1
     Stick where |x| <= b or |x| >= d (|sigma_t| < F, u_t = 0), slip in between with
     sigma_t = F sign(x) = F sign(lambda_t); b < a < d, so the stick set in contact is [-b, b].
     """
-    base = frictionless_case(a)
-    return ManufacturedCase(
-        name=name or f"tresca-b{b:g}-a{a:g}-d{d:g}",
-        description=f"Tresca F = {bound:g}; contact [-{a:g}, {a:g}], stick [-{b:g}, {b:g}] "
-                    f"and |x| >= {d:g}",
-        law="tresca",
+    return _friction_case(
+        a, name or f"tresca-b{b:g}-a{a:g}-d{d:g}", "tresca",
+        f"Tresca F = {bound:g}; contact [-{a:g}, {a:g}], stick [-{b:g}, {b:g}] "
+        f"and |x| >= {d:g}",
         lam_t=SLIDE * (bump(b, d, ONSET + 1) - bump(-d, -b, ONSET + 1)),
-        u_n=base.u_n, lam_n=base.lam_n, sigma_n=base.sigma_n,
-        sigma_t=bound * stick_towards_ends(b, d),
-        contact_set=((-a, a),), stick_set=((-b, b),),
+        sigma_t=bound * stick_towards_ends(b, d), stick_set=((-b, b),),
         tresca_bound=Piecewise.constant(bound))
 
 
 def coulomb_case(b: float = 2.0 / 3.0, a: float = 7.0 / 3.0, mu_f: float = 0.5,
                  name: str | None = None) -> ManufacturedCase:
     """Coulomb, F = mu_f |sigma_n|: contact [-a, a], stick [-b, b], slip on b < |x| <= a."""
-    base = frictionless_case(a)
-    return ManufacturedCase(
-        name=name or f"coulomb-b{b:.4g}-a{a:.4g}",
-        description=f"Coulomb mu_f = {mu_f:g}; contact [-{a:.4g}, {a:.4g}], "
-                    f"stick [-{b:.4g}, {b:.4g}]",
-        law="coulomb",
+    return _friction_case(
+        a, name or f"coulomb-b{b:.4g}-a{a:.4g}", "coulomb",
+        f"Coulomb mu_f = {mu_f:g}; contact [-{a:.4g}, {a:.4g}], stick [-{b:.4g}, {b:.4g}]",
         lam_t=SLIDE * (bump(b, HALF_WIDTH, ONSET + 1) - bump(-HALF_WIDTH, -b, ONSET + 1)),
-        u_n=base.u_n, lam_n=base.lam_n, sigma_n=base.sigma_n,
-        sigma_t=mu_f * PRESSURE * cap(a) * smooth_sign(b),
-        contact_set=((-a, a),), stick_set=((-b, b),), mu_f=mu_f)
+        sigma_t=mu_f * PRESSURE * cap(a) * smooth_sign(b), stick_set=((-b, b),), mu_f=mu_f)
+
+
+def _friction_case(a: float, name: str, law: str, description: str,
+                   **friction) -> ManufacturedCase:
+    """The frictionless case with contact [-a, a] and the tangential fields ``friction``
+    (lam_t, sigma_t, stick_set and the law's bound) of a friction law."""
+    base = frictionless_case(a)
+    return ManufacturedCase(name=name, description=description, law=law, u_n=base.u_n,
+                            lam_n=base.lam_n, sigma_n=base.sigma_n, contact_set=((-a, a),),
+                            **friction)
 
 
 CASES = {
