@@ -17,6 +17,15 @@ Environment variables
 ``NGDUAL_TUTORIALS_DIR``
     Where the tutorial sources are. By default they are found next to the
     package, i.e. in the source checkout that ``pip install -e .`` links to.
+
+Pictures
+--------
+:func:`plot_geometry` draws the domain of a scene with its boundary parts Γ_D, Γ_N,
+Γ_C and the mesh (the first picture of every tutorial); :func:`plot_von_mises` the von
+Mises stress per element on a percentile-clipped colour scale (stated on the colour
+bar), because corner singularities would otherwise take the whole scale;
+:func:`plot_traces` the traces on Γ_C. They return matplotlib figures and need only
+matplotlib; :func:`save_figure` saves a figure and shows it in a notebook.
 """
 
 from __future__ import annotations
@@ -79,7 +88,7 @@ def save_figure(fig, path: str | Path) -> None:
     """Save a matplotlib figure as PNG and close it; in a notebook also show the file.
 
     The PNG is shown rather than the figure object, so the picture appears whatever
-    matplotlib backend is active (:mod:`ngdual.plot` selects Agg).
+    matplotlib backend is active (a headless run uses Agg).
     """
     import matplotlib.pyplot as plt
 
@@ -91,7 +100,7 @@ def save_figure(fig, path: str | Path) -> None:
 
 
 def show_file(path: str | Path) -> None:
-    """Show a PNG (e.g. one written by :mod:`ngdual.plot`) in a notebook; name it elsewhere."""
+    """Show a PNG in a notebook; print its path elsewhere."""
     if in_notebook():
         from IPython.display import Image, display
 
@@ -99,6 +108,143 @@ def show_file(path: str | Path) -> None:
     else:
         print(f"saved {path}")
 
+
+# --- pictures -------------------------------------------------------------------------------
+
+ROLES = {"dirichlet": (r"$\Gamma_D$", "tab:blue"), "neumann": (r"$\Gamma_N$", "tab:green"),
+         "contact": (r"$\Gamma_C$", "tab:red")}
+
+
+def boundary_segments(mesh) -> dict:
+    """The boundary edges of an NGSolve mesh by label: label -> array (k, 2, 2) of segments."""
+    import ngsolve as ngs
+    import numpy as np
+
+    from ..mesh import mesh_arrays
+
+    points, _ = mesh_arrays(mesh)
+    found: dict = {}
+    for element in mesh.Elements(ngs.BND):
+        found.setdefault(element.mat, []).append([v.nr for v in element.vertices])
+    return {label: points[np.array(edges)] for label, edges in found.items()}
+
+
+def plot_geometry(scene, mesh=None, level: int | None = None, title: str | None = None):
+    """The domain of ``scene`` with Γ_D, Γ_N, Γ_C in colour, each side named, and the mesh.
+
+    ``mesh``: an NGSolve mesh of the scene; by default the mesh of ``level`` (default:
+    the scene's level) is built. Returns the matplotlib figure.
+    """
+    import matplotlib.pyplot as plt
+    import numpy as np
+    from matplotlib.collections import LineCollection
+
+    from ..mesh import build_mesh, mesh_arrays
+
+    if mesh is None:
+        mesh = build_mesh(scene.geometry, level)
+    points, triangles = mesh_arrays(mesh)
+    segments = boundary_segments(mesh)
+    width, height = np.ptp(points, axis=0)
+    fig, ax = plt.subplots(figsize=(9, max(3.2, 7 * height / width + 1.6)))
+    ax.triplot(points[:, 0], points[:, 1], triangles, color="0.6", lw=0.4)
+    centre = points.mean(axis=0)
+    for role, (symbol, colour) in ROLES.items():
+        labels = [label for label in scene.labels(role) if label in segments]
+        if not labels:
+            continue
+        lines = np.concatenate([segments[label] for label in labels])
+        ax.add_collection(LineCollection(lines, colors=colour, lw=3.5,
+                                         label=f"{symbol}: {', '.join(labels)}"))
+        for label in labels:
+            middle = segments[label].mean(axis=(0, 1))
+            inward = centre - middle
+            inward = 22 * inward / (np.linalg.norm(inward) or 1.0)
+            ax.annotate(f"{symbol} ({label})", middle, xytext=tuple(inward),
+                        textcoords="offset points", color=colour, ha="center", va="center",
+                        fontsize=9, bbox={"fc": "white", "ec": "none", "alpha": 0.85, "pad": 1})
+    ax.set_aspect("equal")
+    ax.margins(0.1)
+    ax.set_xlabel("$x_1$")
+    ax.set_ylabel("$x_2$")
+    ax.set_title(title or f"{scene.name}: boundary parts and mesh ({mesh.ne} triangles)")
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=3, fontsize=9,
+              frameon=False)
+    fig.tight_layout()
+    return fig
+
+
+def plot_von_mises(mesh, sigma, nu: float, title: str, clip: float | None = 97.0,
+                   label: str = "von Mises stress"):
+    """The plane-strain von Mises stress of ``sigma`` per element (value at the centroid).
+
+    ``clip``: the colour scale ends at this percentile of the element values (corner
+    singularities would otherwise take the whole scale); the colour bar says so and
+    gives the true maximum. ``None`` shows the full range. Returns the figure.
+    """
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    from ..post import element_values, von_mises
+
+    points, triangles, values = element_values(mesh, von_mises(sigma, nu))
+    top = float(values.max())
+    vmax = float(np.percentile(values, clip)) if clip is not None else top
+    width, height = np.ptp(points, axis=0)
+    fig, ax = plt.subplots(figsize=(9, max(3.0, 7 * height / width + 1.0)))
+    art = ax.tripcolor(points[:, 0], points[:, 1], triangles, facecolors=values,
+                       cmap="viridis", vmin=0.0, vmax=vmax, edgecolors="none")
+    clipped = clip is not None and top > vmax
+    note = (f"\n(scale clipped at the {clip:g}th\npercentile; maximum {top:.3g})" if clipped
+            else "")
+    fig.colorbar(art, ax=ax, extend="max" if clipped else "neither", label=label + note,
+                 fraction=0.046, pad=0.02)
+    ax.set_aspect("equal")
+    ax.set_xlabel("$x_1$")
+    ax.set_ylabel("$x_2$")
+    ax.set_title(title)
+    fig.tight_layout()
+    return fig
+
+
+def plot_traces(traces, title: str):
+    """σ_n, σ_t (per fine edge) and λ_n − g, λ_t (nodal) along Γ_C; returns the figure.
+
+    ``traces``: :func:`ngdual.post.contact_traces` (``nd.contact_traces``).
+    """
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    fig, axes = plt.subplots(2, 2, figsize=(11, 6), sharex=True)
+    edge, node = np.argsort(traces.edge_xy[:, 0]), np.argsort(traces.node_xy[:, 0])
+    x_edge, x_node = traces.edge_xy[edge, 0], traces.node_xy[node, 0]
+    opening = (traces.lam_n - traces.gap)[node]
+    panels = [(axes[0, 0], x_edge, traces.sigma_n[edge], r"normal stress $\sigma_n^h$",
+               "steps-mid"),
+              (axes[0, 1], x_edge, traces.sigma_t[edge], r"tangential stress $\sigma_t^h$",
+               "steps-mid"),
+              (axes[1, 0], x_node, opening, r"$\lambda_n - g = -u_n$", "default"),
+              (axes[1, 1], x_node, traces.lam_t[node], r"$\lambda_t = -u_t$", "default")]
+    for ax, xs, ys, label, style in panels:
+        ax.plot(xs, ys, drawstyle=style, lw=1.2)
+        ax.set_ylabel(label)
+        ax.grid(alpha=0.3)
+    for ax, values in ((axes[0, 0], traces.sigma_n), (axes[0, 1], traces.sigma_t)):
+        limit = 1.4 * float(np.percentile(np.abs(values), 90))   # the ends of Γ_C are singular
+        if 0 < limit < np.max(np.abs(values)):
+            ax.set_ylim(-limit, limit)
+            ax.set_title(f"range clipped: |max| = {np.max(np.abs(values)):.3g} at the ends",
+                         fontsize=8)
+    contact = traces.coarse_xy[traces.coarse_in_contact, 0]
+    if contact.size:
+        axes[1, 0].plot(contact, np.interp(contact, x_node, opening), "rv", ms=4,
+                        label=r"$\tilde h$-node in contact")
+        axes[1, 0].legend(loc="best")
+    for ax in axes[1]:
+        ax.set_xlabel(r"$x_1$ on $\Gamma_C$")
+    fig.suptitle(title)
+    fig.tight_layout()
+    return fig
 
 def save_results(tutorial: str, results: dict) -> Path:
     """Write the numbers a tutorial computed to ``output_dir(tutorial)/results.json``.
