@@ -22,7 +22,7 @@ from ngdual.verification import analytic
 THESIS = "Beyond the thesis: contact scenes"
 STUDIES = ()
 SCENES = ("hertz-cylinder", "flat-punch", "cattaneo-mindlin", "wedge")
-CLIP = 99.0        # percentile of the von Mises stress where the colour scale ends
+CLIP = plot.CORNER_CLIP  # percentile of the von Mises stress where the colour scale ends
 WINDOW = 3.0       # the window shown: WINDOW contact half-widths around the contact zone
 
 
@@ -109,12 +109,13 @@ def run(ctx):
                              facecolors=arrays["von_mises"], cmap="viridis", vmin=0, vmax=vmax,
                              edgecolors="none", rasterized=True)
         fig.colorbar(art, ax=ax_f, extend="max",
-                     label=rf"$\sigma_0$ [stress units], clipped at its {CLIP:g}th percentile")
+                     label=plot.unit_label(r"von Mises stress $\sigma_0$", scene.units.stress)
+                     + f"\ncolour scale clipped at its {CLIP:g}th percentile near $\\Gamma_C$")
         ax_f.set_xlim(box[0], box[1])
         ax_f.set_ylim(box[2], box[3])
         ax_f.set_aspect("equal")
-        ax_f.set_xlabel(r"$x_1$ [length]")
-        ax_f.set_ylabel(r"$x_2$ [length]")
+        ax_f.set_xlabel(plot.unit_label(r"$x_1$", scene.units.length))
+        ax_f.set_ylabel(plot.unit_label(r"$x_2$", scene.units.length))
         ax_f.set_title(f"{name}: von Mises stress near $\\Gamma_C$ (level {level})")
         order = np.argsort(x)
         hat = np.argsort(arrays["hat_x"])
@@ -137,8 +138,8 @@ def run(ctx):
         ax_c.set_xlim(box[0], box[1])
         top = max(arrays["hat_pressure"].max(), np.abs(arrays["hat_shear"]).max())
         ax_c.set_ylim(-0.15 * top, 1.5 * top)  # the flat punch's exact p is unbounded
-        ax_c.set_xlabel(r"$x_1$ on $\Gamma_C$ [length]")
-        ax_c.set_ylabel("traction [stress units]")
+        ax_c.set_xlabel(plot.unit_label(r"$x_1$ on $\Gamma_C$", scene.units.length))
+        ax_c.set_ylabel(plot.unit_label("traction", scene.units.stress))
         ax_c.grid(alpha=0.3)
         ax_c.legend(loc="upper right", fontsize=8)
         ax_c.set_title(f"P = {P:.4g}" + (f", Q = {Q:.4g}" if abs(Q) > 1e-9 * abs(P) else ""))

@@ -35,12 +35,8 @@ from ngdual.forms import assemble, boundary_regex
 from ngdual.friction import build_friction_forms, tresca_bound
 from ngdual.mesh import build_mesh
 from ngdual.solvers import solve_scene
-from ngdual.verification.manufactured import (
-    contact_profile,
-    edge_spikes,
-    manufactured_case,
-    pressure_errors,
-)
+from ngdual.verification.manufactured import manufactured_case
+from ngdual.verification.manufactured_errors import contact_profile, edge_spikes, pressure_errors
 
 CASE = "frictionless-offnode"
 LEVELS = (2, 3, 4, 5)

@@ -15,8 +15,8 @@ import pytest
 
 from ngdual.cli import main
 from ngdual.verification import cattaneo_mindlin, flat_punch, hertz
-from ngdual.verification.analytic import _nodes
 from ngdual.verification.contact_benchmarks import domain_study, uniform_study
+from ngdual.verification.traction import _nodes
 
 
 def _integral(f, a, b):

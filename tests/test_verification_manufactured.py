@@ -30,7 +30,7 @@ with |nu| < 1 inside it) are compared with the exact ones by the length of the s
 difference. A grid cannot place an end point between its nodes (``*_resolution``, zero on
 the dyadic cases); beyond that the end points are recovered within one edge, and exactly on
 the dyadic cases except for one node next to the edge of the Tresca contact zone (see
-:func:`ngdual.verification.manufactured.contact_profile`).
+:func:`ngdual.verification.manufactured_errors.contact_profile`).
 
 Run with ``pytest -s`` to see the convergence tables.
 """

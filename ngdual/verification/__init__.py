@@ -1,53 +1,55 @@
 """Verification against exact solutions.
 
 :mod:`ngdual.verification.manufactured`: manufactured contact problems (frictionless,
-Tresca, Coulomb) whose contact, stick and slip sets are known exactly, and the study of
-every error per level with observed orders (:func:`manufactured_study`,
-:func:`convergence_orders`, :func:`format_study`).
+Tresca, Coulomb) whose contact, stick and slip sets are known exactly;
+:mod:`ngdual.verification.manufactured_errors`: the study of every error per level with
+observed orders (:func:`manufactured_study`, :func:`convergence_orders`,
+:func:`format_study`).
 
 :mod:`ngdual.verification.analytic`: the half-plane contact solutions (Hertz, the rigid flat
-punch, Cattaneo-Mindlin) and the errors of a computed pressure and shear traction against
-them (:func:`pressure_errors`, :func:`traction_errors`).
+punch, a blunt wedge, Cattaneo-Mindlin); :mod:`ngdual.verification.traction`: the discrete
+pressure and shear traction on Gamma_C and their errors against them
+(:func:`traction_profile`, :func:`pressure_errors`, :func:`traction_errors`);
+:mod:`ngdual.verification.corner`: Williams' L-shaped corner problem.
 :mod:`ngdual.verification.contact_benchmarks`: those errors per level on the shipped contact
 scenes, adaptive runs and the finite-box study; :mod:`ngdual.verification.report`: the
 tables of ``ngdual verify``.
 """
 
 from .analytic import (
-    CattaneoMindlin,
-    FlatPunch,
-    HertzContact,
-    TractionProfile,
-    Wedge,
-    cattaneo_mindlin,
-    flat_punch,
-    hertz,
-    mcewen_approach,
-    pressure_errors,
-    traction_errors,
-    traction_profile,
-    wedge,
+           CattaneoMindlin,
+           FlatPunch,
+           HertzContact,
+           Wedge,
+           cattaneo_mindlin,
+           flat_punch,
+           hertz,
+           mcewen_approach,
+           wedge,
 )
 from .manufactured import (
-    CASES,
-    ExactSolution,
-    ManufacturedCase,
-    boundary_errors,
-    contact_profile,
-    convergence_orders,
-    coulomb_case,
-    discrete_sets,
-    format_study,
-    frictionless_case,
-    intersection,
-    manufactured_case,
-    manufactured_study,
-    print_study,
-    symmetric_difference,
-    tresca_case,
-    volume_errors,
+           CASES,
+           ExactSolution,
+           ManufacturedCase,
+           coulomb_case,
+           frictionless_case,
+           manufactured_case,
+           tresca_case,
+)
+from .manufactured_errors import (
+           boundary_errors,
+           contact_profile,
+           convergence_orders,
+           discrete_sets,
+           format_study,
+           intersection,
+           manufactured_study,
+           print_study,
+           symmetric_difference,
+           volume_errors,
 )
 from .piecewise import Piecewise
+from .traction import TractionProfile, pressure_errors, traction_errors, traction_profile
 
 __all__ = ["CASES", "CattaneoMindlin", "ExactSolution", "FlatPunch", "HertzContact",
            "ManufacturedCase", "Piecewise", "TractionProfile", "Wedge", "boundary_errors",

@@ -62,14 +62,8 @@ from ..mesh import mesh_size
 from ..scene import Scene, load_scene
 from ..solvers import solve_scene
 from ..solvers.result import Solution
-from .analytic import (
-    cattaneo_mindlin,
-    flat_punch,
-    hertz,
-    pressure_errors,
-    traction_errors,
-    traction_profile,
-)
+from .analytic import cattaneo_mindlin, flat_punch, hertz
+from .traction import pressure_errors, traction_errors, traction_profile
 
 
 def _cylinder_overrides(half_width: float = 4.0, height: float = 4.0,
@@ -139,7 +133,7 @@ def _common(solution: Solution, errors: dict) -> dict:
 
 
 def hertz_row(solution: Solution) -> dict:
-    """Hertz errors of one solution (:func:`~ngdual.verification.analytic.pressure_errors`,
+    """Hertz errors of one solution (:func:`~ngdual.verification.traction.pressure_errors`,
     exact Hertz with the computed force); ``force_core`` = |int_{|x|<a/2} p_h / (the
     Hertz force there) - 1| (and ``force_core_signed``), ``a_error`` = |a_h - a|."""
     scene = solution.problem.scene
@@ -255,7 +249,7 @@ def _signed(row: dict, key: str) -> float:
 def format_rows(rows: list[dict], keys, h_label: str = "h~") -> str:
     """A text table: level, ndof, h (``h_label``: h~ under uniform refinement), each error
     with its observed order in h, then a, a_h, P."""
-    from .manufactured import convergence_orders
+    from .manufactured_errors import convergence_orders
 
     if not rows:
         return ""

@@ -10,7 +10,7 @@ so that solves in different processes (a sweep's records) can be compared later:
   at these nodes *is* the field, triangle by triangle (values taken inside the triangle,
   discontinuities kept).
 * the contact pressure on a horizontal Gamma_C as a P1 function on the h~ mesh: the lumped
-  L2 projection of -sigma_n^h onto the h~ hats (:func:`ngdual.verification.analytic.
+  L2 projection of -sigma_n^h onto the h~ hats (:func:`ngdual.verification.traction.
   traction_profile`; the fine-edge values of sigma_n^h oscillate, see there).
 
 Errors (:func:`field_errors`, :func:`pressure_error`) are integrals over the reference's
@@ -185,7 +185,7 @@ def solution_samples(solution) -> dict:
     row-major), u and the rotation eta, and the Gamma_C pressure (``p_nodes``, ``p``: P1 on
     the h~ mesh) when the scene has a contact boundary."""
     from ..quantities import fields
-    from .analytic import traction_profile
+    from .traction import traction_profile
 
     f = fields(solution)
     pb = solution.problem

@@ -16,7 +16,8 @@ import math
 from ..io import write_json
 from .contact_benchmarks import BENCHMARKS, KEYS, adaptive_study, domain_study, format_rows
 from .contact_benchmarks import uniform_study as benchmark_study
-from .manufactured import CASES, format_study, manufactured_study
+from .manufactured import CASES
+from .manufactured_errors import format_study, manufactured_study
 
 QUICK = {"manufactured": ("frictionless", "coulomb"), "manufactured_levels": (1, 2),
          "benchmark_levels": (1, 2)}

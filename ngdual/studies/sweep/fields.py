@@ -16,7 +16,7 @@ def field_arrays(solution) -> dict[str, np.ndarray]:
     ``lam_n``, ``lam_t``, ``gap``; per h~ node ``coarse_x``, ``in_contact`` and the
     pressure and shear traction the contact conditions see, ``hat_x`` (coordinate along the
     foundation), ``hat_pressure``, ``hat_shear``
-    (:func:`ngdual.verification.analytic.traction_profile`).
+    (:func:`ngdual.verification.traction.traction_profile`).
     With friction (:func:`ngdual.post.friction_diagnostics`): per h~ node
     ``hat_ratio`` (|int sigma_t mu_i| / |int sigma_n mu_i|), ``bound_ratio``
     (|int sigma_t mu_i| / int F mu_i, at most 1 by (3.62): the discrete Coulomb
@@ -50,7 +50,7 @@ def field_arrays(solution) -> dict[str, np.ndarray]:
                    sigma_t=tr.sigma_t, edge_active=tr.edge_active, node_x=tr.node_xy[:, 0],
                    lam_n=tr.lam_n, lam_t=tr.lam_t, gap=tr.gap, coarse_x=tr.coarse_xy[:, 0],
                    in_contact=tr.coarse_in_contact)
-        from ...verification.analytic import traction_profile
+        from ...verification.traction import traction_profile
 
         profile = traction_profile(solution)
         out.update(hat_x=profile.x, hat_pressure=profile.pressure, hat_shear=profile.shear)

@@ -170,9 +170,10 @@ def manufactured_task(case: str, level: int, marking: str | None = None, theta: 
                       steps: int = 1) -> tuple[dict, dict]:
     """A manufactured case (:mod:`ngdual.verification.manufactured`) on uniform ``level``
     (``marking=None``) or adaptively from it: per step the DOFs, the estimator of (4.50)
-    and the exact errors (:func:`~ngdual.verification.manufactured.volume_errors`)."""
+    and the exact errors (:func:`~ngdual.verification.manufactured_errors.volume_errors`)."""
     from ...afem import adapt
-    from ...verification.manufactured import manufactured_case, volume_errors
+    from ...verification.manufactured import manufactured_case
+    from ...verification.manufactured_errors import volume_errors
 
     mc = manufactured_case(case)
     history = []
