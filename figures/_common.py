@@ -5,6 +5,7 @@ from pathlib import Path
 import numpy as np
 
 from ngdual import plot
+from ngdual.scene import load_scene
 from ngdual.studies.figures import (
     PROBLEM_TITLES,
     SCENES,
@@ -13,6 +14,20 @@ from ngdual.studies.figures import (
     markdown_table,
     outcome,
 )
+
+# the units the thesis scenes declare ([units]; none: labels name the quantity alone)
+UNITS = load_scene(SCENES["frictionless"]).units
+
+
+def length(quantity: str) -> str:
+    """An axis label of a length, displacement or gap, in the thesis scenes' length unit."""
+    return plot.unit_label(quantity, UNITS.length)
+
+
+def stress(quantity: str) -> str:
+    """An axis label of a stress or traction, in the thesis scenes' stress unit."""
+    return plot.unit_label(quantity, UNITS.stress)
+
 
 NORM_KEYS = ("sigma_X", "u", "eta", "phi", "lam_t", "lam_n", "nu")
 NORM_LABELS = {"sigma_X": "||sigma||_X", "u": "||u||_L2", "eta": "||eta||_L2",
@@ -130,16 +145,16 @@ def gamma_c_stress(ctx: Context, fields: dict, thesis: str, key: str, tex: str, 
                        "ylim": (-1.25 * span, 1.25 * span),
                        "note": f"corner singularities at x_1 = +-4 off scale "
                                f"(|{key}| up to {np.abs(a[key]).max():.3g}; see the CSV)",
-                       "xlabel": r"$x_1$ on $\Gamma_C$ [length]",
-                       "ylabel": rf"${tex}^h$ [stress units]",
+                       "xlabel": length(r"$x_1$ on $\Gamma_C$"),
+                       "ylabel": stress(rf"${tex}^h$"),
                        "curves": [{"x": a["edge_x"][order], "y": a[key][order],
                                    "drawstyle": "steps-mid", "label": rf"${tex}^h$"}]})
         active = a["edge_active"].astype(bool)
         numbers[f"max |{key}| on A_C, {PROBLEM_TITLES[p]}"] = float(np.abs(a[key][active]).max())
         numbers[f"max |{key}| overall (corners), {PROBLEM_TITLES[p]}"] = float(
             np.abs(a[key]).max())
-    figs = plot.plot_curves(panels, ctx.figure_stem(stem),
-                            rf"{thesis}: {what} ${tex}^h$ on $\Gamma_C$")
+    fig = plot.plot_curves(panels, rf"{thesis}: {what} ${tex}^h$ on $\Gamma_C$")
+    figs = plot.save_figure(fig, ctx.figure_stem(stem))
     return figs, data, numbers
 
 
@@ -155,12 +170,12 @@ def neumann_multiplier(ctx: Context, thesis: str, component: int, stem: str) -> 
                          f"phi_{component}^h at the fine vertices of Gamma_N (x_2 = 1), "
                          "both problems")
     panels = [{"title": f"{PROBLEM_TITLES[p]}, level {ctx.plan.field_level}",
-               "xlabel": r"$x_1$ on $\Gamma_N$ [length]", "ylabel": rf"${tex}^h$ [length]",
+               "xlabel": length(r"$x_1$ on $\Gamma_N$"), "ylabel": length(rf"${tex}^h$"),
                "curves": [{"x": a["phi_x"], "y": a[key], "label": PROBLEM_TITLES[p],
                            **NEUMANN_STYLE[p]}]}
               for p, (_, a) in fields.items()]
-    figs = plot.plot_curves(panels, ctx.figure_stem(stem),
-                            rf"{thesis}: ${tex}^h$ on the Neumann boundary $\Gamma_N$")
+    fig = plot.plot_curves(panels, rf"{thesis}: ${tex}^h$ on the Neumann boundary $\Gamma_N$")
+    figs = plot.save_figure(fig, ctx.figure_stem(stem))
     name = f"phi_{component}"
     ctx.entry(thesis, f"{name} on Gamma_N", [*figs, data],
               {f"range {name}, mu_f = 0": [float(a0[key].min()), float(a0[key].max())],

@@ -118,10 +118,10 @@ def run(ctx):
                                "y": [r["effectivity"] for r in pts], "label": m, **style[m]})
         panels.append({"title": p, "xlabel": "unknowns [-]",
                        "ylabel": r"$\eta\,/\,e_{true}$ [-]", "loglog": True, "curves": curves})
-    figs = plot.plot_curves(panels, ctx.figure_stem("effectivity"),
-                            r"Effectivity $\eta / e_{true}$ of the estimator (4.50) against "
-                            "exact and overkill errors", ncols=3, panel_size=(4.4, 3.2),
-                            figure_legend=True)
+    fig = plot.plot_curves(panels, r"Effectivity $\eta / e_{true}$ of the estimator (4.50) against "
+                           "exact and overkill errors", ncols=3, panel_size=(4.4, 3.2),
+                           figure_legend=True)
+    figs = plot.save_figure(fig, ctx.figure_stem("effectivity"))
     numbers = {f"{s['problem']}, {s['method']}: effectivity range": [s["min"], s["max"]]
                for s in summary}
     for e in ("thesis", "consistent"):

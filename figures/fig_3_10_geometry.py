@@ -37,14 +37,15 @@ def run(ctx):
     data = ctx.write_csv("fig_3_10_geometry.csv", rows,
                          "Example 3.46: traction t_0,2 on Gamma_N and gap functions g on Gamma_C")
     # PLOT
-    figs = plot.plot_domain(points, triangles, x, load,
-                            [(x, -1 - 20 * gaps[list(GAPS)[0]], "constant gap g = 0.01 (x20)",
-                              {"color": "red"}),
-                             (x, -1 - gaps[list(GAPS)[3]], "gap (3.125)",
-                              {"color": "blue", "ls": "--"})],
-                            [(x, g, label, {}) for label, g in gaps.items()],
-                            ctx.figure_stem("fig_3_10_geometry"),
-                            "Example 3.46: geometry, boundary parts and rigid foundations")
+    fig = plot.plot_domain(points, triangles, x, load,
+                           [(x, -1 - 20 * gaps[list(GAPS)[0]], "constant gap g = 0.01 (x20)",
+                             {"color": "red"}),
+                            (x, -1 - gaps[list(GAPS)[3]], "gap (3.125)",
+                             {"color": "blue", "ls": "--"})],
+                           [(x, g, label, {}) for label, g in gaps.items()],
+                           "Example 3.46: geometry, boundary parts and rigid foundations",
+                           units=scene.units)
+    figs = plot.save_figure(fig, ctx.figure_stem("fig_3_10_geometry"))
     ctx.entry(THESIS, "Geometry, boundary parts and rigid foundations", [*figs, data],
               numbers={"min t_0,2 (at x_1 = 0)": float(load.min()),
                        "gap (3.125) at x_1 = -4, 0, 0.4, 4": [

@@ -1,7 +1,7 @@
 """Fig. 3.12: displacement u_1^h in Omega (piecewise constant), mu_f = 0 and mu_f = 0.5."""
 
 import numpy as np
-from _common import element_rows
+from _common import UNITS, element_rows, length
 
 from ngdual import plot
 from ngdual.studies.figures import script_main
@@ -20,10 +20,10 @@ def run(ctx):
     data = ctx.write_csv("fig_3_12_u1.csv", element_rows(fields, "u1"),
                          "u_1^h per element (centroid), both problems")
     # PLOT
-    figs = plot.plot_field_pair(a0["points"], a0["triangles"], [a0["u1"], a1["u1"]],
-                                ctx.titles(), r"$u_1^h$ [length]",
-                                "Fig. 3.12: horizontal displacement $u_1^h$",
-                                ctx.figure_stem("fig_3_12_u1"))
+    fig = plot.plot_field_pair(a0["points"], a0["triangles"], [a0["u1"], a1["u1"]],
+                               ctx.titles(), length(r"$u_1^h$"),
+                               "Fig. 3.12: horizontal displacement $u_1^h$", units=UNITS)
+    figs = plot.save_figure(fig, ctx.figure_stem("fig_3_12_u1"))
     k = int(np.argmax(diff))
     ctx.entry(THESIS, "Displacement u_1 in Omega", [*figs, data],
               {"range u_1, mu_f = 0": [float(a0["u1"].min()), float(a0["u1"].max())],

@@ -1,7 +1,7 @@
 """Fig. 3.13: displacement u_2^h in Omega (piecewise constant), mu_f = 0 and mu_f = 0.5."""
 
 import numpy as np
-from _common import element_rows
+from _common import UNITS, element_rows, length
 
 from ngdual import plot
 from ngdual.studies.figures import script_main
@@ -18,10 +18,10 @@ def run(ctx):
     data = ctx.write_csv("fig_3_13_u2.csv", element_rows(fields, "u2"),
                          "u_2^h per element (centroid), both problems")
     # PLOT
-    figs = plot.plot_field_pair(a0["points"], a0["triangles"], [a0["u2"], a1["u2"]],
-                                ctx.titles(), r"$u_2^h$ [length]",
-                                "Fig. 3.13: vertical displacement $u_2^h$",
-                                ctx.figure_stem("fig_3_13_u2"))
+    fig = plot.plot_field_pair(a0["points"], a0["triangles"], [a0["u2"], a1["u2"]],
+                               ctx.titles(), length(r"$u_2^h$"),
+                               "Fig. 3.13: vertical displacement $u_2^h$", units=UNITS)
+    figs = plot.save_figure(fig, ctx.figure_stem("fig_3_13_u2"))
     ctx.entry(THESIS, "Displacement u_2 in Omega", [*figs, data],
               {"min u_2, mu_f = 0": float(a0["u2"].min()),
                "min u_2, mu_f = 0.5": float(a1["u2"].min()),

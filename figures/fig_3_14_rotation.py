@@ -6,7 +6,7 @@ body starts to slide; the extrema lie on the boundary.
 """
 
 import numpy as np
-from _common import element_rows
+from _common import UNITS, element_rows
 
 from ngdual import plot
 from ngdual.studies.figures import script_main
@@ -27,10 +27,10 @@ def run(ctx):
     data = ctx.write_csv("fig_3_14_rotation.csv", element_rows(fields, "eta"),
                          "rotation eta^h at the element centroids, both problems")
     # PLOT
-    figs = plot.plot_field_pair(a0["points"], a0["triangles"], [a0["eta"], a1["eta"]],
-                                ctx.titles(), r"$\eta^h$ [rad]",
-                                r"Fig. 3.14: rotation $\eta^h$",
-                                ctx.figure_stem("fig_3_14_rotation"))
+    fig = plot.plot_field_pair(a0["points"], a0["triangles"], [a0["eta"], a1["eta"]],
+                               ctx.titles(), r"$\eta^h$ [rad]",
+                               r"Fig. 3.14: rotation $\eta^h$", units=UNITS)
+    figs = plot.save_figure(fig, ctx.figure_stem("fig_3_14_rotation"))
     ctx.entry(THESIS, "Rotation eta in Omega", [*figs, data],
               {"max |eta| on the bottom row, |x_1| < 1, mu_f = 0":
                    float(np.abs(a0["eta"][contact_row]).max()),

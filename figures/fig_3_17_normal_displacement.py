@@ -5,7 +5,7 @@ but with friction the contact zone is larger (ten more vertices in contact on le
 """
 
 import numpy as np
-from _common import curve_rows
+from _common import curve_rows, length
 
 from ngdual import plot
 from ngdual.studies.figures import PROBLEM_TITLES, script_main
@@ -33,8 +33,8 @@ def run(ctx):
         x, y = a["node_x"][order], (a["lam_n"] - a["gap"])[order]
         xc = a["coarse_x"][a["in_contact"]]
         panels.append({"title": f"{PROBLEM_TITLES[p]}, level {ctx.plan.field_level}",
-                       "xlabel": r"$x_1$ on $\Gamma_C$ [length]",
-                       "ylabel": r"$\lambda_n^h - g$ [length]",
+                       "xlabel": length(r"$x_1$ on $\Gamma_C$"),
+                       "ylabel": length(r"$\lambda_n^h - g$"),
                        "curves": [{"x": x, "y": y, "label": r"$\lambda_n^h - g$"},
                                   {"x": xc, "y": np.interp(xc, x, y), "ls": "none",
                                    "marker": "v", "color": "red", "ms": 4,
@@ -45,8 +45,9 @@ def run(ctx):
         if len(xc):
             numbers[f"contact zone (h~ nodes), {PROBLEM_TITLES[p]}"] = [float(xc.min()),
                                                                         float(xc.max())]
-    figs = plot.plot_curves(panels, ctx.figure_stem("fig_3_17_normal_displacement"),
-                            r"Fig. 3.17: normal displacement $\lambda_n^h - g$ on $\Gamma_C$")
+    fig = plot.plot_curves(panels,
+                           r"Fig. 3.17: normal displacement $\lambda_n^h - g$ on $\Gamma_C$")
+    figs = plot.save_figure(fig, ctx.figure_stem("fig_3_17_normal_displacement"))
     ctx.entry(THESIS, "Normal displacement lambda_n - g on Gamma_C", [*figs, data, contact],
               numbers, thesis_says="frictional case: ten more vertices in contact than "
               "frictionless on the finest level (level 8); active zone about x_1 in (-1.3, 1.3).")

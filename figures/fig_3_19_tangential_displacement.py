@@ -5,7 +5,7 @@ With friction, the h~ nodes in contact are marked stick (green) or slip (red) as
 """
 
 import numpy as np
-from _common import curve_rows
+from _common import curve_rows, length
 
 from ngdual import plot
 from ngdual.studies.figures import PROBLEM_TITLES, script_main
@@ -42,10 +42,11 @@ def run(ctx):
             numbers["stick / slip nodes, mu_f = 0.5"] = [record["contact"]["stick_nodes"],
                                                          record["contact"]["slip_nodes"]]
         panels.append({"title": f"{PROBLEM_TITLES[p]}, level {ctx.plan.field_level}",
-                       "xlabel": r"$x_1$ on $\Gamma_C$ [length]",
-                       "ylabel": r"$\lambda_t^h$ [length]", "curves": curves})
-    figs = plot.plot_curves(panels, ctx.figure_stem("fig_3_19_tangential_displacement"),
-                            r"Fig. 3.19: tangential displacement $\lambda_t^h$ on $\Gamma_C$")
+                       "xlabel": length(r"$x_1$ on $\Gamma_C$"),
+                       "ylabel": length(r"$\lambda_t^h$"), "curves": curves})
+    fig = plot.plot_curves(panels,
+                           r"Fig. 3.19: tangential displacement $\lambda_t^h$ on $\Gamma_C$")
+    figs = plot.save_figure(fig, ctx.figure_stem("fig_3_19_tangential_displacement"))
     ctx.entry(THESIS, "Tangential displacement lambda_t on Gamma_C", [*figs, data, status],
               numbers, thesis_says="with friction a sticking zone around x_1 in (-0.5, 0.5).")
 

@@ -9,6 +9,7 @@ sticks (the thesis: nu = sigma_t / (mu_f |sigma_n|) on all of A_C, Remark 3.15).
 """
 
 import numpy as np
+from _common import length
 
 from ngdual import plot
 from ngdual.studies.figures import script_main
@@ -47,7 +48,7 @@ def run(ctx):
     ys = np.repeat(a["nu"][support], 2)
     panels = [
         {"title": r"(a) $|\sigma_t^h| / |\sigma_n^h|$ on $A_C$",
-         "xlabel": r"$x_1$ on $\Gamma_C$ [length]", "ylabel": "traction ratio [-]",
+         "xlabel": length(r"$x_1$ on $\Gamma_C$"), "ylabel": "traction ratio [-]",
          "curves": [{"x": a["edge_x"][active][order], "y": ratio[active][order],
                      "marker": ".", "label": "per fine edge"},
                     {"x": a["hat_node_x"][in_contact], "y": discrete[in_contact],
@@ -55,13 +56,13 @@ def run(ctx):
                      "label": r"$\mu_f |\int\sigma_t\mu_i| / \int F\mu_i$ per $\tilde h$ node"}],
          "hlines": [(MU_F, r"$\mu_f = 0.5$", {"color": "k", "ls": "--", "lw": 1})]},
         {"title": r"(b) sign $\nu^h$ of $\lambda_t^h$ on $A_C$ ($\hat h$ edges)",
-         "xlabel": r"$x_1$ on $\Gamma_C$ [length]", "ylabel": r"$\nu^h$ [-]",
+         "xlabel": length(r"$x_1$ on $\Gamma_C$"), "ylabel": r"$\nu^h$ [-]",
          "curves": [{"x": xs, "y": ys, "color": "tab:red", "label": r"$\nu^h$"}],
          "ylim": (-1.1, 1.1)},
     ]
-    figs = plot.plot_curves(panels, ctx.figure_stem("fig_3_21_friction_ratio_and_sign"),
-                            rf"Fig. 3.21: Coulomb friction $\mu_f = 0.5$, level "
-                            rf"{ctx.plan.field_level}")
+    fig = plot.plot_curves(panels, rf"Fig. 3.21: Coulomb friction $\mu_f = 0.5$, level "
+                           rf"{ctx.plan.field_level}")
+    figs = plot.save_figure(fig, ctx.figure_stem("fig_3_21_friction_ratio_and_sign"))
     ctx.entry(THESIS, "|sigma_t| / |sigma_n| and the sign nu on A_C", [*figs, data, nu_data],
               {"max mu_f |int sigma_t mu_i| / int F mu_i on contact nodes":
                    float(discrete[in_contact].max()),

@@ -35,15 +35,15 @@ def run(ctx):
     n_last = series["frictionless"][-1][0]
     curves.append({"x": [n0, n_last], "y": [0.7 * e0, 0.7 * e0 * (n_last / n0) ** -0.2],
                    "color": "k", "ls": ":", "label": "slope -1/5 (thesis)"})
-    figs = plot.plot_curves([{"title": "uniform refinement, Example 3.46",
-                              "xlabel": "degrees of freedom N [-]",
-                              "ylabel": r"$e_{tot}$ (3.124) [norm units]",
-                              "curves": curves, "loglog": True,
-                              "note": f"reference: Aitken limit of levels "
-                                      f"{ctx.plan.reference_levels}"}],
-                            ctx.figure_stem("fig_3_22_convergence"),
-                            "Fig. 3.22: convergence of the frictionless and frictional problems",
-                            ncols=1, panel_size=(6.5, 4.5))
+    fig = plot.plot_curves([{"title": "uniform refinement, Example 3.46",
+                             "xlabel": "degrees of freedom N [-]",
+                             "ylabel": r"$e_{tot}$ (3.124)",
+                             "curves": curves, "loglog": True,
+                             "note": f"reference: Aitken limit of levels "
+                                     f"{ctx.plan.reference_levels}"}],
+                           "Fig. 3.22: convergence of the frictionless and frictional problems",
+                           ncols=1, panel_size=(6.5, 4.5))
+    figs = plot.save_figure(fig, ctx.figure_stem("fig_3_22_convergence"))
     ctx.entry(THESIS, "Convergence of the total error", [*figs, data],
               {**{f"e_tot at level {lv}, {PROBLEM_TITLES[p]}": e for p, pts in series.items()
                   for _, e, lv in pts[-2:]},

@@ -36,12 +36,12 @@ def run(ctx):
     data = ctx.write_csv("fig_3_23_rho_grid.csv", rows,
                          f"nested Uzawa iterations over (rho_1, rho_2), level {plan.rho_level}")
     # PLOT
-    figs = plot.plot_heatmaps(plan.rho1_grid, plan.rho2_grid, [grids["outer"], grids["inner"]],
-                              ["(a) outer iterations", "(b) inner iterations (total)"],
-                              r"$\rho_1$ [-]", r"$\rho_2$ (relative to the stability bound) [-]",
-                              ["outer iterations [count]", "inner iterations [count]"],
-                              ctx.figure_stem("fig_3_23_rho_grid"),
-                              rf"Fig. 3.23: Coulomb $\mu_f = 0.5$, level {plan.rho_level}")
+    fig = plot.plot_heatmaps(plan.rho1_grid, plan.rho2_grid, [grids["outer"], grids["inner"]],
+                             ["(a) outer iterations", "(b) inner iterations (total)"],
+                             r"$\rho_1$ [-]", r"$\rho_2$ (relative to the stability bound) [-]",
+                             ["outer iterations [count]", "inner iterations [count]"],
+                             rf"Fig. 3.23: Coulomb $\mu_f = 0.5$, level {plan.rho_level}")
+    figs = plot.save_figure(fig, ctx.figure_stem("fig_3_23_rho_grid"))
     opt = best(records)
     ctx.entry(THESIS, "Iteration numbers over (rho_1, rho_2)", [*figs, data],
               {"optimal (rho_1, rho_2)": opt,

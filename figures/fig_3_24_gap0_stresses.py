@@ -6,6 +6,7 @@ kinks of sigma_t mark the change between slip and stick.
 """
 
 import numpy as np
+from _common import length, stress
 
 from ngdual import plot
 from ngdual.studies.figures import gap_tasks, outcome, require, script_main
@@ -31,22 +32,22 @@ def run(ctx):
     # PLOT
     level = task.params["level"]
     panels = [{"title": f"(a) normal stress, level {level}",
-               "xlabel": r"$x_1$ on $\Gamma_C$ [length]",
-               "ylabel": r"$\sigma_n^h$ [stress units]",
+               "xlabel": length(r"$x_1$ on $\Gamma_C$"),
+               "ylabel": stress(r"$\sigma_n^h$"),
                "curves": [{"x": a["edge_x"][order], "y": a["sigma_n"][order],
                            "drawstyle": "steps-mid", "label": r"$\sigma_n^h$"}]},
               {"title": f"(b) tangential stress, level {level}",
-               "xlabel": r"$x_1$ on $\Gamma_C$ [length]",
-               "ylabel": r"$\sigma_t^h$ [stress units]",
+               "xlabel": length(r"$x_1$ on $\Gamma_C$"),
+               "ylabel": stress(r"$\sigma_t^h$"),
                "curves": [{"x": a["edge_x"][order], "y": a["sigma_t"][order],
                            "drawstyle": "steps-mid", "label": r"$\sigma_t^h$"},
                           {"x": a["edge_x"][order], "y": 0.5 * np.abs(a["sigma_n"][order]),
                            "ls": ":", "color": "k", "label": r"$\pm\mu_f|\sigma_n^h|$"},
                           {"x": a["edge_x"][order], "y": -0.5 * np.abs(a["sigma_n"][order]),
                            "ls": ":", "color": "k"}]}]
-    figs = plot.plot_curves(panels, ctx.figure_stem("fig_3_24_gap0_stresses"),
-                            r"Fig. 3.24: stresses on $\Gamma_C$, $g = 0$, $\hat h = 2\tilde h$, "
-                            r"$\mu_f = 0.5$")
+    fig = plot.plot_curves(panels, r"Fig. 3.24: stresses on $\Gamma_C$, $g = 0$, "
+                           r"$\hat h = 2\tilde h$, $\mu_f = 0.5$")
+    figs = plot.save_figure(fig, ctx.figure_stem("fig_3_24_gap0_stresses"))
     end = np.argsort(np.abs(a["edge_x"]))[-2:]
     ctx.entry(THESIS, "Stresses on Gamma_C with g = 0, h^ = 2h~", [*figs, data],
               {"iterations outer / inner": [record["iterations"]["outer"],

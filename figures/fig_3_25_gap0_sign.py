@@ -8,6 +8,7 @@ also requires the residual of nu lambda_t = |lambda_t| to be below eps_2.
 """
 
 import numpy as np
+from _common import length
 
 from ngdual import plot
 from ngdual.studies.figures import gap_tasks, outcome, require, script_main
@@ -52,13 +53,14 @@ def run(ctx):
         curves.append({"x": xs, "y": ys, "label": f"{name}, level {task.params['level']}",
                        **style})
     panels = [{"title": f"(a) tangential displacement, level {tasks['gap0'].params['level']}",
-               "xlabel": r"$x_1$ on $\Gamma_C$ [length]", "ylabel": r"$\lambda_t^h$ [length]",
+               "xlabel": length(r"$x_1$ on $\Gamma_C$"), "ylabel": length(r"$\lambda_t^h$"),
                "curves": [{"x": a["node_x"][order], "y": a["lam_t"][order],
                            "label": r"$\lambda_t^h$"}]},
-              {"title": r"(b) sign $\nu^h$ of $\lambda_t^h$", "xlabel": r"$x_1$ on $\Gamma_C$ "
-               r"[length]", "ylabel": r"$\nu^h$ [-]", "curves": curves, "ylim": (-1.15, 1.15)}]
-    figs = plot.plot_curves(panels, ctx.figure_stem("fig_3_25_gap0_sign"),
-                            r"Fig. 3.25: $g = 0$, $\hat h = 2\tilde h$, $\mu_f = 0.5$")
+              {"title": r"(b) sign $\nu^h$ of $\lambda_t^h$",
+               "xlabel": length(r"$x_1$ on $\Gamma_C$"), "ylabel": r"$\nu^h$ [-]",
+               "curves": curves, "ylim": (-1.15, 1.15)}]
+    fig = plot.plot_curves(panels, r"Fig. 3.25: $g = 0$, $\hat h = 2\tilde h$, $\mu_f = 0.5$")
+    figs = plot.save_figure(fig, ctx.figure_stem("fig_3_25_gap0_sign"))
     numbers = {"default solver: |nu| on the two end h^ edges": [float(abs(a["nu"][0])),
                                                                  float(abs(a["nu"][-1]))],
                "default solver": outcome(exact)}

@@ -9,7 +9,7 @@ Plan.uzawa_gap_level) is listed in the index. A case that did not converge is na
 """
 
 import numpy as np
-from _common import HHAT_CASES, HHAT_STYLE, hhat_numbers, hhat_solutions
+from _common import HHAT_CASES, HHAT_STYLE, hhat_numbers, hhat_solutions, length
 
 from ngdual import plot
 from ngdual.studies.figures import script_main
@@ -39,8 +39,8 @@ def run(ctx):
         if curves:
             curves.append({"x": foundation[0], "y": foundation[1], "color": "tab:blue",
                            "ls": ":", "label": "rigid foundation $-g$"})
-        panels.append({"title": HHAT_CASES[case][0], "xlabel": r"$x_1$ on $\Gamma_C$ [length]",
-                       "ylabel": r"$\lambda_n^h - g$ [length]", "curves": curves,
+        panels.append({"title": HHAT_CASES[case][0], "xlabel": length(r"$x_1$ on $\Gamma_C$"),
+                       "ylabel": length(r"$\lambda_n^h - g$"), "curves": curves,
                        "note": "; ".join(notes)})
         # the displacements away from the ends, where lambda_n = 0 is prescribed (C_h~ of (3.61))
         lows.append(min((c["y"][np.abs(c["x"]) <= 3].min() for c in curves[:-1]), default=-0.01))
@@ -50,9 +50,9 @@ def run(ctx):
                        "ylim": (1.6 * low, -0.4 * low)})
     data = ctx.write_csv("fig_3_26_normal_displacement_hhat.csv", rows,
                          "lambda_n - g and g on Gamma_C for both gaps and both h^")
-    figs = plot.plot_curves(panels, ctx.figure_stem("fig_3_26_normal_displacement_hhat"),
-                            rf"Fig. 3.26: normal displacement, $\mu_f = 0.5$, level "
-                            rf"{ctx.plan.gap_level}")
+    fig = plot.plot_curves(panels, rf"Fig. 3.26: normal displacement, $\mu_f = 0.5$, level "
+                           rf"{ctx.plan.gap_level}")
+    figs = plot.save_figure(fig, ctx.figure_stem("fig_3_26_normal_displacement_hhat"))
     ctx.entry(THESIS, "Normal displacement for h^ = h~ and h^ = 2h~", [*figs, data],
               hhat_numbers(ctx),
               thesis_says="the normal displacements for the two h^ fit very well.")

@@ -2,7 +2,7 @@
 (a) g = |x_1|, (b) g of (3.125), mu_f = 0.5."""
 
 import numpy as np
-from _common import HHAT_CASES, HHAT_STYLE, hhat_numbers, hhat_solutions
+from _common import HHAT_CASES, HHAT_STYLE, hhat_numbers, hhat_solutions, length
 
 from ngdual import plot
 from ngdual.studies.figures import script_main
@@ -31,14 +31,14 @@ def run(ctx):
             t1, t2 = by_factor[1][1]["lam_t"], by_factor[2][1]["lam_t"]
             numbers[f"max |lam_t(h~) - lam_t(2h~)| / max |lam_t|, {HHAT_CASES[case][1]}"] = (
                 float(np.abs(t1 - t2).max() / max(np.abs(t2).max(), 1e-300)))
-        panels.append({"title": HHAT_CASES[case][0], "xlabel": r"$x_1$ on $\Gamma_C$ [length]",
-                       "ylabel": r"$\lambda_t^h$ [length]", "curves": curves,
+        panels.append({"title": HHAT_CASES[case][0], "xlabel": length(r"$x_1$ on $\Gamma_C$"),
+                       "ylabel": length(r"$\lambda_t^h$"), "curves": curves,
                        "note": "; ".join(notes)})
     data = ctx.write_csv("fig_3_27_tangential_displacement_hhat.csv", rows,
                          "lambda_t on Gamma_C for both gaps and both h^")
-    figs = plot.plot_curves(panels, ctx.figure_stem("fig_3_27_tangential_displacement_hhat"),
-                            rf"Fig. 3.27: tangential displacement, $\mu_f = 0.5$, level "
-                            rf"{ctx.plan.gap_level}")
+    fig = plot.plot_curves(panels, rf"Fig. 3.27: tangential displacement, $\mu_f = 0.5$, level "
+                           rf"{ctx.plan.gap_level}")
+    figs = plot.save_figure(fig, ctx.figure_stem("fig_3_27_tangential_displacement_hhat"))
     ctx.entry(THESIS, "Tangential displacement for h^ = h~ and h^ = 2h~", [*figs, data],
               {**numbers, **hhat_numbers(ctx)},
               thesis_says="(a) fits very well; (b) a bit different (complex gap, eps_2 = 1e-6).")

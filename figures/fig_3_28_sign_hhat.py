@@ -2,7 +2,7 @@
 (a) g = |x_1|, (b) g of (3.125), mu_f = 0.5 (piecewise constant on the h^ edges where F > 0)."""
 
 import numpy as np
-from _common import HHAT_CASES, hhat_numbers, hhat_solutions
+from _common import HHAT_CASES, hhat_numbers, hhat_solutions, length
 
 from ngdual import plot
 from ngdual.studies.figures import script_main
@@ -34,14 +34,14 @@ def run(ctx):
             numbers[f"width of A_C (F > 0), {HHAT_CASES[case][1]}, h^ = "
                     f"{'2' if factor == 2 else ''}h~"] = float(
                 np.sum(a["nu_end"][support] - a["nu_start"][support]))
-        panels.append({"title": HHAT_CASES[case][0], "xlabel": r"$x_1$ on $\Gamma_C$ [length]",
+        panels.append({"title": HHAT_CASES[case][0], "xlabel": length(r"$x_1$ on $\Gamma_C$"),
                        "ylabel": r"$\nu^h$ [-]", "curves": curves, "note": "; ".join(notes),
                        "ylim": (-1.1, 1.1)})
     data = ctx.write_csv("fig_3_28_sign_hhat.csv", rows,
                          "nu on the h^ edges with F > 0, both gaps and both h^")
-    figs = plot.plot_curves(panels, ctx.figure_stem("fig_3_28_sign_hhat"),
-                            rf"Fig. 3.28: sign $\nu^h$ of $\lambda_t^h$, $\mu_f = 0.5$, level "
-                            rf"{ctx.plan.gap_level}")
+    fig = plot.plot_curves(panels, rf"Fig. 3.28: sign $\nu^h$ of $\lambda_t^h$, $\mu_f = 0.5$, "
+                           rf"level {ctx.plan.gap_level}")
+    figs = plot.save_figure(fig, ctx.figure_stem("fig_3_28_sign_hhat"))
     ctx.entry(THESIS, "Sign nu for h^ = h~ and h^ = 2h~", [*figs, data],
               {**numbers, **hhat_numbers(ctx)},
               thesis_says="the signs agree; the width of A_C differs with the edge length.")

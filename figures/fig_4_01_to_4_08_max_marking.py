@@ -5,6 +5,8 @@ the thesis shows the initial mesh and the meshes after 4, 8, ..., 28 steps. Shad
 triangles marked for the next refinement. One file per thesis figure (fig_4_01 ... fig_4_08).
 """
 
+from _common import UNITS
+
 from ngdual import plot
 from ngdual.studies.figures import adaptive_task, require, script_main
 
@@ -28,12 +30,13 @@ def run(ctx):
     # PLOT
     files = [data]
     for i, k in enumerate(ctx.plan.max_marking_snapshots):
-        files += plot.plot_adaptive_mesh(
-            arrays[f"points_{k}"], arrays[f"triangles_{k}"], arrays[f"marked_{k}"],
-            ctx.figure_stem(f"fig_4_{i + 1:02d}_max_marking_step{k:02d}"),
-            f"Fig. 4.{i + 1}: max marking $\\theta = 0.5$, "
-            + ("initial mesh" if k == 0 else f"after {k} steps")
-            + f" ({steps[k]['dofs']['total']} DOFs)")
+        title = (f"Fig. 4.{i + 1}: max marking $\\theta = 0.5$, "
+                 + ("initial mesh" if k == 0 else f"after {k} steps")
+                 + f" ({steps[k]['dofs']['total']} DOFs)")
+        fig = plot.plot_mesh(arrays[f"points_{k}"], arrays[f"triangles_{k}"], title,
+                             arrays[f"marked_{k}"], units=UNITS)
+        files += plot.save_figure(
+            fig, ctx.figure_stem(f"fig_4_{i + 1:02d}_max_marking_step{k:02d}"))
     ctx.entry(THESIS, "Adaptive meshes, max marking theta = 0.5", files,
               {"steps shown": ctx.plan.max_marking_snapshots,
                "triangles / DOFs at the last step": [steps[k]["elements"],

@@ -5,6 +5,8 @@ mesh; the thesis shows the meshes after 1, 3, 5, 7 and 9 steps. Shaded: the tria
 for the next refinement. One file per thesis figure (fig_4_09 ... fig_4_13).
 """
 
+from _common import UNITS
+
 from ngdual import plot
 from ngdual.studies.figures import adaptive_task, require, script_main
 
@@ -28,11 +30,12 @@ def run(ctx):
     # PLOT
     files = [data]
     for i, k in enumerate(ctx.plan.fraction_snapshots):
-        files += plot.plot_adaptive_mesh(
-            arrays[f"points_{k}"], arrays[f"triangles_{k}"], arrays[f"marked_{k}"],
-            ctx.figure_stem(f"fig_4_{i + 9:02d}_fraction_marking_step{k:02d}"),
-            f"Fig. 4.{i + 9}: fraction marking $\\theta = 0.2$, after {k} "
-            f"step{'s' if k > 1 else ''} ({steps[k]['dofs']['total']} DOFs)")
+        title = (f"Fig. 4.{i + 9}: fraction marking $\\theta = 0.2$, after {k} "
+                 f"step{'s' if k > 1 else ''} ({steps[k]['dofs']['total']} DOFs)")
+        fig = plot.plot_mesh(arrays[f"points_{k}"], arrays[f"triangles_{k}"], title,
+                             arrays[f"marked_{k}"], units=UNITS)
+        files += plot.save_figure(
+            fig, ctx.figure_stem(f"fig_4_{i + 9:02d}_fraction_marking_step{k:02d}"))
     last = ctx.plan.fraction_snapshots[-1]
     ctx.entry(THESIS, "Adaptive meshes, fraction marking theta = 0.2", files,
               {"steps shown": ctx.plan.fraction_snapshots,

@@ -147,10 +147,10 @@ def run(ctx):
                     "hlines": [(t, None, {"color": "0.7", "lw": 0.6}) for t in TARGETS]
                     + ([(floor, "overkill's own error (Richardson)",
                          {"color": "k", "ls": "-.", "lw": 0.8})] if floor else [])})
-    figs = plot.plot_curves(panels, ctx.figure_stem("work_precision"),
-                            "What accuracy costs: true errors against an overkill, ngdual "
-                            "(uniform, adaptive, Uzawa) and a primal P1/P2 Nitsche peer",
-                            ncols=4, panel_size=(4.4, 3.2), figure_legend=True)
+    fig = plot.plot_curves(panels, "What accuracy costs: true errors against an overkill, ngdual "
+                           "(uniform, adaptive, Uzawa) and a primal P1/P2 Nitsche peer",
+                           ncols=4, panel_size=(4.4, 3.2), figure_legend=True)
+    figs = plot.save_figure(fig, ctx.figure_stem("work_precision"))
     numbers = {}
     for r in table:
         if r["method"] == "fastest ngdual / fastest peer" and r["measure"] == "pressure":

@@ -14,8 +14,9 @@ Scenes: :func:`load_scene`, :func:`validate`, :func:`shipped_scenes`, :class:`Sc
 or the active-set method), :class:`Solution`. Adaptivity (Chapter 4): :func:`estimate`
 (the indicators of eq. 4.50), :func:`mark`, :func:`adapt` (SOLVE, ESTIMATE, MARK,
 REFINE). Post-processing: :func:`fields`, :func:`norms`, :func:`contact_traces`,
-:func:`force_balance`, :func:`result_record`. Plotting: :func:`plot_contact_traces`,
-:func:`plot_element_field`, :func:`plot_mesh`.
+:func:`force_balance`, :func:`result_record`. Plotting (each returns a matplotlib figure):
+:func:`plot_contact_traces`, :func:`plot_element_field`, :func:`plot_mesh`; saving one is
+the caller's choice, :func:`save_figure`.
 
 The names are loaded lazily (PEP 562): ``import ngdual`` imports neither NGSolve nor
 matplotlib, so that the command line starts fast; the first use of a name imports its
@@ -48,6 +49,7 @@ _PUBLIC = {
     "plot_contact_traces": ("ngdual.plot", "plot_contact_traces"),
     "plot_element_field": ("ngdual.plot", "plot_element_field"),
     "plot_mesh": ("ngdual.plot", "plot_mesh"),
+    "save_figure": ("ngdual.plot", "save_figure"),
 }
 
 __all__ = ["__version__", *_PUBLIC]

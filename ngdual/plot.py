@@ -1,90 +1,193 @@
-"""Matplotlib figures (no computation here: inputs are arrays from :mod:`ngdual.post`)."""
+"""Matplotlib figures (no computation here: inputs are arrays from :mod:`ngdual.post`).
+
+Every ``plot_*`` function returns a :class:`matplotlib.figure.Figure`; saving it is the
+caller's choice, :func:`save_figure`. Importing this module leaves matplotlib's backend
+alone: a notebook keeps its inline backend, a headless run gets Agg by matplotlib's own
+fallback.
+
+Axis labels carry the units the scene declares in its ``[units]`` table
+(:class:`ngdual.scene.Units`, passed as ``units``); where it declares none a label names
+the quantity only ("$x_1$", "von Mises stress"), never a made-up unit. Fields with
+corner singularities take ``clip``: the colour scale ends at that percentile and the
+colour bar says so.
+
+>>> import numpy as np
+>>> fig = plot_mesh(np.array([[0., 0.], [1., 0.], [0., 1.]]), np.array([[0, 1, 2]]))
+>>> type(fig).__name__
+'Figure'
+"""
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
-import matplotlib
+import matplotlib.pyplot as plt
+import matplotlib.tri as mtri
+import numpy as np
+from matplotlib.figure import Figure
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import matplotlib.tri as mtri  # noqa: E402
-import numpy as np  # noqa: E402
-
-
-def _save(fig, path: Path) -> Path:
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.stem + ".part" + path.suffix)
-    fig.savefig(tmp, dpi=150, bbox_inches="tight")
-    plt.close(fig)
-    tmp.replace(path)
-    return path
+SIDECAR_FORMATS = (".png", ".pdf")  # what a stem without suffix becomes, with its .json
+CORNER_CLIP = 99.0  # percentile where the colour scale of a field with corner singularities ends
+TRACE_CLIP = 90.0   # the same for the y-range of a trace on Gamma_C (fewer values, more at corners)
 
 
-def plot_contact_traces(traces, path: Path, title: str = "") -> Path:
-    """sigma_n, sigma_t (per fine edge), lambda_n - g and lambda_t (nodal) along Gamma_C."""
+def unit_label(quantity: str, unit: str | None) -> str:
+    """``quantity [unit]``, or the quantity alone where no unit is declared.
+
+    >>> unit_label("stress", "MPa"), unit_label("stress", None)
+    ('stress [MPa]', 'stress')
+    """
+    return f"{quantity} [{unit}]" if unit else quantity
+
+
+def _length(units) -> str | None:
+    return getattr(units, "length", None)
+
+
+def _stress(units) -> str | None:
+    return getattr(units, "stress", None)
+
+
+def clipped_scale(values: np.ndarray, clip: float | None) -> tuple[float, float, str, str]:
+    """``(vmin, vmax, extend, note)`` of a colour scale ending at the ``clip`` percentile.
+
+    A field that changes sign is clipped symmetrically in |value|. ``note`` states the
+    clipping and the largest value beyond it (empty without clipping, or when nothing
+    lies beyond the percentile).
+    """
+    values = np.asarray(values, float)
+    low, high = float(values.min()), float(values.max())
+    if clip is None or not 0 < clip < 100:
+        return low, high, "neither", ""
+    if low < 0 < high:
+        top = float(np.percentile(np.abs(values), clip))
+        if top >= max(-low, high):
+            return low, high, "neither", ""
+        return -top, top, "both", (f"colour scale clipped at the {clip:g}th percentile of |value| "
+                                   f"(range {low:.3g} to {high:.3g})")
+    top = float(np.percentile(values, clip))
+    if top >= high:
+        return low, high, "neither", ""
+    return low, top, "max", f"colour scale clipped at the {clip:g}th percentile (max {high:.3g})"
+
+
+def _clip_axis(ax, values: np.ndarray, clip: float | None) -> None:
+    """y-range 1.25 times the ``clip`` percentile of |values| when the largest is more than
+    twice that (a corner singularity), with a note in the panel saying so."""
+    values = np.abs(np.asarray(values, float))
+    if clip is None or not len(values):
+        return
+    span = 1.25 * float(np.percentile(values, clip))
+    top = float(values.max())
+    if span > 0 and top > 2 * span:
+        ax.set_ylim(-span, span)
+        ax.text(0.02, 0.03, f"y-range clipped ({clip:g}th percentile of |value|): values up "
+                            f"to {top:.3g} off scale", transform=ax.transAxes,
+                fontsize=7, va="bottom", ha="left",
+                bbox={"fc": "white", "alpha": 0.8, "lw": 0})
+
+
+def _coordinates(ax, units) -> None:
+    ax.set_aspect("equal")
+    ax.set_xlabel(unit_label(r"$x_1$", _length(units)))
+    ax.set_ylabel(unit_label(r"$x_2$", _length(units)))
+
+
+def _colorbar(fig, art, ax, label: str, extend: str, note: str, **kwargs) -> None:
+    fig.colorbar(art, ax=ax, label=f"{label}\n{note}" if note else label, extend=extend,
+                 **kwargs)
+
+
+def plot_contact_traces(traces, title: str = "", units=None,
+                        clip: float | None = TRACE_CLIP) -> Figure:
+    """sigma_n, sigma_t (per fine edge), lambda_n - g and lambda_t (nodal) along Gamma_C.
+
+    ``traces``: :func:`ngdual.post.contact_traces`; ``units``: the scene's ``units``;
+    ``clip``: the stress panels' y-range follows this percentile of |sigma| where corner
+    singularities would flatten the rest (the panel says so; None: the full range).
+    """
     fig, axes = plt.subplots(2, 2, figsize=(11, 6.5), sharex=True)
     x_edge, x_node = traces.edge_xy[:, 0], traces.node_xy[:, 0]
     order = np.argsort(x_node)
+    stress, length = _stress(units), _length(units)
     panels = [
-        (axes[0, 0], x_edge, traces.sigma_n, r"$\sigma_n^h$ [stress units]", "steps-mid"),
-        (axes[0, 1], x_edge, traces.sigma_t, r"$\sigma_t^h$ [stress units]", "steps-mid"),
+        (axes[0, 0], x_edge, traces.sigma_n, unit_label(r"$\sigma_n^h$", stress), "steps-mid"),
+        (axes[0, 1], x_edge, traces.sigma_t, unit_label(r"$\sigma_t^h$", stress), "steps-mid"),
         (axes[1, 0], x_node[order], (traces.lam_n - traces.gap)[order],
-         r"$\lambda_n^{\tilde h} - g$ [length]", "default"),
-        (axes[1, 1], x_node[order], traces.lam_t[order], r"$\lambda_t^{\tilde h}$ [length]",
-         "default"),
+         unit_label(r"$\lambda_n^{\tilde h} - g$", length), "default"),
+        (axes[1, 1], x_node[order], traces.lam_t[order],
+         unit_label(r"$\lambda_t^{\tilde h}$", length), "default"),
     ]
     for ax, xs, ys, label, style in panels:
         idx = np.argsort(xs)
         ax.plot(xs[idx], ys[idx], drawstyle=style, lw=1.2)
         ax.set_ylabel(label)
         ax.grid(alpha=0.3)
+    for ax, values in ((axes[0, 0], traces.sigma_n), (axes[0, 1], traces.sigma_t)):
+        _clip_axis(ax, values, clip)
     contact = traces.coarse_xy[traces.coarse_in_contact, 0]
     level = np.interp(contact, x_node[order], (traces.lam_n - traces.gap)[order])
     axes[1, 0].plot(contact, level, "rv", ms=4, label=r"$\tilde h$-node in contact")
     axes[1, 0].legend(loc="best")
     for ax in axes[1]:
-        ax.set_xlabel(r"$x_1$ on $\Gamma_C$ [length]")
+        ax.set_xlabel(unit_label(r"$x_1$ on $\Gamma_C$", length))
     fig.suptitle(title or r"Traces on the contact boundary $\Gamma_C$")
     fig.tight_layout()
-    return _save(fig, path)
+    return fig
 
 
 def plot_element_field(points: np.ndarray, triangles: np.ndarray, values: np.ndarray,
-                       path: Path, title: str, label: str) -> Path:
-    """A piecewise constant field on the triangulation, with a colour bar."""
-    fig, ax = plt.subplots(figsize=(11, 3.6))
+                       title: str, label: str, clip: float | None = None,
+                       units=None) -> Figure:
+    """A piecewise constant field on the triangulation, with a colour bar labelled ``label``.
+
+    ``clip``: end the colour scale at this percentile (e.g. 99 for a von Mises stress
+    with corner singularities); the colour bar states the clipping.
+    """
+    aspect = float(np.ptp(points[:, 1])) / max(float(np.ptp(points[:, 0])), 1e-300)
+    fig, ax = plt.subplots(figsize=(11, min(9 * aspect, 12.0) + 1.6), constrained_layout=True)
     tri = mtri.Triangulation(points[:, 0], points[:, 1], triangles)
-    art = ax.tripcolor(tri, facecolors=values, cmap="viridis", edgecolors="none")
-    fig.colorbar(art, ax=ax, label=label)
-    ax.set_aspect("equal")
-    ax.set_xlabel(r"$x_1$ [length]")
-    ax.set_ylabel(r"$x_2$ [length]")
+    vmin, vmax, extend, note = clipped_scale(values, clip)
+    art = ax.tripcolor(tri, facecolors=values, cmap="viridis", vmin=vmin, vmax=vmax,
+                       edgecolors="none")
+    _colorbar(fig, art, ax, label, extend, note)
+    _coordinates(ax, units)
     ax.set_title(title)
-    return _save(fig, path)
+    return fig
 
 
-def plot_mesh(points: np.ndarray, triangles: np.ndarray, path: Path, title: str = "",
-              marked: np.ndarray | None = None) -> Path:
-    """The triangulation, with the elements marked for refinement shaded (Figs. 4.1-4.13)."""
-    fig, ax = plt.subplots(figsize=(8, 8 * np.ptp(points[:, 1]) / max(np.ptp(points[:, 0]), 1e-300)
-                                    + 0.8))
+def plot_mesh(points: np.ndarray, triangles: np.ndarray, title: str = "",
+              marked: np.ndarray | None = None, units=None) -> Figure:
+    """The triangulation, with the elements marked for refinement shaded (Figs. 4.1-4.13).
+
+    ``marked``: one flag per triangle (the MARK step of the adaptive loop); the legend
+    counts them.
+    """
+    from matplotlib.patches import Patch
+
+    width = max(float(np.ptp(points[:, 0])), 1e-300)
+    aspect = float(np.ptp(points[:, 1])) / width
+    fig, ax = plt.subplots(figsize=(9.5, min(9.5 * aspect, 12.0) + 1.2))
     tri = mtri.Triangulation(points[:, 0], points[:, 1], triangles)
+    handles = []
     if marked is not None and np.any(marked):
-        ax.tripcolor(tri, facecolors=np.asarray(marked, dtype=float), cmap="Oranges",
-                     vmin=0, vmax=2.5, edgecolors="none")
-    ax.triplot(tri, color="k", lw=0.3)
-    ax.set_aspect("equal")
-    ax.set_xlabel(r"$x_1$ [length]")
-    ax.set_ylabel(r"$x_2$ [length]")
+        marked = np.asarray(marked, float)
+        ax.tripcolor(tri, facecolors=marked, cmap="Oranges", vmin=0, vmax=1.6,
+                     edgecolors="none", rasterized=True)
+        handles.append(Patch(color=plt.get_cmap("Oranges")(1 / 1.6),
+                             label=f"{int(np.count_nonzero(marked))} marked for refinement"))
+    ax.triplot(tri, color="k", lw=0.25, label=f"{len(triangles)} triangles")
+    _coordinates(ax, units)
     ax.set_title(title or f"{len(triangles)} triangles")
-    return _save(fig, path)
+    ax.legend(handles=[*ax.get_legend_handles_labels()[0][:1], *handles], loc="upper center",
+              bbox_to_anchor=(0.5, -0.25 if aspect < 0.5 else -0.12), ncol=2, fontsize=8)
+    return fig
 
 
-# --- figures of Sections 3.4 and 4.2 (ngdual figures) -------------------------------------------
+# --- saving, and the JSON sidecar of ngdual figures ----------------------------------------------
 
-def figure_texts(fig) -> dict:
+def figure_texts(fig: Figure) -> dict:
     """Titles, axis labels, legend entries and colour bars of a figure (the JSON sidecar)."""
     axes = []
     for ax in fig.axes:
@@ -105,62 +208,62 @@ def figure_texts(fig) -> dict:
     return {"suptitle": suptitle, "axes": axes, "figure_legend": legends}
 
 
-def save_figure(fig, stem: Path, dpi: int = 130) -> list[Path]:
-    """Write ``stem``.png, ``stem``.pdf and ``stem``.json (:func:`figure_texts`), atomically."""
-    import json
+def save_figure(fig: Figure, target: str | Path, dpi: int = 130) -> list[Path]:
+    """Write ``fig`` atomically and close it; returns the files written.
 
-    stem = Path(stem)
-    stem.parent.mkdir(parents=True, exist_ok=True)
-    texts = figure_texts(fig)
+    ``target`` with a suffix (``out/von_mises.png``) is that one file; a stem without
+    suffix (``figures/fig_3_11``) becomes ``stem.png``, ``stem.pdf`` and ``stem.json``
+    (:func:`figure_texts`: what the figure says, for tests and indexes).
+    """
+    target = Path(target)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    texts = figure_texts(fig) if not target.suffix else None
     written = []
-    for suffix in (".png", ".pdf"):
-        path = stem.with_suffix(suffix)
-        tmp = stem.with_name(stem.name + ".part" + suffix)
-        fig.savefig(tmp, dpi=dpi, bbox_inches="tight")
-        tmp.replace(path)
-        written.append(path)
-    plt.close(fig)
-    sidecar = stem.with_suffix(".json")
-    tmp = stem.with_name(stem.name + ".part.json")
-    tmp.write_text(json.dumps(texts, indent=1))
-    tmp.replace(sidecar)
+    try:
+        for path in [target] if target.suffix else [target.with_suffix(s)
+                                                    for s in SIDECAR_FORMATS]:
+            tmp = path.with_name(path.stem + ".part" + path.suffix)
+            fig.savefig(tmp, dpi=dpi, bbox_inches="tight")
+            tmp.replace(path)
+            written.append(path)
+    finally:
+        plt.close(fig)
+    if texts is not None:
+        sidecar = target.with_suffix(".json")
+        tmp = target.with_name(target.name + ".part.json")
+        tmp.write_text(json.dumps(texts, indent=1))
+        tmp.replace(sidecar)
     return written
 
 
+# --- figures of Sections 3.4 and 4.2 (ngdual figures) -------------------------------------------
+
 def plot_field_pair(points: np.ndarray, triangles: np.ndarray, values: list[np.ndarray],
-                    titles: list[str], label: str, suptitle: str, stem: Path,
-                    vmax: float | None = None) -> list[Path]:
+                    titles: list[str], label: str, suptitle: str, clip: float | None = None,
+                    units=None) -> Figure:
     """Element fields on one mesh side by side with one colour bar (Figs. 3.11-3.14).
 
-    With ``vmax`` below the largest value the colour scale ends there (the colour bar
-    is extended), so that corner singularities do not wash out the rest.
+    ``clip``: the colour scale ends at this percentile of all values (the colour bar is
+    extended and says so), so that corner singularities do not wash out the rest.
     """
-    fig, axes = plt.subplots(1, len(values), figsize=(6.2 * len(values), 2.6),
+    fig, axes = plt.subplots(1, len(values), figsize=(6.2 * len(values), 2.8),
                              constrained_layout=True)
     axes = np.atleast_1d(axes)
     tri = mtri.Triangulation(points[:, 0], points[:, 1], triangles)
-    allv = np.concatenate(values)
-    vmin = float(allv.min())
-    extend = "neither"
-    if vmax is not None and vmax < allv.max():
-        extend = "max"
-    else:
-        vmax = float(allv.max())
+    vmin, vmax, extend, note = clipped_scale(np.concatenate(values), clip)
     for ax, v, title in zip(axes, values, titles):
         art = ax.tripcolor(tri, facecolors=v, cmap="viridis", vmin=vmin, vmax=vmax,
                            edgecolors="none", rasterized=True)
-        ax.set_aspect("equal")
-        ax.set_xlabel(r"$x_1$ [length]")
-        ax.set_ylabel(r"$x_2$ [length]")
+        _coordinates(ax, units)
         ax.set_title(title)
-    fig.colorbar(art, ax=list(axes), label=label, extend=extend, shrink=0.9)
+    _colorbar(fig, art, list(axes), label, extend, note, shrink=0.9)
     fig.suptitle(suptitle)
-    return save_figure(fig, stem)
+    return fig
 
 
-def plot_curves(panels: list[dict], stem: Path, suptitle: str, ncols: int = 2,
+def plot_curves(panels: list[dict], suptitle: str, ncols: int = 2,
                 panel_size: tuple[float, float] = (5.6, 3.4),
-                figure_legend: bool = False) -> list[Path]:
+                figure_legend: bool = False) -> Figure:
     """Line plots, one panel per dict: ``title``, ``xlabel``, ``ylabel``, ``curves`` (dicts of
     ``x``, ``y``, ``label`` and matplotlib style keywords), optional ``loglog``, ``hlines``
     (``(y, label, style)``), ``note`` (text in the corner), ``xlim``, ``ylim``.
@@ -207,12 +310,11 @@ def plot_curves(panels: list[dict], stem: Path, suptitle: str, ncols: int = 2,
         fig.legend(handles.values(), handles.keys(), loc="outside lower center",
                    ncol=min(3, len(handles)), fontsize=8)
     fig.suptitle(suptitle)
-    return save_figure(fig, stem)
+    return fig
 
 
 def plot_heatmaps(x: np.ndarray, y: np.ndarray, grids: list[np.ndarray], titles: list[str],
-                  xlabel: str, ylabel: str, cbar_labels: list[str], stem: Path,
-                  suptitle: str) -> list[Path]:
+                  xlabel: str, ylabel: str, cbar_labels: list[str], suptitle: str) -> Figure:
     """Iteration counts over a parameter grid (Fig. 3.23): blue few, red many, numbers in the
     cells, NaN cells (did not converge) hatched and marked with a cross."""
     fig, axes = plt.subplots(1, len(grids), figsize=(5.4 * len(grids), 4.2),
@@ -234,34 +336,11 @@ def plot_heatmaps(x: np.ndarray, y: np.ndarray, grids: list[np.ndarray], titles:
         ax.set_title(title)
         fig.colorbar(art, ax=ax, label=clabel)
     fig.suptitle(suptitle)
-    return save_figure(fig, stem)
-
-
-def plot_adaptive_mesh(points: np.ndarray, triangles: np.ndarray, marked: np.ndarray,
-                       stem: Path, title: str) -> list[Path]:
-    """An adaptive mesh with the triangles marked for the next refinement shaded (Figs. 4.x)."""
-    from matplotlib.patches import Patch
-
-    fig, ax = plt.subplots(figsize=(9.5, 3.0))
-    tri = mtri.Triangulation(points[:, 0], points[:, 1], triangles)
-    handles = []
-    if marked is not None and np.any(marked):
-        ax.tripcolor(tri, facecolors=np.asarray(marked, float), cmap="Oranges", vmin=0,
-                     vmax=1.6, edgecolors="none", rasterized=True)
-        handles.append(Patch(color=plt.get_cmap("Oranges")(1 / 1.6),
-                             label="marked for the next refinement"))
-    ax.triplot(tri, color="k", lw=0.25, label=f"{len(triangles)} triangles")
-    ax.set_aspect("equal")
-    ax.set_xlabel(r"$x_1$ [length]")
-    ax.set_ylabel(r"$x_2$ [length]")
-    ax.set_title(title)
-    ax.legend(handles=[*ax.get_legend_handles_labels()[0][:1], *handles], loc="upper center",
-              bbox_to_anchor=(0.5, -0.25), ncol=2, fontsize=8)
-    return save_figure(fig, stem)
+    return fig
 
 
 def plot_domain(points: np.ndarray, triangles: np.ndarray, x: np.ndarray, load: np.ndarray,
-                foundations: list, gaps: list, stem: Path, suptitle: str) -> list[Path]:
+                foundations: list, gaps: list, suptitle: str, units=None) -> Figure:
     """Fig. 3.10: Example 3.46 with Gamma_D, Gamma_N (load arrows), Gamma_C and foundations
     (``(x, y, label, style)``) on the left, the gap functions (same form) on the right."""
     fig, (ax, ag) = plt.subplots(1, 2, figsize=(13, 3.8), constrained_layout=True,
@@ -277,22 +356,21 @@ def plot_domain(points: np.ndarray, triangles: np.ndarray, x: np.ndarray, load: 
         if abs(ti) > 0:
             ax.annotate("", (xi, 1), (xi, 1 - ti * scale),
                         arrowprops={"arrowstyle": "->", "color": "tab:orange", "lw": 1})
+    peak = float(np.max(np.abs(load)))
     ax.plot([], [], color="tab:orange", marker=r"$\downarrow$", ls="none",
-            label=rf"$t_0$ (max {float(np.max(np.abs(load))):.0f})")
+            label=rf"$t_0$ (max {peak:.0f}{' ' + _stress(units) if _stress(units) else ''})")
     for fx, fy, label, style in foundations:
         ax.plot(fx, fy, label=label, **style)
-    ax.set_aspect("equal")
+    _coordinates(ax, units)
     ax.set_ylim(-3.3, 1.9)
-    ax.set_xlabel(r"$x_1$ [length]")
-    ax.set_ylabel(r"$x_2$ [length]")
     ax.set_title(r"$\Omega = [-4, 4] \times [-1, 1]$, level-1 mesh")
     ax.legend(loc="upper center", ncol=3, fontsize=8)
     for gx, gy, label, style in gaps:
         ag.plot(gx, gy, label=label, **style)
-    ag.set_xlabel(r"$x_1$ on $\Gamma_C$ [length]")
-    ag.set_ylabel(r"gap $g(x_1)$ [length]")
+    ag.set_xlabel(unit_label(r"$x_1$ on $\Gamma_C$", _length(units)))
+    ag.set_ylabel(unit_label(r"gap $g(x_1)$", _length(units)))
     ag.set_title("Gap functions of the shipped scenes")
     ag.grid(alpha=0.3)
     ag.legend(fontsize=8)
     fig.suptitle(suptitle)
-    return save_figure(fig, stem)
+    return fig

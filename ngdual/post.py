@@ -194,19 +194,86 @@ def result_record(solution: Solution) -> dict:
     }
 
 
-def write_vtk(solution: Solution, filename: str) -> str:
-    """Write sigma, u, eta and the von Mises stress for ParaView; returns the file name."""
+def write_vtk(solution: Solution, filename: str) -> list[str]:
+    """Write the solution for ParaView; returns the files written.
+
+    ``filename.vtu``: sigma (components), the displacement ``u`` as a 3-vector (z = 0, so
+    that Warp By Vector applies it), the rotation eta and the von Mises stress. With a
+    contact boundary also ``filename_contact.vtu``: Gamma_C as line cells, at its fine
+    vertices the multiplier ``lambda`` = lambda_n n + lambda_t t as a 3-vector, its
+    components, the gap g, the normal n and the boundary displacement ``u`` = (g -
+    lambda_n) n - lambda_t t (Theorem 3.10: lambda_n = g - u_n, lambda_t = -u_t); per
+    fine edge sigma_n, sigma_t and the traction sigma n = sigma_n n + sigma_t t.
+    """
     f = fields(solution)
     pb = solution.problem
     nu = pb.scene.material.nu
     out = ngs.VTKOutput(pb.fes.mesh,
                         coefs=[f.sigma[0, 0], f.sigma[0, 1], f.sigma[1, 0], f.sigma[1, 1],
-                               f.u, f.eta, von_mises(f.sigma, nu)],
+                               ngs.CoefficientFunction((f.u[0], f.u[1], 0)), f.eta,
+                               von_mises(f.sigma, nu)],
                         names=["sigma_11", "sigma_12", "sigma_21", "sigma_22", "u", "eta",
                                "von_mises"],
                         filename=str(filename), subdivision=0)
     out.Do()
-    return str(filename) + ".vtu"
+    written = [str(filename) + ".vtu"]
+    if pb.spaces.contact is not None:
+        written.append(_write_contact_vtu(solution, str(filename) + "_contact.vtu"))
+    return written
+
+
+def _write_contact_vtu(solution: Solution, path: str) -> str:
+    """Gamma_C with the contact multipliers and tractions as VTK vectors (ASCII XML)."""
+    import os
+
+    tr = contact_traces(solution)
+    gamma_c = solution.problem.spaces.gamma_c
+    n_node = gamma_c.vertex_normals()
+    t_node = np.column_stack([n_node[:, 1], -n_node[:, 0]])  # t = (n_2, -n_1), as in (3.24)
+    lam = tr.lam_n[:, None] * n_node + tr.lam_t[:, None] * t_node
+    u = (tr.gap - tr.lam_n)[:, None] * n_node - tr.lam_t[:, None] * t_node
+    traction = tr.sigma_n[:, None] * gamma_c.normals + tr.sigma_t[:, None] * gamma_c.tangents
+    lines, first = [], 0
+    for chain in solution.problem.spaces.contact.chains:
+        lines += [(first + k, first + k + 1) for k in range(chain.n_edges)]
+        first += chain.n_edges + 1
+
+    def array(name, values):
+        values = np.asarray(values, float)
+        values = values.reshape(len(values), -1)
+        if values.shape[1] == 2:  # ParaView's vector filters want three components
+            values = np.column_stack([values, np.zeros(len(values))])
+        body = " ".join(f"{v:.17g}" for v in values.ravel())
+        return (f'<DataArray type="Float64" Name="{name}" NumberOfComponents='
+                f'"{values.shape[1]}" format="ascii">{body}</DataArray>')
+
+    points = array("Points", tr.node_xy)
+    node_data = [array("lambda", lam), array("lambda_n", tr.lam_n), array("lambda_t", tr.lam_t),
+                 array("gap", tr.gap), array("normal", n_node), array("u", u)]
+    edge_data = [array("sigma_n", tr.sigma_n), array("sigma_t", tr.sigma_t),
+                 array("traction", traction)]
+    connectivity = " ".join(f"{a} {b}" for a, b in lines)
+    offsets = " ".join(str(2 * (k + 1)) for k in range(len(lines)))
+    text = "\n".join([
+        '<?xml version="1.0"?>',
+        '<VTKFile type="UnstructuredGrid" version="1.0" byte_order="LittleEndian">',
+        "<UnstructuredGrid>",
+        f'<Piece NumberOfPoints="{len(tr.node_xy)}" NumberOfCells="{len(lines)}">',
+        "<Points>", points, "</Points>",
+        "<Cells>",
+        f'<DataArray type="Int64" Name="connectivity" format="ascii">{connectivity}</DataArray>',
+        f'<DataArray type="Int64" Name="offsets" format="ascii">{offsets}</DataArray>',
+        f'<DataArray type="UInt8" Name="types" format="ascii">{" ".join(["3"] * len(lines))}'
+        "</DataArray>",
+        "</Cells>",
+        '<PointData Vectors="lambda">', *node_data, "</PointData>",
+        '<CellData Vectors="traction">', *edge_data, "</CellData>",
+        "</Piece>", "</UnstructuredGrid>", "</VTKFile>", ""])
+    tmp = path + ".part"
+    with open(tmp, "w") as handle:
+        handle.write(text)
+    os.replace(tmp, path)
+    return path
 
 
 def element_values(mesh: ngs.Mesh, cf) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -23,6 +23,7 @@ The schema (all tables optional except ``geometry``, whose ``kind`` must be give
                  normal_stress = "hat-projection" | "fine-edges" (the |sigma_n| of F)
     [solver]     method, metric, rho, eps, max_iter, rho1, rho2, eps1, eps2, loop_order,
                  friction_metric
+    [units]      length = "m" | "mm" | ..., stress = "Pa" | "MPa" | ...  (labels of plots)
 
 Loads, gap and bound are formulas in ``x`` and ``y`` (see :mod:`ngdual.expr`).
 """
@@ -55,6 +56,8 @@ LOOP_ORDERS = ("friction-outer", "contact-outer")
 FRICTION_METRICS = ("jacobi", "mass")
 SOLVER_METHODS = ("auto", "uzawa", "active-set")
 GEOMETRY_KINDS = ("thesis-3.46", "polygon")
+LENGTH_UNITS = ("m", "cm", "mm", "um", "km", "in", "ft")
+STRESS_UNITS = ("Pa", "kPa", "MPa", "GPa", "N/mm^2", "psi", "ksi")
 
 
 class SceneError(ValueError):
@@ -268,6 +271,19 @@ class Solver:
 
 
 @dataclass
+class Units:
+    """The units the numbers of the scene are in, for the labels of plots and records.
+
+    The solver never reads them (it computes in whatever consistent units the scene is
+    written in: lengths in ``length``, E, tractions and stresses in ``stress``); plots
+    label their axes with them. Not given: labels name the quantity without a unit.
+    """
+
+    length: str | None = None
+    stress: str | None = None
+
+
+@dataclass
 class Scene:
     """Everything needed to set up and solve one problem."""
 
@@ -279,6 +295,7 @@ class Scene:
     contact: Contact = field(default_factory=Contact)
     friction: Friction = field(default_factory=Friction)
     solver: Solver = field(default_factory=Solver)
+    units: Units = field(default_factory=Units)
 
     @property
     def has_contact(self) -> bool:
@@ -298,7 +315,7 @@ class Scene:
 
 
 _SECTIONS = {"geometry": Geometry, "material": Material, "loads": Loads,
-             "contact": Contact, "friction": Friction, "solver": Solver}
+             "contact": Contact, "friction": Friction, "solver": Solver, "units": Units}
 _ROLES = ("dirichlet", "neumann", "contact")
 
 
@@ -878,6 +895,8 @@ def validate(scene: Scene) -> None:
         ok["friction"] = problems.run(_validate_friction_settings, scene)
     if ok["solver"]:
         _validate_solver(scene.solver, problems)
+    if isinstance(scene.units, Units):  # a bad type of one unit is reported above
+        _validate_units(scene.units, problems)
     if ok["solver"] and ok["friction"] and scene.solver.method in SOLVER_METHODS:
         reported = {f for f, _ in problems.found}
         for f, m in _settings_without_effect(scene):
@@ -957,6 +976,14 @@ def _validate_solver(sol: Solver, problems: _Problems) -> None:
                                         "iteration converges (it is relative to the stability "
                                         "bound)")
     problems.run(_positive, sol.max_iter, "solver.max_iter", integer=True)
+
+
+def _validate_units(units: Units, problems: _Problems) -> None:
+    for key, allowed in (("length", LENGTH_UNITS), ("stress", STRESS_UNITS)):
+        value = getattr(units, key)
+        if isinstance(value, str) and value not in allowed:
+            problems.add(f"units.{key}", f"unknown {key} unit {_show(value)}; use one of "
+                                         + ", ".join(allowed) + " (or leave it out: no unit)")
 
 
 # The settings each choice reads. "uzawa" reads those of Algorithm 3.38 or of Algorithm 3.41

@@ -180,6 +180,10 @@ MEANINGS = {
     "solver.friction_metric": "Diagonal metric of the projection P^Lambda: `mass` (Remark "
                               "3.44) or `jacobi` (mass weighted by the diagonal of the nu "
                               "operator).",
+    "units.length": "Unit of every length of the scene (coordinates, gap, displacements); "
+                    "only the labels of plots read it. Not given: no unit is shown.",
+    "units.stress": "Unit of E, tractions and stresses; only the labels of plots read it. "
+                    "Not given: no unit is shown.",
 }
 
 # the module constant that lists the allowed values of a key
@@ -188,6 +192,7 @@ CHOICES = {
     "friction.law": "FRICTION_LAWS", "friction.normal_stress": "NORMAL_STRESSES",
     "solver.method": "SOLVER_METHODS", "solver.metric": "METRICS",
     "solver.loop_order": "LOOP_ORDERS", "solver.friction_metric": "FRICTION_METRICS",
+    "units.length": "LENGTH_UNITS", "units.stress": "STRESS_UNITS",
 }
 
 

@@ -4,8 +4,9 @@
 solves one scene, prints the result table and writes ``DIR/result.json``
 (atomically) plus figures. ``ngdual scenes`` lists the shipped scenes;
 ``ngdual dofs SCENE --levels 1 2 3`` prints DOF counts without solving;
-``ngdual adapt SCENE --marking max|fraction|dorfler --theta T --steps N --out DIR``
-runs the adaptive loop and writes ``DIR/history.json`` plus a mesh (.vol, .png) per step.
+``ngdual adapt SCENE --marking max|fraction|dorfler --theta T --steps N --out DIR [--vtk]``
+runs the adaptive loop and writes ``DIR/history.json`` plus a mesh (.vol, .png with the
+marked triangles shaded) and, with ``--vtk``, a VTK file per step.
 ``ngdual tutorials [--notebooks DIR] [--solutions]`` lists the lecture tutorials or
 writes them as Jupyter notebooks.
 ``ngdual bench [--levels ...] [--json FILE]`` times the contact solvers against one
@@ -53,21 +54,30 @@ def parser() -> argparse.ArgumentParser:
     s.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="override a scene entry, e.g. --set friction.mu=0.5")
     s.add_argument("--out", default="out", help="output folder (default: out)")
-    s.add_argument("--vtk", action="store_true", help="also write a VTK file for ParaView")
+    s.add_argument("--vtk", action="store_true",
+                   help="also write DIR/solution.vtu (u as a vector: ParaView's Warp By Vector "
+                        "applies it) and, with contact, DIR/solution_contact.vtu (lambda as "
+                        "a vector on Gamma_C)")
     s.add_argument("--no-plots", action="store_true", help="do not write PNG figures")
     s.set_defaults(func=cmd_solve)
     sc = sub.add_parser("scenes", help="list the shipped scenes", parents=[common])
     sc.set_defaults(func=cmd_scenes)
     d = sub.add_parser("dofs", help="degrees of freedom per level (Table 3.1), without solving",
                        parents=[sized])
-    d.add_argument("scene")
-    d.add_argument("--levels", type=int, nargs="+", default=[1, 2, 3, 4])
-    d.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+    d.add_argument("scene", help="path to a TOML scene or the name of a shipped scene")
+    d.add_argument("--levels", type=int, nargs="+", default=[1, 2, 3, 4], metavar="LEVEL",
+                   help="mesh levels (default: 1 2 3 4)")
+    d.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                   help="override a scene entry, e.g. --set contact.htilde_factor=1")
     d.set_defaults(func=cmd_dofs)
     ad = sub.add_parser("adapt", help="adaptive refinement (Chapter 4), writes DIR/history.json",
                         parents=[sized])
-    ad.add_argument("scene")
-    ad.add_argument("--marking", choices=["max", "fraction", "dorfler"], default="dorfler")
+    ad.add_argument("scene", help="path to a TOML scene or the name of a shipped scene")
+    ad.add_argument("--marking", choices=["max", "fraction", "dorfler"], default="dorfler",
+                    help="marking strategy (Section 4.2): max (eta_T >= theta max eta_T), "
+                         "fraction (the theta share of the triangles with the largest "
+                         "eta_T) or dorfler (the fewest triangles carrying theta of the "
+                         "squared estimate, Doerfler; default)")
     ad.add_argument("--theta", type=float, default=0.5, help="marking parameter in [0, 1]")
     ad.add_argument("--steps", type=int, default=5, help="number of solves (default 5)")
     ad.add_argument("--level", type=int, default=None, help="initial mesh level")
@@ -77,8 +87,12 @@ def parser() -> argparse.ArgumentParser:
     ad.add_argument("--reference-levels", type=int, nargs="+", default=None, metavar="LEVEL",
                     help="uniform levels whose norms give, by Aitken extrapolation, the "
                          "reference for the total error (3.124) and the effectivity index")
-    ad.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+    ad.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="override a scene entry, e.g. --set friction.mu=0.5")
     ad.add_argument("--out", default="out-adapt", help="output folder (default: out-adapt)")
+    ad.add_argument("--vtk", action="store_true",
+                    help="also write DIR/solution_stepNN.vtu (and _contact.vtu) per step for "
+                         "ParaView")
     ad.set_defaults(func=cmd_adapt)
     tu = sub.add_parser("tutorials", help="list the tutorials or write them as notebooks",
                         parents=[common])
@@ -115,9 +129,14 @@ def parser() -> argparse.ArgumentParser:
     be = sub.add_parser("bench", help="contact-solve time / one linear solve, per level and "
                                       "solver (Example 3.46), JSON with --json",
                         parents=[sized])
-    be.add_argument("--levels", type=int, nargs="+", default=[1, 2, 3, 4, 5])
-    be.add_argument("--cases", nargs="+", default=["thesis-3.46", "thesis-3.46-coulomb"])
-    be.add_argument("--solvers", nargs="+", default=["uzawa", "uzawa-tuned", "active-set"])
+    be.add_argument("--levels", type=int, nargs="+", default=[1, 2, 3, 4, 5], metavar="LEVEL",
+                    help="mesh levels (default: 1 2 3 4 5)")
+    be.add_argument("--cases", nargs="+", default=["thesis-3.46", "thesis-3.46-coulomb"],
+                    metavar="CASE", help="benchmark cases (default: thesis-3.46 "
+                                         "thesis-3.46-coulomb)")
+    be.add_argument("--solvers", nargs="+", default=["uzawa", "uzawa-tuned", "active-set"],
+                    metavar="SOLVER", help="solvers to time (default: uzawa uzawa-tuned "
+                                           "active-set)")
     be.add_argument("--json", default=None, metavar="FILE",
                     help="write all records (with package versions) to FILE, atomically")
     be.add_argument("--isolate", choices=["auto", "always", "never"], default="auto",

@@ -65,13 +65,38 @@ def result_table(record: dict) -> str:
     return "\n".join(lines)
 
 
-def progress_bar():
+def progress_bar(desc: str = "Uzawa"):
+    """progress(iteration, increment) drawing a tqdm bar on stderr when it is a terminal."""
     from tqdm import tqdm
 
-    bar = tqdm(desc="Uzawa", unit="it", leave=False, file=sys.stderr,
+    bar = tqdm(desc=desc, unit="it", leave=False, file=sys.stderr,
                disable=not sys.stderr.isatty())
 
     def update(iteration: int, increment: float) -> None:
         bar.update(1)
         bar.set_postfix(increment=f"{increment:.1e}")
     return update
+
+
+class PhaseStatus:
+    """status(phase): one stderr line when a phase of a long run begins (meshing,
+    assembling, factorising), stamped with the seconds since the run began.
+
+    Silent unless ``enabled`` (the CLI enables it when stderr is a terminal or the mesh
+    is large), so that logs of small runs and the tests stay clean.
+    """
+
+    def __init__(self, enabled: bool):
+        import time
+
+        self.enabled, self._clock = enabled, time.perf_counter
+        self._start = self._clock()
+
+    def __call__(self, phase: str) -> None:
+        if self.enabled:
+            print(f"ngdual: {self._clock() - self._start:7.1f} s  {phase} ...", file=sys.stderr,
+                  flush=True)
+
+    def done(self) -> None:
+        """Say that the last phase has ended."""
+        self("done")

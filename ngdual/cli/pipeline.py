@@ -8,6 +8,7 @@ from ..scene import SceneError, check_level, load_scene, shipped_scenes
 from .output import (
     EXIT_NOT_CONVERGED,
     LARGE_MESH,
+    PhaseStatus,
     level_flags,
     not_converged,
     number_flag,
@@ -17,9 +18,8 @@ from .output import (
 
 
 def cmd_solve(args) -> int:
-    from .. import budget, plot, post
+    from .. import budget, post
     from ..io import check_output_dir, write_json
-    from ..quantities import fields
     from ..solvers import solve_scene
     from ..solvers.result import ConvergenceError
 
@@ -30,30 +30,47 @@ def cmd_solve(args) -> int:
                         method=scene.solver.method)
     if size.elements > LARGE_MESH:
         print(f"ngdual: {size.describe()}: meshing and solving take a while", file=sys.stderr)
+    status = PhaseStatus(sys.stderr.isatty() or size.elements > LARGE_MESH)
+    iterations = progress_bar("Uzawa" if scene.solver.method == "uzawa" else "Newton")
     try:
-        solution = solve_scene(scene, level, progress=progress_bar(), allow_large=args.allow_large)
+        solution = solve_scene(scene, level, progress=iterations, allow_large=args.allow_large,
+                               status=status)
     except ConvergenceError as err:
+        status.done()
         return not_converged(err)
+    status("post-processing")
     record = post.result_record(solution)
+    status.done()
     print(result_table(record))
     write_json(record, out / "result.json")
     print(f"wrote {out / 'result.json'}")
     if args.vtk:
-        print(f"wrote {post.write_vtk(solution, str(out / 'solution'))}")
+        print("wrote " + ", ".join(post.write_vtk(solution, str(out / "solution"))))
     if not args.no_plots:
-        f = fields(solution)
-        pts, tris, vm = post.element_values(solution.problem.fes.mesh,
-                                            post.von_mises(f.sigma, scene.material.nu))
-        written = [plot.plot_element_field(pts, tris, vm, out / "von_mises.png",
-                                           f"Plane-strain von Mises stress, {scene.name}, "
-                                           f"level {record['level']}", "stress units")]
-        if solution.problem.spaces.contact is not None:
-            written.append(plot.plot_contact_traces(post.contact_traces(solution),
-                                                    out / "contact_traces.png",
-                                                    f"Gamma_C traces, {scene.name}, "
-                                                    f"level {record['level']}"))
-        print("wrote " + ", ".join(str(p) for p in written))
+        print("wrote " + ", ".join(str(p) for p in solution_figures(solution, out)))
     return 0 if solution.converged else EXIT_NOT_CONVERGED
+
+
+def solution_figures(solution, out) -> list:
+    """von_mises.png (colour scale clipped: the corners are singular) and, with contact,
+    contact_traces.png, labelled in the scene's units."""
+    from .. import plot, post
+    from ..quantities import fields
+
+    scene, level = solution.problem.scene, solution.problem.level
+    pts, tris, vm = post.element_values(solution.problem.fes.mesh,
+                                        post.von_mises(fields(solution).sigma, scene.material.nu))
+    fig = plot.plot_element_field(
+        pts, tris, vm, f"Plane-strain von Mises stress, {scene.name}, level {level}",
+        plot.unit_label(r"von Mises stress $\sigma_0$", scene.units.stress),
+        clip=plot.CORNER_CLIP, units=scene.units)
+    written = plot.save_figure(fig, out / "von_mises.png")
+    if solution.problem.spaces.contact is not None:
+        fig = plot.plot_contact_traces(post.contact_traces(solution),
+                                       f"Gamma_C traces, {scene.name}, level {level}",
+                                       units=scene.units)
+        written += plot.save_figure(fig, out / "contact_traces.png")
+    return written
 
 
 def cmd_scenes(args) -> int:
@@ -81,9 +98,10 @@ def cmd_dofs(args) -> int:
 
 
 def cmd_adapt(args) -> int:
-    """SOLVE -> ESTIMATE -> MARK -> REFINE; writes DIR/history.json and a mesh per step."""
+    """SOLVE -> ESTIMATE -> MARK -> REFINE; writes DIR/history.json and a mesh per step
+    (.vol, and .png with the marked triangles shaded), with --vtk a VTK file per step."""
 
-    from .. import budget, plot
+    from .. import budget, plot, post
     from ..afem import adapt, reference_norms
     from ..io import check_output_dir, versions, write_json
     from ..mesh import mesh_arrays
@@ -120,9 +138,12 @@ def cmd_adapt(args) -> int:
         stem.parent.mkdir(parents=True, exist_ok=True)
         mesh.ngmesh.Save(str(stem) + ".vol")
         points, triangles = mesh_arrays(mesh)
-        plot.plot_mesh(points, triangles, str(stem) + ".png",
-                       f"{scene.name}, {args.marking} marking, step {record['step']}: "
-                       f"{mesh.ne} triangles", marked)
+        plot.save_figure(plot.plot_mesh(points, triangles,
+                                        f"{scene.name}, {args.marking} marking, step "
+                                        f"{record['step']}: {mesh.ne} triangles", marked,
+                                        units=scene.units), str(stem) + ".png")
+        if args.vtk:
+            post.write_vtk(solution, str(out / f"solution_step{record['step']:02d}"))
         run["history"].append(record)
         write_json(run, out / "history.json")
         effectivity = record.get("effectivity")
@@ -137,5 +158,6 @@ def cmd_adapt(args) -> int:
     except ConvergenceError as err:
         return not_converged(err)
     write_json(run, out / "history.json")
-    print(f"wrote {out / 'history.json'} and {len(run['history'])} meshes (.vol, .png)")
+    print(f"wrote {out / 'history.json'} and {len(run['history'])} meshes (.vol, .png"
+          + (", solution_stepNN.vtu)" if args.vtk else ")"))
     return 0 if all(r["converged"] for r in run["history"]) else EXIT_NOT_CONVERGED

@@ -41,7 +41,8 @@ from .uzawa import uzawa
 
 def solve_scene(scene: Scene, level: int | None = None,
                 progress: Callable[[int, float], None] | None = None,
-                allow_large: bool = False) -> Solution:
+                allow_large: bool = False,
+                status: Callable[[str], None] | None = None) -> Solution:
     """Mesh, assemble and solve ``scene`` on ``level`` (default: the scene's level).
 
     The scene is validated (once: a scene from :func:`ngdual.scene.load_scene` is not
@@ -50,7 +51,9 @@ def solve_scene(scene: Scene, level: int | None = None,
     :mod:`ngdual.budget`), and the formulas are checked on the mesh before assembly
     (:mod:`ngdual.quadrature_check`). Bad input raises :class:`ngdual.scene.SceneError`
     naming the argument or field; a solve that fails raises
-    :class:`ngdual.solvers.result.ConvergenceError`.
+    :class:`ngdual.solvers.result.ConvergenceError`. ``progress(iteration, increment)`` is
+    called after every iteration of the contact solver, ``status(phase)`` when a phase
+    begins (meshing, assembling, factorising and solving), e.g. for a progress display.
     """
     start = time.perf_counter()
     ensure_valid(scene)
@@ -61,11 +64,15 @@ def solve_scene(scene: Scene, level: int | None = None,
     if not isinstance(allow_large, bool):
         raise SceneTypeError("allow_large", f"must be True or False, got {allow_large!r}")
     budget.check(scene.geometry, level, "level", allow_large, method=scene.solver.method)
+    status = status or (lambda phase: None)
+    status(f"meshing level {scene.geometry.level if level is None else level}")
     mesh = build_mesh(scene.geometry, level)
     check_formulas(scene, mesh)
+    status(f"assembling on {mesh.ne} triangles")
     problem = assemble(scene, mesh)
     problem.level = scene.geometry.level if level is None else level
     check_unknowns(problem)
+    status(f"factorising and solving, {problem.fes.ndof} unknowns")
     solution = solve_problem(problem, solver_settings(scene), progress)
     solution.timings["total"] = time.perf_counter() - start
     return solution
