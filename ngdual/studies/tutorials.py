@@ -175,12 +175,13 @@ def plot_geometry(scene, mesh=None, level: int | None = None, title: str | None 
 
 
 def plot_von_mises(mesh, sigma, nu: float, title: str, clip: float | None = 97.0,
-                   label: str = "von Mises stress"):
+                   label: str = "von Mises stress", vmax: float | None = None):
     """The plane-strain von Mises stress of ``sigma`` per element (value at the centroid).
 
     ``clip``: the colour scale ends at this percentile of the element values (corner
     singularities would otherwise take the whole scale); the colour bar says so and
-    gives the true maximum. ``None`` shows the full range. Returns the figure.
+    gives the true maximum. ``None`` shows the full range. ``vmax`` ends the scale at a
+    given value instead (to compare pictures). Returns the figure.
     """
     import matplotlib.pyplot as plt
     import numpy as np
@@ -189,14 +190,16 @@ def plot_von_mises(mesh, sigma, nu: float, title: str, clip: float | None = 97.0
 
     points, triangles, values = element_values(mesh, von_mises(sigma, nu))
     top = float(values.max())
-    vmax = float(np.percentile(values, clip)) if clip is not None else top
+    by_percentile = vmax is None and clip is not None
+    if vmax is None:
+        vmax = float(np.percentile(values, clip)) if clip is not None else top
     width, height = np.ptp(points, axis=0)
     fig, ax = plt.subplots(figsize=(9, max(3.0, 7 * height / width + 1.0)))
     art = ax.tripcolor(points[:, 0], points[:, 1], triangles, facecolors=values,
                        cmap="viridis", vmin=0.0, vmax=vmax, edgecolors="none")
-    clipped = clip is not None and top > vmax
-    note = (f"\n(scale clipped at the {clip:g}th\npercentile; maximum {top:.3g})" if clipped
-            else "")
+    clipped = top > vmax
+    where = f"the {clip:g}th\npercentile" if by_percentile else f"{vmax:.3g}"
+    note = f"\n(scale clipped at {where};\nmaximum {top:.3g})" if clipped else ""
     fig.colorbar(art, ax=ax, extend="max" if clipped else "neither", label=label + note,
                  fraction=0.046, pad=0.02)
     ax.set_aspect("equal")

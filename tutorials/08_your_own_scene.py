@@ -1,5 +1,5 @@
 # %% [markdown]
-# # Tutorial 6: Your own scene
+# # Tutorial 8: Your own scene
 #
 # **Problem.** A new geometry, set up without writing any finite element code: an
 # elastic stamp (a hexagon) clamped at its two short vertical sides, loaded from
@@ -18,28 +18,36 @@
 # 3. Solving on several levels (uniform refinement) from Python and from the command
 #    line, and reading the result record.
 #
-# **References.** M. Andres (2011), eqs. (3.1), (3.61), (3.68), Algorithm 3.38; the scene
+# **References.** M. Andres, *Dual-dual formulations for frictional contact problems in
+# mechanics*, PhD thesis, Leibniz Universität Hannover, 2011:
+# eqs. (3.1), (3.61), (3.68), Algorithm 3.38; the scene
 # schema in `ngdual/scene.py`; the shipped scenes (`ngdual scenes`).
+
+# %% [markdown]
+# ## Parameters
 
 # %%
 import json
 
 import numpy as np
 
-from ngdual import plot, post, quantities
+import ngdual as nd
 from ngdual.cli import main as ngdual_cli
 from ngdual.mesh import mesh_size
-from ngdual.scene import SceneError, load_scene
-from ngdual.solvers import solve_scene
-from ngdual.studies.tutorials import draw, output_dir, quick_mode, save_results, show_file
+from ngdual.studies.tutorials import (
+    draw,
+    output_dir,
+    plot_geometry,
+    plot_traces,
+    plot_von_mises,
+    quick_mode,
+    save_figure,
+    save_results,
+)
 
-# %% [markdown]
-# ## Parameters
-
-# %%
 QUICK = quick_mode()
 LEVELS = [1, 2] if QUICK else [1, 2, 3, 4]
-OUT = output_dir("06_your_own_scene")
+OUT = output_dir("08_your_own_scene")
 print(f"quick mode: {QUICK}; levels {LEVELS}; output in {OUT}")
 
 # %% [markdown]
@@ -84,7 +92,8 @@ metric = "h12"
 """
 scene_file = OUT / "stamp.toml"
 scene_file.write_text(SCENE)
-scene = load_scene(scene_file)
+scene = nd.load_scene(scene_file)
+save_figure(plot_geometry(scene, level=LEVELS[0]), OUT / "geometry.png")
 print(f"loaded {scene.name!r}: {len(scene.geometry.points)} corners, "
       f"contact on {scene.labels('contact')}, friction law {scene.friction.law!r}")
 
@@ -115,8 +124,8 @@ MISTAKES = [
 caught = []
 for what, path, overrides in MISTAKES:
     try:
-        load_scene(path, overrides)
-    except SceneError as err:
+        nd.load_scene(path, overrides)
+    except nd.SceneError as err:
         caught.append(err.field)
         print(f"{what}:\n    field {err.field!r}\n    {err}")
     else:
@@ -134,7 +143,7 @@ print(f"exit status {bad_status}; output folder exists: {(OUT / 'never-written')
 # %% [markdown]
 # ## 3. Solving and refining
 #
-# `solve_scene(scene, level)` meshes (level k = k − 1 uniform refinements of the netgen
+# `nd.solve(scene, level)` meshes (level k = k − 1 uniform refinements of the netgen
 # mesh), assembles only what the scene needs and runs the matching algorithm — here
 # Algorithm 3.38. The record of `post.result_record` is what `ngdual solve` writes to
 # `result.json`.
@@ -142,8 +151,8 @@ print(f"exit status {bad_status}; output folder exists: {(OUT / 'never-written')
 # %%
 levels = []
 for level in LEVELS:
-    solution = solve_scene(scene, level)
-    record = post.result_record(solution)
+    solution = nd.solve(scene, level)
+    record = nd.result_record(solution)
     levels.append({"level": level, "h": mesh_size(solution.problem.fes.mesh),
                    "dofs": record["dofs"], "converged": record["converged"],
                    "iterations": record["iterations"]["outer"],
@@ -157,20 +166,20 @@ for row in levels:
           f"{row['iterations']:4d} {row['nodes_in_contact']:10d} {row['sigma_X']:10.4e}")
 
 # %% [markdown]
-# Pictures of the finest level: the von Mises stress (matplotlib, saved as PNG; in a
+# Pictures of the finest level: the von Mises stress (matplotlib, saved as PNG, the
+# colour scale clipped at the 97th percentile because of the corners, see below; in a
 # notebook also NGSolve's interactive webgui) and the traces on Γ_C.
 
 # %%
-fields = quantities.fields(solution)
 mesh = solution.problem.fes.mesh
-von_mises = post.von_mises(fields.sigma, scene.material.nu)
-points, triangles, values = post.element_values(mesh, von_mises)
-show_file(plot.plot_element_field(points, triangles, values, OUT / "von_mises.png",
-                                  f"von Mises stress, {scene.name}, level {LEVELS[-1]}",
-                                  "stress units"))
-show_file(plot.plot_contact_traces(post.contact_traces(solution), OUT / "contact_traces.png",
-                                   f"Gamma_C traces, {scene.name}, level {LEVELS[-1]}"))
-draw(von_mises, mesh, "von_mises")
+sigma_h = nd.fields(solution).sigma
+save_figure(plot_von_mises(mesh, sigma_h, scene.material.nu,
+                           f"von Mises stress, {scene.name}, level {LEVELS[-1]}"),
+            OUT / "von_mises.png")
+save_figure(plot_traces(nd.contact_traces(solution),
+                        f"Traces on Γ_C, {scene.name}, level {LEVELS[-1]}"),
+            OUT / "contact_traces.png")
+draw(nd.post.von_mises(sigma_h, scene.material.nu), mesh, "von_mises")
 
 # %% [markdown]
 # Two things stand out, and both are mathematics rather than bugs:
@@ -202,11 +211,11 @@ results = {"quick": QUICK, "caught": caught,
            "cli_status": status, "levels": levels,
            "sigma_X_change": float(np.abs(np.diff([row["sigma_X"] for row in levels])).max()
                                    / levels[-1]["sigma_X"]) if len(levels) > 1 else None}
-print(f"wrote {save_results('06_your_own_scene', results)}")
+print(f"wrote {save_results('08_your_own_scene', results)}")
 
 # %% [markdown]
 # ## Exercises
-# Solutions: `tutorials/solutions/06_your_own_scene_solutions.py`.
+# Solutions: `tutorials/solutions/08_your_own_scene_solutions.py`.
 #
 # 1. **First contact.** Make the foundation flat (g = 0.002) and find the load factor s
 #    (traction s · t₀) at which the stamp first touches it. Hint: before contact the

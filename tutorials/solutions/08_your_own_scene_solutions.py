@@ -1,5 +1,5 @@
 # %% [markdown]
-# # Solutions to Tutorial 6: Your own scene
+# # Solutions to Tutorial 8: Your own scene
 #
 # Each exercise is one section; all run in seconds with `NGDUAL_QUICK=1`.
 
@@ -13,7 +13,7 @@ from ngdual.studies.tutorials import output_dir, quick_mode, save_results
 
 QUICK = quick_mode()
 LEVELS = [1, 2, 3] if QUICK else [1, 2, 3, 4]
-OUT = output_dir("06_your_own_scene_solutions")
+OUT = output_dir("08_your_own_scene_solutions")
 
 STAMP = """
 name = "stamp"
@@ -155,7 +155,7 @@ for (level, norm, share) in rows:
 print(f"observed orders of |sigma|_X differences: {np.round(orders, 2)}")
 
 # %%
-save_results("06_your_own_scene_solutions",
+save_results("08_your_own_scene_solutions",
              {"s_star": s_star, "touching": {str(k): v for k, v in touching.items()},
               "arch_errors": arch_errors, "arch_contact": arch_contact,
               "refinement": rows})

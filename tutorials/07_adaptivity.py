@@ -1,16 +1,16 @@
 # %% [markdown]
-# # Tutorial 5: Adaptive refinement
+# # Tutorial 7: Adaptive refinement
 #
 # **Problem.** Solutions of contact problems are not smooth: σ is singular at corners
 # where boundary conditions change, and at the ends of the contact zone. Uniform
-# refinement then converges slowly. The indicators η_{tot,T} of (4.50) (Tutorial 4) say
+# refinement then converges slowly. The indicators η_{tot,T} of (4.50) (Tutorial 6) say
 # *where* the error is made; refining there should restore the convergence rate that
 # PEERS has for smooth solutions, e ~ N^{-1/2} in the number N of unknowns.
 #
 # **Discretisation.** PEERS (3.61) on netgen meshes refined by bisection with conforming
 # closure; the coarse boundary meshes h̃ (Γ_N, Γ_C) and ĥ (ν) follow the refinement, nested,
 # with h̃ ≈ 2h locally. Each step solves the discrete problem (3.62) with the solver the
-# scene asks for (`solver.method`; Tutorials 2 and 3 show that they all agree).
+# scene asks for (`solver.method`; Tutorials 3 and 4 show that they all agree).
 #
 # **What you will learn.**
 # 1. The loop SOLVE → ESTIMATE → MARK → REFINE (`ngdual.afem.adapt`) and its history.
@@ -22,12 +22,20 @@
 # 4. Example 3.46 with Coulomb friction: where the indicators refine (Figs. 4.1-4.13),
 #    and the total error (3.124) against extrapolated norms (Table 4.4).
 #
-# **References.** M. Andres (2011), Section 4.2: Figs. 4.1-4.13, Tables 4.1, 4.3, 4.4;
+# **References.** M. Andres, *Dual-dual formulations for frictional contact problems in
+# mechanics*, PhD thesis, Leibniz Universität Hannover, 2011:
+# Section 4.2: Figs. 4.1-4.13, Tables 4.1, 4.3, 4.4;
 # eq. (3.124) and Aitken extrapolation in Section 3.4. W. Dörfler, *A convergent adaptive
 # algorithm for Poisson's equation*, SIAM J. Numer. Anal. 33 (1996). M. L. Williams,
 # *Stress singularities resulting from various boundary conditions in angular corners of
 # plates in extension*, J. Appl. Mech. 19 (1952). L. Chen, *iFEM: an innovative finite
 # element method package in MATLAB* (2008), the SOLVE-ESTIMATE-MARK-REFINE loop.
+
+# %% [markdown]
+# ## Parameters
+#
+# A run is (marking, θ, number of SOLVE steps). Uniform refinement is `max` with θ = 0
+# (every element has η_T ≥ 0 · max η).
 
 # %%
 import math
@@ -37,22 +45,19 @@ import matplotlib.tri as mtri
 import ngsolve as ngs
 import numpy as np
 
-from ngdual.afem import adapt, reference_norms
-from ngdual.estimator import estimate
-from ngdual.marking import STRATEGIES, mark
+import ngdual as nd
+from ngdual.afem import reference_norms
+from ngdual.marking import STRATEGIES
 from ngdual.rates import fitted_rate
-from ngdual.scene import load_scene
-from ngdual.solvers import solve_scene
-from ngdual.studies.tutorials import output_dir, quick_mode, save_figure, save_results
+from ngdual.studies.tutorials import (
+    output_dir,
+    plot_geometry,
+    quick_mode,
+    save_figure,
+    save_results,
+)
 from ngdual.verification import corner
 
-# %% [markdown]
-# ## Parameters
-#
-# A run is (marking, θ, number of SOLVE steps). Uniform refinement is `max` with θ = 0
-# (every element has η_T ≥ 0 · max η).
-
-# %%
 QUICK = quick_mode()
 L_RUNS = {"uniform": ("max", 0.0, 3 if QUICK else 5),
           "max": ("max", 0.5, 4 if QUICK else 10),
@@ -62,7 +67,7 @@ THESIS_RUNS = {"max": ("max", 0.5, 1, 3 if QUICK else 8),          # Table 4.1: 
                "fraction": ("fraction", 0.2, 2, 3 if QUICK else 5),  # Tables 4.3, 4.4
                "dorfler": ("dorfler", 0.5, 2, 3 if QUICK else 6)}
 REFERENCE_LEVELS = [1, 2, 3] if QUICK else [2, 3, 4]   # Aitken extrapolation (Section 3.4)
-OUT = output_dir("05_adaptivity")
+OUT = output_dir("07_adaptivity")
 print(f"quick mode: {QUICK}; output in {OUT}")
 
 # %% [markdown]
@@ -79,13 +84,15 @@ print(f"quick mode: {QUICK}; output in {OUT}")
 # convergence rates are proven. On the indicators of Example 3.46 (level 2):
 
 # %%
-thesis = load_scene("thesis-3.46-coulomb")
-example = estimate(solve_scene(thesis, 2))
+thesis = nd.load_scene("thesis-3.46-coulomb")
+save_figure(plot_geometry(thesis, level=2, title="Example 3.46, Coulomb friction: "
+                          "boundary parts, level 2"), OUT / "geometry.png")
+example = nd.estimate(nd.solve(thesis, 2))
 eta = example.eta
 examples = {"max": 0.5, "fraction": 0.2, "dorfler": 0.5}
 marked_sets = {}
 for strategy, theta in examples.items():
-    marked_sets[strategy] = mark(eta, theta, strategy)
+    marked_sets[strategy] = nd.mark(eta, theta, strategy)
     chosen = marked_sets[strategy]
     print(f"{strategy:8s} theta = {theta}: {chosen.sum():3d} of {len(eta)} elements, "
           f"{100 * np.sum(eta[chosen] ** 2) / np.sum(eta**2):5.1f} % of eta^2")
@@ -122,7 +129,7 @@ def plot_meshes(panels: list, path, title: str, columns: int = 2) -> None:
     save_figure(fig, path)
 
 
-level2 = triangulation(solve_scene(thesis, 2).problem.fes.mesh)
+level2 = triangulation(nd.solve(thesis, 2).problem.fes.mesh)
 plot_meshes([(level2, marked_sets[s], f"{s}, theta = {examples[s]}: {marked_sets[s].sum()} marked")
              for s in examples], OUT / "marking_example.png",
             "Marked elements (shaded), Example 3.46, level 2", columns=1)
@@ -182,7 +189,7 @@ def run(scene, marking, theta, steps, level=1, reference=None, error=None) -> di
         if error is not None:
             kept["errors"].append(error(solution))
 
-    kept["history"] = adapt(scene, marking, theta, steps, level=level, reference=reference,
+    kept["history"] = nd.adapt(scene, marking, theta, steps, level=level, reference=reference,
                             on_step=on_step)
     return kept
 
@@ -331,11 +338,11 @@ results = {
                       | {"ndof": r["dofs"]["total"]} for r in kept["history"]]
                for name, kept in thesis_runs.items()},
 }
-print(f"wrote {save_results('05_adaptivity', results)}")
+print(f"wrote {save_results('07_adaptivity', results)}")
 
 # %% [markdown]
 # ## Exercises
-# Solutions: `tutorials/solutions/05_adaptivity_solutions.py`.
+# Solutions: `tutorials/solutions/07_adaptivity_solutions.py`.
 #
 # 1. **The Dörfler parameter.** Run Dörfler marking on the L-shape with θ ∈ {0.2, 0.5,
 #    0.8}. Compare the rates, the number of SOLVE steps needed to reach N ≈ 5000 and the
@@ -346,5 +353,5 @@ print(f"wrote {save_results('05_adaptivity', results)}")
 #    those of η_{tot,T}. Which terms put the refinement on Γ_N and Γ_C?
 # 3. **The corners of Example 3.46.** Refine `thesis-3.46-frictionless` uniformly and
 #    with Dörfler marking (θ = 0.5), once with the gap g = 0.01 and once with g = 0
-#    (`load_scene(..., ["contact.gap='0'"])`). Compare η, its rate (`fitted_rate`)
+#    (`nd.load_scene(..., ["contact.gap='0'"])`). Compare η, its rate (`fitted_rate`)
 #    and the largest asymmetry indicator. Explain the difference.

@@ -1,5 +1,5 @@
 # %% [markdown]
-# # Tutorial 2: Signorini contact and the Uzawa algorithm
+# # Tutorial 3: Signorini contact and the Uzawa algorithm
 #
 # **Problem.** Example 3.46 of the thesis without friction: the block [−4,4]×[−1,1] is
 # clamped at its ends, pressed down by a parabolic traction on top and may touch a
@@ -19,22 +19,30 @@
 # 2. The projection P⁺ as a small convex quadratic program posed in cvxpy, and why its
 #    metric W matters (Remark 3.40): P⁺ is *not* componentwise clipping.
 # 3. How the step length ρ and the metric (`"h12"` vs `"euclidean"`) change the number
-#    of iterations, on one mesh and under refinement.
+#    of iterations, on one mesh and under refinement, and what a too large ρ does.
 # 4. How to check the result against an independent solver (one convex QP, `solve_qp`).
 #
-# **References.** M. Andres (2011), Section 3.3: eqs. (3.98)-(3.107), Algorithm 3.38,
-# Theorem 3.39, Remark 3.40, Example 3.46, Table 3.5. M. Maischak, *FEM/BEM methods for
-# Signorini-type problems* (Habilitation, Hannover 2004), Section 5.3.
+# **References.** M. Andres, *Dual-dual formulations for frictional contact problems in
+# mechanics*, PhD thesis, Leibniz Universität Hannover, 2011: Section 3.3, eqs.
+# (3.98)-(3.107), Algorithm 3.38, Theorem 3.39, Remark 3.40, Example 3.46, Table 3.5.
+# M. Maischak, *FEM/BEM methods for Signorini-type problems* (Habilitation, Hannover
+# 2004), Section 5.3.
+
+# %% [markdown]
+# ## Parameters
+# The algorithms themselves are the subject here, so besides the public API
+# (`import ngdual as nd`) this tutorial imports the Uzawa loop, its projection and the
+# reference QP solver from their modules.
 
 # %%
 import cvxpy as cp
 import matplotlib.pyplot as plt
 import numpy as np
 
-from ngdual import peers, plot, post, quantities
+import ngdual as nd
+from ngdual import peers
 from ngdual.forms import assemble
 from ngdual.mesh import build_mesh
-from ngdual.scene import load_scene
 from ngdual.solvers.linear import solve_linear
 from ngdual.solvers.projections import NonnegativeProjection, metric_matrix
 from ngdual.solvers.reference import solve_qp
@@ -43,37 +51,42 @@ from ngdual.solvers.uzawa import uzawa
 from ngdual.studies.tutorials import (
     draw,
     output_dir,
+    plot_geometry,
+    plot_traces,
+    plot_von_mises,
     quick_mode,
     save_figure,
     save_results,
-    show_file,
 )
 
-# %% [markdown]
-# ## Parameters
-
-# %%
 QUICK = quick_mode()
 LEVEL = 2 if QUICK else 4                                # mesh level of Example 3.46
-RHOS = [0.25, 0.5, 1.0, 1.5, 2.0]                        # step lengths of Algorithm 3.38
+RHOS = [0.25, 0.5, 1.0, 1.5]                             # step lengths of Algorithm 3.38
 TOO_LARGE_RHO = 3.0                                      # beyond the convergence range
 MAX_ITER = 500                                           # per run of the sweep
+SHORT_RUN = 40                                           # iterations shown for TOO_LARGE_RHO
 METRICS = ["h12", "euclidean"]
 REFINEMENT_LEVELS = [1, 2, 3] if QUICK else [1, 2, 3, 4, 5]
 EPS = 1e-8                                               # stopping tolerance (step 5)
 EPS_COMPARE = 1e-10                                      # tighter, for the comparison with the QP
-OUT = output_dir("02_signorini_uzawa")
+OUT = output_dir("03_signorini_uzawa")
 print(f"quick mode: {QUICK}; level {LEVEL}; output in {OUT}")
 
 # %% [markdown]
 # ## 1. The algebraic problem
+#
+# The block [−4,4]×[−1,1]: Γ_D the clamped ends, Γ_N the top with the parabolic
+# traction, Γ_C the bottom above the foundation.
 #
 # `assemble` builds the matrix of (3.103) once. The unknown vector is ordered
 # [σ | u, η, φ, λ_t | λ_n]; `problem.sigma`, `problem.mult` and `problem.lam_n` index the
 # three groups, and `problem.block(rows, cols)` cuts out A, B and C_n.
 
 # %%
-scene = load_scene("thesis-3.46-frictionless")
+scene = nd.load_scene("thesis-3.46-frictionless")
+save_figure(plot_geometry(scene, level=LEVEL,
+                          title=f"Example 3.46: boundary parts and mesh, level {LEVEL}"),
+            OUT / "geometry.png")
 problem = assemble(scene, build_mesh(scene.geometry, LEVEL))
 A = problem.block(problem.sigma, problem.sigma)
 B = problem.block(problem.sigma, problem.mult)
@@ -156,6 +169,24 @@ for metric in METRICS:
         print(f"metric {metric:9s} rho = {rho:4.2f}: {solution.iterations['outer']:4d} "
               f"iterations, converged {solution.converged}")
 
+# %% [markdown]
+# For small ρ the contraction factor is about 1 − cρ, so halving ρ doubles the number of
+# iterations.
+#
+# Too large a step and the iteration no longer contracts. A short run is enough to see
+# it: with ρ = 3 the increments stop decreasing after a few steps and the iteration
+# oscillates (or diverges, in which case `uzawa` raises `ConvergenceError`). Theorem 3.39
+# explains why: λ ↦ P⁺(λ + ρΦ(σ(λ))) is a contraction only for ρ below a bound set by
+# the ellipticity of ã (in ngdual's scaling about 2; where exactly depends on the mesh:
+# on level 4, ρ = 2 already stalls). ngdual reports this through `converged`; it never
+# passes an unconverged iterate off as a solution.
+
+# %%
+overshoot = uzawa(problem, UzawaSettings.from_scene(scene, rho=TOO_LARGE_RHO, eps=EPS, metric="h12",
+                                                    max_iter=SHORT_RUN))
+print(f"rho = {TOO_LARGE_RHO}: converged {overshoot.converged} after "
+      f"{overshoot.iterations['outer']} iterations, last increment {overshoot.history[-1]:.1e}")
+
 fig, axes = plt.subplots(1, 2, figsize=(11, 4), sharey=True)
 for ax, metric in zip(axes, METRICS):
     for rho in RHOS:
@@ -164,22 +195,11 @@ for ax, metric in zip(axes, METRICS):
     ax.set_title(f"metric {metric!r}, level {LEVEL}")
     ax.set_xlabel("Uzawa iteration i")
     ax.grid(True, which="both", alpha=0.3)
+axes[0].semilogy(range(1, len(overshoot.history) + 1), overshoot.history, "r--",
+                 label=f"ρ = {TOO_LARGE_RHO} ({SHORT_RUN} steps)")
 axes[0].set_ylabel("relative increment (step 5)")
-axes[1].legend()
+axes[0].legend()
 save_figure(fig, OUT / "uzawa_histories.png")
-
-# %% [markdown]
-# For small ρ the contraction factor is about 1 − cρ, so halving ρ doubles the number of
-# iterations. Too large a step and the iteration no longer contracts: it oscillates (or
-# diverges, in which case `uzawa` raises `ConvergenceError`) and stops at `max_iter`
-# unconverged. ngdual reports that through `converged` instead of returning a wrong
-# answer. Where "too large" begins depends on the mesh: on level 4, ρ = 2 already stalls.
-
-# %%
-overshoot = uzawa(problem, UzawaSettings.from_scene(scene, rho=TOO_LARGE_RHO, eps=EPS, metric="h12",
-                                                    max_iter=200))
-print(f"rho = {TOO_LARGE_RHO}: converged {overshoot.converged} after "
-      f"{overshoot.iterations['outer']} iterations, last increment {overshoot.history[-1]:.1e}")
 
 # %% [markdown]
 # ## 4. Iterations under refinement (Remark 3.40)
@@ -230,7 +250,8 @@ def relative_difference(a, b):
 agreement = {
     "sigma": relative_difference(tight.part(*peers.STRESS), reference.part(*peers.STRESS)),
     "lam_n": relative_difference(tight.part("lam_n"), reference.part("lam_n")),
-    "nodes_in_contact": [post.contact_summary(s)["nodes_in_contact"] for s in (tight, reference)],
+    "nodes_in_contact": [nd.result_record(s)["contact"]["nodes_in_contact"]
+                         for s in (tight, reference)],
 }
 print(f"Uzawa vs QP: sigma {agreement['sigma']:.1e}, lambda_n {agreement['lam_n']:.1e}, "
       f"nodes in contact {agreement['nodes_in_contact']}")
@@ -242,10 +263,23 @@ print("contact residuals of the Uzawa solution:",
 # λ_n = 0) exactly where σ_n < 0.
 
 # %%
-show_file(plot.plot_contact_traces(post.contact_traces(tight), OUT / "contact_traces.png",
-                                   f"Example 3.46 without friction, level {LEVEL}"))
+save_figure(plot_traces(nd.contact_traces(tight),
+                        f"Example 3.46 without friction: traces on Γ_C, level {LEVEL}"),
+            OUT / "contact_traces.png")
+
+# %% [markdown]
+# The stress in the body: the von Mises stress of the Uzawa solution. The corners where
+# the clamped ends meet Γ_C are singular (Tutorial 6), so the colour scale is clipped at
+# the 97th percentile of the element values (stated on the colour bar). In a notebook,
+# NGSolve's webgui adds an interactive view.
+
+# %%
 mesh = problem.fes.mesh
-draw(post.von_mises(quantities.fields(tight).sigma, scene.material.nu), mesh, "von_mises")
+sigma_h = nd.fields(tight).sigma
+save_figure(plot_von_mises(mesh, sigma_h, scene.material.nu,
+                           f"Example 3.46 without friction: von Mises stress, level {LEVEL}"),
+            OUT / "von_mises.png")
+draw(nd.post.von_mises(sigma_h, scene.material.nu), mesh, "von_mises")
 
 # %%
 results = {
@@ -260,11 +294,11 @@ results = {
     "agreement": agreement,
     "residuals": tight.residuals,
 }
-print(f"wrote {save_results('02_signorini_uzawa', results)}")
+print(f"wrote {save_results('03_signorini_uzawa', results)}")
 
 # %% [markdown]
 # ## Exercises
-# Solutions: `tutorials/solutions/02_signorini_uzawa_solutions.py`.
+# Solutions: `tutorials/solutions/03_signorini_uzawa_solutions.py`.
 #
 # 1. **Optimal ρ.** For levels 1-4 and both metrics find the ρ ∈ [0.25, 2.5] with the
 #    fewest iterations (compare Table 3.5 of the thesis). How does ρ_opt move with h?
@@ -272,6 +306,6 @@ print(f"wrote {save_results('02_signorini_uzawa', results)}")
 #    that it has the units of the others) and run the Uzawa loop with it. Is the mass
 #    matrix H^{1/2}-equivalent? What do the iteration counts do under refinement?
 # 3. **Other gaps.** Solve with g = |x₁| and with g = 0.005 + 0.002 x₁²
-#    (`load_scene(..., ["contact.gap='abs(x)'"])`) on level 3 and compare the number of
+#    (`nd.load_scene(..., ["contact.gap='abs(x)'"])`) on level 3 and compare the number of
 #    nodes in contact of the Uzawa and the QP solution. Why does the body not touch the
 #    foundation g = |x₁| at all on level 2?

@@ -1,5 +1,5 @@
 # %% [markdown]
-# # Solutions to Tutorial 2: Signorini contact and the Uzawa algorithm
+# # Solutions to Tutorial 3: Signorini contact and the Uzawa algorithm
 #
 # Each exercise is one section; all run in seconds with `NGDUAL_QUICK=1`.
 
@@ -20,7 +20,7 @@ from ngdual.studies.tutorials import output_dir, quick_mode, save_results
 QUICK = quick_mode()
 LEVELS = [1, 2] if QUICK else [1, 2, 3, 4]
 RHOS = [0.5, 1.0, 1.5, 2.0] if QUICK else list(np.arange(0.25, 2.51, 0.25))
-OUT = output_dir("02_signorini_uzawa_solutions")
+OUT = output_dir("03_signorini_uzawa_solutions")
 scene = load_scene("thesis-3.46-frictionless")
 problems = {level: assemble(scene, build_mesh(scene.geometry, level)) for level in LEVELS}
 
@@ -112,6 +112,6 @@ for gap in ("abs(x)", "0.005 + 0.002*x*x"):
     print(f"g = {gap:18s}: nodes in contact, Uzawa {nodes[0]}, QP {nodes[1]}")
 
 # %%
-save_results("02_signorini_uzawa_solutions",
+save_results("03_signorini_uzawa_solutions",
              {"optimal": optimal, "mass_metric_iterations": mass_iterations,
               "hand_vs_ngdual": hand_vs_ngdual, "gaps": gaps})

@@ -1,31 +1,30 @@
 # %% [markdown]
-# # Solutions to Tutorial 3: Tresca and Coulomb friction, the nested Uzawa algorithm
+# # Solutions to Tutorial 4: Tresca and Coulomb friction, the nested Uzawa algorithm
 #
 # Each exercise is one section; all run in seconds with `NGDUAL_QUICK=1`.
 
 # %%
+import matplotlib.pyplot as plt
 import numpy as np
 
+import ngdual as nd
 from ngdual import peers, post
 from ngdual.forms import assemble
-from ngdual.friction import build_friction_forms
 from ngdual.mesh import build_mesh
-from ngdual.scene import load_scene
 from ngdual.solvers.nested import nested_uzawa
 from ngdual.solvers.result import ConvergenceError
 from ngdual.solvers.settings import NestedUzawaSettings, UzawaSettings
 from ngdual.solvers.uzawa import uzawa
-from ngdual.studies.tutorials import output_dir, quick_mode, save_results
+from ngdual.studies.tutorials import output_dir, quick_mode, save_figure, save_results
 
 QUICK = quick_mode()
 LEVEL = 3                                             # the first level with a stick zone
 RHO1S = [1.0] if QUICK else [0.5, 1.0, 1.5]
 RHO2S = [0.5, 1.0, 1.5] if QUICK else [0.25, 0.5, 1.0, 1.5]
 LARGE_RHO2S = [2.5, 8.0]
-GAP_ABS_LEVEL = 3 if QUICK else 4
 MUS = [0.0, 0.1, 0.5, 1.0] if QUICK else [0.0, 0.1, 0.25, 0.5, 1.0]
-OUT = output_dir("03_friction_solutions")
-coulomb = load_scene("thesis-3.46-coulomb")
+OUT = output_dir("04_friction_solutions")
+coulomb = nd.load_scene("thesis-3.46-coulomb")
 problem = assemble(coulomb, build_mesh(coulomb.geometry, LEVEL))
 
 
@@ -66,36 +65,20 @@ large = {str(rho2): attempt(rho2=rho2, max_iter=600) for rho2 in LARGE_RHO2S}
 for rho2, (outer, _, converged) in large.items():
     print(f"rho2 = {rho2}: converged {converged} after {outer} outer steps")
 
-# %% [markdown]
-# ## Exercise 2: ĥ = h̃ when (3.73) holds
-#
-# With g = |x₁| the body touches only around x₁ = 0, far from the ends of Γ_C: 𝓕 = 0
-# near ∂Γ_C, the hats next to the ends of A_C pin the checkerboard mode, and the
-# inf-sup condition (3.74) holds with ĥ = h̃ (Lemma 3.31). Both choices converge, and λ_n,
-# λ_t agree up to the discretisation difference of ν (Figs. 3.26-3.27). ν itself is a
-# different function on the two ĥ meshes; it is printed on A_C = supp 𝓕 only (elsewhere
-# 𝓕 is zero up to round-off and ν does not enter (3.62)).
-
-# %%
-gap_abs = {}
-for factor in (1, 2):
-    scene = load_scene("thesis-3.46-coulomb-gap-abs", [f"contact.hhat_factor={factor}"])
-    gap_abs[factor] = nested_uzawa(assemble(scene, build_mesh(scene.geometry, GAP_ABS_LEVEL)),
-                                   NestedUzawaSettings.from_scene(scene, eps2=1e-8))
-a, b = gap_abs[1], gap_abs[2]
-scale = max(np.linalg.norm(b.part("lam_n")), np.linalg.norm(b.part("lam_t")))
-gap_abs_difference = {name: float(np.linalg.norm(a.part(name) - b.part(name)) / scale)
-                      for name in ("lam_n", "lam_t")}
-for factor, solution in gap_abs.items():
-    forms = build_friction_forms(solution.problem)
-    F_hat = forms.per_hat_edge(solution.friction_bound)
-    on_a_c = (F_hat > 1e-6 * F_hat.max())[forms.edge_of]
-    print(f"h^ = {factor} h~: {solution.iterations}, converged {solution.converged}; "
-          f"nu on the fine edges of A_C: {np.round(solution.nu[forms.edge_of][on_a_c], 2)}")
-print(f"difference of the multipliers (relative): {gap_abs_difference}")
+fig, ax = plt.subplots(figsize=(6.5, 4))
+for order, style in (("friction-outer", "o-"), ("contact-outer", "s--")):
+    for rho1 in RHO1S:
+        inner = [sweep[f"{order} {rho1} {rho2}"][1] for rho2 in RHO2S]
+        ax.plot(RHO2S, inner, style, label=f"{order}, ρ₁ = {rho1}")
+ax.set_xlabel("ρ₂")
+ax.set_ylabel("inner iterations (= solves)")
+ax.set_title(f"Coulomb, level {LEVEL}: cost of the two loop orders")
+ax.grid(alpha=0.3)
+ax.legend(fontsize=8)
+save_figure(fig, OUT / "step_lengths.png")
 
 # %% [markdown]
-# ## Exercise 3: the friction coefficient
+# ## Exercise 2: the friction coefficient
 #
 # With μ_f = 0 the friction bound vanishes, ν plays no role and the nested algorithm
 # solves the frictionless problem: σ agrees with Algorithm 3.38 to the solver tolerance.
@@ -103,7 +86,7 @@ print(f"difference of the multipliers (relative): {gap_abs_difference}")
 # carried without slip on a growing part of the contact zone: the stick zone grows.
 
 # %%
-frictionless = load_scene("thesis-3.46-frictionless")
+frictionless = nd.load_scene("thesis-3.46-frictionless")
 reference = uzawa(assemble(frictionless, build_mesh(frictionless.geometry, LEVEL)),
                   UzawaSettings.from_scene(frictionless, eps=1e-10))
 by_mu = {}
@@ -126,8 +109,18 @@ for mu in MUS:
           f"{row['nodes_in_contact']} ({split}), |sigma - sigma(mu=0)| = "
           f"{row['sigma_vs_frictionless']:.1e}")
 
+fig, ax = plt.subplots(figsize=(6.5, 4))
+positive = [mu for mu in MUS if mu > 0]
+ax.plot(positive, [by_mu[str(mu)]["stick_nodes"] for mu in positive], "o-", label="stick")
+ax.plot(positive, [by_mu[str(mu)]["slip_nodes"] for mu in positive], "s-", label="slip")
+ax.set_xlabel(r"friction coefficient $\mu_f$")
+ax.set_ylabel(r"$\tilde h$-nodes in contact")
+ax.set_title(f"Coulomb friction, level {LEVEL}: stick grows with $\\mu_f$")
+ax.grid(alpha=0.3)
+ax.legend()
+save_figure(fig, OUT / "stick_slip.png")
+
 # %%
-save_results("03_friction_solutions",
+save_results("04_friction_solutions",
              {"sweep": sweep, "rho2s": RHO2S, "rho1s": RHO1S, "large_rho2": large,
-              "gap_abs_converged": [s.converged for s in gap_abs.values()],
-              "gap_abs_difference": gap_abs_difference, "by_mu": by_mu})
+              "by_mu": by_mu})

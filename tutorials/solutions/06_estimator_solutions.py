@@ -1,5 +1,5 @@
 # %% [markdown]
-# # Solutions to Tutorial 4: The a posteriori error estimator of Chapter 4
+# # Solutions to Tutorial 6: The a posteriori error estimator of Chapter 4
 #
 # Each exercise is one section; all run in seconds with `NGDUAL_QUICK=1`.
 
@@ -16,7 +16,7 @@ from ngdual.studies.tutorials import output_dir, quick_mode, save_results
 
 QUICK = quick_mode()
 LEVELS = [1, 2, 3] if QUICK else [1, 2, 3, 4]
-OUT = output_dir("04_estimator_solutions")
+OUT = output_dir("06_estimator_solutions")
 
 # %% [markdown]
 # ## Exercise 1: the patch test
@@ -88,13 +88,13 @@ for level in LEVELS:
 #
 # By Cauchy-Schwarz Σ_T η_T ≤ √N_T (Σ_T η_T²)^{1/2}, with near equality when the
 # indicators are about equal. For the smooth square (u = Curl ψ, ψ = x²(1−x)²y²(1−y)²,
-# clamped, the problem of Tutorial 1) they are, and under uniform refinement the ratio
+# clamped, the problem of Tutorial 2) they are, and under uniform refinement the ratio
 # grows like √N_T, by 2 per level: an effectivity index built on Σ_T η_T doubles per
 # level even though η/e is constant. Theorem 4.8 is a reliability statement; the ℓ² sum
 # (Σ η_T²)^{1/2} is what is comparable with the error. In Example 3.46 a few corner
 # elements carry most of η (σ is singular there, and η itself stops decreasing), so the
 # ratio grows more slowly, far below √N_T: the indicators are not equidistributed, which
-# is what adaptive refinement is for (Tutorial 5).
+# is what adaptive refinement is for (Tutorial 7).
 
 # %%
 P = {"p": "(T**2*(1 - T)**2)", "dp": "(2*T - 6*T**2 + 4*T**3)",
@@ -131,6 +131,6 @@ for level in LEVELS:
           f"{math.sqrt(thesis_row['elements']):6.2f}, eta = {thesis_row['eta']:.1f})")
 
 # %%
-save_results("04_estimator_solutions",
+save_results("06_estimator_solutions",
              {"patch_sigma": sigma_part, "patch_u": u_part, "table_4_2": table_4_2,
               "sum_ratios": ratios})

@@ -1,5 +1,5 @@
 # %% [markdown]
-# # Tutorial 4: The a posteriori error estimator of Chapter 4
+# # Tutorial 6: The a posteriori error estimator of Chapter 4
 #
 # **Problem.** Given a discrete solution (σ_h, ν_h; u_h, η_h, φ_h, λ_t, λ_n) of (3.62),
 # how large is its error, and *where* is it made? Theorem 4.8 bounds the error in
@@ -27,12 +27,17 @@
 # 4. Why ngdual measures the asymmetry as(σ_h) in L² and not in H(div) as printed in
 #    (4.15): for PEERS ‖div as(σ_h)‖ does not tend to zero (cf. Table 4.2).
 #
-# **References.** M. Andres (2011), Chapter 4: eqs. (4.15), (4.31), (4.49)-(4.50),
+# **References.** M. Andres, *Dual-dual formulations for frictional contact problems in
+# mechanics*, PhD thesis, Leibniz Universität Hannover, 2011:
+# Chapter 4: eqs. (4.15), (4.31), (4.49)-(4.50),
 # Theorems 4.2 and 4.8, Table 4.2. C. Carstensen, G. Dolzmann, *A posteriori error
 # estimates for mixed FEM in elasticity*, Numer. Math. 81 (1998). G. N. Gatica, L. F.
 # Gatica, E. P. Stephan, *A dual-mixed finite element method for nonlinear incompressible
 # elasticity with mixed boundary conditions*, CMAME 196 (2007). R. Verfürth, *A posteriori
 # error estimation techniques for finite element methods* (2013).
+
+# %% [markdown]
+# ## Parameters
 
 # %%
 import math
@@ -43,23 +48,25 @@ import ngsolve as ngs
 import numpy as np
 from matplotlib.colors import LogNorm
 
-from ngdual.estimator import OTHER_TERMS, SIGMA_TERMS, TERMS, U_TERMS, estimate
+import ngdual as nd
+from ngdual.estimator import OTHER_TERMS, SIGMA_TERMS, TERMS, U_TERMS
 from ngdual.expr import Expression
-from ngdual.quantities import fields
 from ngdual.rates import observed_rates
-from ngdual.scene import Geometry, Loads, Material, Scene, load_scene, validate
-from ngdual.solvers import solve_scene
-from ngdual.studies.tutorials import draw, output_dir, quick_mode, save_figure, save_results
+from ngdual.scene import Geometry, Loads, Material
+from ngdual.studies.tutorials import (
+    draw,
+    output_dir,
+    plot_geometry,
+    quick_mode,
+    save_figure,
+    save_results,
+)
 
-# %% [markdown]
-# ## Parameters
-
-# %%
 QUICK = quick_mode()
 THESIS_LEVEL = 3 if QUICK else 4              # Example 3.46 for the pictures of every term
 LEVELS = [1, 2, 3] if QUICK else [1, 2, 3, 4, 5]   # uniform levels of the smooth problem
 E, NU, MAXH = 100.0, 0.3, 0.4                 # material and mesh size of the smooth problem
-OUT = output_dir("04_estimator")
+OUT = output_dir("06_estimator")
 print(f"quick mode: {QUICK}; output in {OUT}")
 
 # %% [markdown]
@@ -97,9 +104,13 @@ print("others of (4.50):  ", OTHER_TERMS)
 # of them dominate η; the pictures show where.
 
 # %%
-thesis = load_scene("thesis-3.46-coulomb")
-solution = solve_scene(thesis, THESIS_LEVEL)
-est = estimate(solution)
+thesis = nd.load_scene("thesis-3.46-coulomb")
+save_figure(plot_geometry(thesis, level=THESIS_LEVEL,
+                          title=f"Example 3.46, Coulomb friction: boundary parts, "
+                                f"level {THESIS_LEVEL}"),
+            OUT / "geometry.png")
+solution = nd.solve(thesis, THESIS_LEVEL)
+est = nd.estimate(solution)
 mesh = solution.problem.fes.mesh
 summed = est.summed()
 print(f"level {THESIS_LEVEL}: {mesh.ne} triangles, eta = {est.total:.4e}, "
@@ -168,8 +179,8 @@ draw(eta_gf, mesh, "eta_tot")
 #   conditions change and σ is singular. `asymmetry` is largest in the two lower
 #   corners, where Γ_D meets Γ_C (Table 4.2). There λ_n ∈ C_h̃ must vanish, i.e.
 #   u_n = g = 0.01, while u = 0 on Γ_D: the data jump, σ ~ 1/r is not square
-#   integrable, and these indicators do not decrease under refinement (Exercise 2,
-#   Tutorial 5).
+#   integrable, and these indicators do not decrease under refinement (Exercise 3,
+#   Tutorial 7).
 # * `neumann` and `jump_neumann` live on the elements at Γ_N, largest where the
 #   traction t₀ switches off (x₁ = ±2) and at the ends of Γ_N.
 # * `friction` lives on the elements along Γ_C (A_C = supp 𝓕), where it measures how
@@ -245,7 +256,7 @@ sigma = [[mu * (grad[i][j] + grad[j][i]) + (lam * div_u if i == j else 0) for j 
 div_sigma = [dx(sigma[i][0]) + dy(sigma[i][1]) for i in range(2)]
 rotation = 0.5 * (grad[0][1] - grad[1][0])
 normal = np.array([1.0, 1.0]) / math.sqrt(2)                # outward normal of roof_right
-smooth = Scene(name="pentagon-manufactured",
+smooth = nd.Scene(name="pentagon-manufactured",
                geometry=Geometry(kind="polygon", points=POINTS, labels=SIDES, maxh=MAXH),
                boundary={"dirichlet": ["bottom", "right", "roof_left", "left"],
                          "neumann": ["roof_right"]},
@@ -254,7 +265,7 @@ smooth = Scene(name="pentagon-manufactured",
                            traction=[text(normal[0] * sigma[i][0] + normal[1] * sigma[i][1])
                                      for i in range(2)],
                            displacement=[text(c) for c in u]))
-validate(smooth)
+nd.validate(smooth)
 
 
 def cf(a: np.ndarray) -> ngs.CoefficientFunction:
@@ -269,7 +280,7 @@ EXACT = {"sigma": ngs.CF(tuple(cf(sigma[i][j]) for i in range(2) for j in range(
 def exact_error(solution) -> float:
     """e = (||sigma - sigma_h||^2 + ||div(sigma - sigma_h)||^2 + ||u - u_h||^2
     + ||eta - eta_h||^2)^(1/2), computed exactly (polynomials, order 8)."""
-    f = fields(solution)
+    f = nd.fields(solution)
     m = solution.problem.fes.mesh
     diffs = (EXACT["sigma"] - f.sigma, EXACT["div_sigma"] - f.div_sigma, EXACT["u"] - f.u,
              EXACT["eta"] - f.eta)
@@ -288,8 +299,8 @@ print(f"u_1 = {text(u[0])[:90]}...")
 # %%
 rows = []
 for level in LEVELS:
-    solution_s = solve_scene(smooth, level)
-    l2, hdiv = estimate(solution_s), estimate(solution_s, asymmetry="hdiv")
+    solution_s = nd.solve(smooth, level)
+    l2, hdiv = nd.estimate(solution_s), nd.estimate(solution_s, asymmetry="hdiv")
     rows.append({"level": level, "ndof": int(sum(solution_s.problem.spaces.dofs().values())),
                  "error": exact_error(solution_s), "eta": l2.total, "eta_hdiv": hdiv.total,
                  "terms": {k: math.sqrt(v) for k, v in l2.summed().items()},
@@ -352,7 +363,7 @@ save_figure(fig, OUT / "effectivity.png")
 # first order like every other term. This is `asymmetry="l2"`, the default.
 
 # %%
-mesh1 = solve_scene(smooth, LEVELS[0]).problem.fes.mesh
+mesh1 = nd.solve(smooth, LEVELS[0]).problem.fes.mesh
 body = ngs.CF(tuple(cf(-d) for d in div_sigma))
 quarter_f = 0.25 * math.sqrt(ngs.Integrate(body * body, mesh1, order=8))
 hdiv_ratio = [r["eta_hdiv"] / r["error"] for r in rows]
@@ -379,11 +390,11 @@ results = {
     "smooth": rows, "effectivity": effectivity, "hdiv_effectivity": hdiv_ratio,
     "quarter_f": quarter_f,
 }
-print(f"wrote {save_results('04_estimator', results)}")
+print(f"wrote {save_results('06_estimator', results)}")
 
 # %% [markdown]
 # ## Exercises
-# Solutions: `tutorials/solutions/04_estimator_solutions.py`.
+# Solutions: `tutorials/solutions/06_estimator_solutions.py`.
 #
 # 1. **Patch test.** For an affine displacement u = Gx + c (G not symmetric) PEERS
 #    reproduces σ and η exactly. Build such a scene on the pentagon (u_D = u on Γ_D, the
@@ -395,6 +406,6 @@ print(f"wrote {save_results('04_estimator', results)}")
 # 3. **Sum or square root of the sum of squares?** Theorem 4.8 bounds the error by
 #    Σ_T η_{tot,T} (`Estimate.total_sum`, the η_tot of Table 4.4), not by
 #    (Σ_T η²_{tot,T})^{1/2} (`Estimate.total`). Compute the ratio of the two under uniform
-#    refinement for the smooth clamped square of Tutorial 1 and for Example 3.46 without
+#    refinement for the smooth clamped square of Tutorial 2 and for Example 3.46 without
 #    friction, and compare it with √(number of triangles). What does this mean for an
 #    effectivity index computed with Σ_T η_{tot,T}?

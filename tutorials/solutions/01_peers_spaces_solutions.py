@@ -1,24 +1,24 @@
 # %% [markdown]
-# # Solutions to Tutorial 1: Mixed elasticity with PEERS
+# # Solutions to Tutorial 1: The PEERS spaces, their unknowns and the discrete inf-sup condition
 #
 # Each exercise is one section; all run in seconds with `NGDUAL_QUICK=1`.
 
 # %%
+import matplotlib.pyplot as plt
 import ngsolve as ngs
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+import ngdual as nd
 from ngdual import peers
-from ngdual.expr import Expression
 from ngdual.forms import Spaces, assemble
-from ngdual.mesh import build_mesh, polygon_mesh
-from ngdual.scene import Material, load_scene
-from ngdual.studies.tutorials import output_dir, quick_mode, save_results
+from ngdual.mesh import build_mesh
+from ngdual.studies.tutorials import output_dir, quick_mode, save_figure, save_results
 
 QUICK = quick_mode()
 LEVELS = [1, 2] if QUICK else [1, 2, 3, 4]
-OUT = output_dir("01_peers_mixed_elasticity_solutions")
+OUT = output_dir("01_peers_spaces_solutions")
 
 # %% [markdown]
 # ## Exercise 1: the inf-sup constant in the L² norm
@@ -32,9 +32,9 @@ OUT = output_dir("01_peers_mixed_elasticity_solutions")
 # constants are h-independent, which is what Lemma 3.28 and Theorem 3.34 use.
 
 # %%
-clamped = load_scene("thesis-3.46-frictionless",
-                     ["boundary.dirichlet=['left', 'right', 'bottom', 'top']",
-                      "boundary.neumann=[]", "boundary.contact=[]"])
+clamped = nd.load_scene("thesis-3.46-frictionless",
+                        ["boundary.dirichlet=['left', 'right', 'bottom', 'top']",
+                         "boundary.neumann=[]", "boundary.contact=[]"])
 
 
 def to_scipy(matrix) -> sp.csr_matrix:
@@ -91,63 +91,20 @@ growth = {key: values[-1][1] / values[0][1] for key, values in singular.items()}
 print(f"largest singular value grew by {growth['l2']:.2f} (L2) and {growth['hdiv']:.2f} "
       f"(H(div)) over {len(LEVELS) - 1} halvings of h")
 
-# %% [markdown]
-# ## Exercise 2: P2 on the same meshes
-#
-# We reuse the manufactured divergence-free solution of the tutorial. P2 is much better
-# than P1, but on general triangulations it is still not robust in λ: the error ratio
-# between ν = 0.4999 and ν = 0.3 exceeds one noticeably (locking-free conforming
-# Lagrange elements need degree ≥ 4 with special meshes, Scott-Vogelius).
-
-# %%
-P = {"p": "(T**2*(1 - T)**2)", "dp": "(2*T - 6*T**2 + 4*T**3)",
-     "d2p": "(2 - 12*T + 12*T**2)", "d3p": "(24*T - 12)"}
-
-
-def term(first: str, second: str) -> str:
-    return P[first].replace("T", "x") + "*" + P[second].replace("T", "y")
-
-
-def cf(formula: str):
-    return Expression(formula).coefficient()
-
-
-mu = 1.0
-shear = f"{mu}*({term('p', 'd2p')} - {term('d2p', 'p')})"
-sigma_exact = ngs.CF((cf(f"{2 * mu}*{term('dp', 'dp')}"), cf(shear), cf(shear),
-                      cf(f"-{2 * mu}*{term('dp', 'dp')}")), dims=(2, 2))
-force = ngs.CF((cf(f"-{mu}*({term('d2p', 'dp')} + {term('p', 'd3p')})"),
-                cf(f"{mu}*({term('d3p', 'p')} + {term('dp', 'd2p')})")))
-SIDES = ["bottom", "right", "top", "left"]
-
-
-def primal_stress_error(mesh, nu: float, order: int) -> float:
-    lam, shear_modulus = Material(2 * mu * (1 + nu), nu).lame
-    space = ngs.VectorH1(mesh, order=order, dirichlet="|".join(SIDES))
-    u, v = space.TnT()
-    eps_u, eps_v = ngs.Sym(ngs.Grad(u)), ngs.Sym(ngs.Grad(v))
-    a = ngs.BilinearForm(2 * shear_modulus * ngs.InnerProduct(eps_u, eps_v) * ngs.dx
-                         + lam * ngs.div(u) * ngs.div(v) * ngs.dx).Assemble()
-    rhs = ngs.LinearForm(force * v * ngs.dx(bonus_intorder=4)).Assemble()
-    uh = ngs.GridFunction(space)
-    uh.vec.data = a.mat.Inverse(space.FreeDofs(), inverse="umfpack") * rhs.vec
-    sigma_h = 2 * shear_modulus * ngs.Sym(ngs.Grad(uh)) + lam * ngs.div(uh) * ngs.Id(2)
-    error = sigma_h - sigma_exact
-    return float(np.sqrt(ngs.Integrate(ngs.InnerProduct(error, error), mesh, order=10)
-                         / ngs.Integrate(ngs.InnerProduct(sigma_exact, sigma_exact), mesh,
-                                         order=10)))
-
-
-mesh = polygon_mesh([[0, 0], [1, 0], [1, 1], [0, 1]], SIDES, maxh=0.25, level=LEVELS[-1])
-ratios = {}
-for order in (1, 2):
-    errors = [primal_stress_error(mesh, nu, order) for nu in (0.3, 0.4999)]
-    ratios[f"P{order}"] = errors[1] / errors[0]
-    print(f"P{order}: stress error {errors[0]:.3e} (nu = 0.3), {errors[1]:.3e} (nu = 0.4999), "
-          f"ratio {ratios[f'P{order}']:.2f}")
+fig, ax = plt.subplots(figsize=(6.5, 4.5))
+hs = [np.sqrt(2.0) * 2.0 ** (1 - level) for level in LEVELS]
+for key, marker, name in (("hdiv", "o", "H(div)"), ("l2", "s", "L²")):
+    ax.loglog(hs, [v[0] for v in singular[key]], marker + "-", label=f"smallest, {name}")
+    ax.loglog(hs, [v[1] for v in singular[key]], marker + "--", label=f"largest, {name}")
+ax.set_xlabel("mesh size h")
+ax.set_ylabel("singular value of B")
+ax.set_title("Extreme singular values of b + s in two norms on X_h")
+ax.grid(True, which="both", alpha=0.3)
+ax.legend(fontsize=8)
+save_figure(fig, OUT / "singular_values.png")
 
 # %% [markdown]
-# ## Exercise 3: counting with Euler's formula
+# ## Exercise 2: counting with Euler's formula
 #
 # Level k of Example 3.46 has n = 2^(k−1), an 8n × 2n grid of squares, so
 # V = (8n + 1)(2n + 1), T = 2 · 16n² and, by Euler, E = V + T − 1. Hence
@@ -167,13 +124,12 @@ def formula(level: int) -> tuple[int, int, int]:
 
 
 assert all(formula(k) == TABLE_3_1[k] for k in TABLE_3_1)
-thesis = load_scene("thesis-3.46-frictionless")
+thesis = nd.load_scene("thesis-3.46-frictionless")
 for level in LEVELS:
     dofs = Spaces.build(thesis, build_mesh(thesis.geometry, level)).dofs()
     assert (dofs["X"], dofs["M"], dofs["S"]) == formula(level)
 print("Euler's formula reproduces all eight rows of Table 3.1")
 
 # %%
-save_results("01_peers_mixed_elasticity_solutions",
-             {"singular_values": singular, "growth_of_largest": growth,
-              "primal_ratios": ratios})
+save_results("01_peers_spaces_solutions",
+             {"singular_values": singular, "growth_of_largest": growth})

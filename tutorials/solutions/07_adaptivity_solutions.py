@@ -1,5 +1,5 @@
 # %% [markdown]
-# # Solutions to Tutorial 5: Adaptive refinement
+# # Solutions to Tutorial 7: Adaptive refinement
 #
 # Each exercise is one section; all run in seconds with `NGDUAL_QUICK=1`.
 
@@ -26,7 +26,7 @@ THETAS = [0.2, 0.5, 0.8]
 THESIS_STEPS = 3 if QUICK else 5            # Exercise 2
 CORNER_STEPS = 4 if QUICK else 9            # Exercise 3
 UNIFORM_LEVELS = [1, 2, 3] if QUICK else [1, 2, 3, 4]
-OUT = output_dir("05_adaptivity_solutions")
+OUT = output_dir("07_adaptivity_solutions")
 
 
 def adapt_until(scene, marking, theta, max_dofs, level=1, indicator="eta", error=None,
@@ -143,5 +143,5 @@ for gap in ("0.01", "0"):
     print(f"         Dörfler: eta {np.round(etas, 1)}, rate {row['dorfler_rate']:.2f}")
 
 # %%
-save_results("05_adaptivity_solutions",
+save_results("07_adaptivity_solutions",
              {"dorfler": dorfler, "by_indicator": by_indicator, "corners": corners})

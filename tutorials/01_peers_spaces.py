@@ -1,0 +1,228 @@
+# %% [markdown]
+# # Tutorial 1: The PEERS spaces, their unknowns and the discrete inf-sup condition
+#
+# **Problem.** Plane-strain linear elasticity on a polygon Ω, written for the *stress*
+# σ as the primary unknown (thesis Ch. 3.1, Hellinger-Reissner form with weakly imposed
+# symmetry): find σ, the displacement u and the rotation η = ½(∂₂u₁ − ∂₁u₂) with
+#
+#     ã(σ, τ) + b(u, τ) + s(η, τ) = ⟨u_D, τn⟩   for all τ   (C⁻¹σ = ε(u), tested)
+#     b(v, σ)                     = −f(v)      for all v   (div σ = −f)
+#     s(ξ, σ)                     = 0          for all ξ   (σ is symmetric)
+#
+# with ã(σ, τ) = ∫ C⁻¹σ : τ, b(v, τ) = ∫ v · div τ and s(ξ, τ) = ∫ ξ (τ₁₂ − τ₂₁)
+# (eqs. (3.12), (3.24), (3.32); the first three rows of (3.62)). The domain is the
+# block [−4,4]×[−1,1] of Example 3.46; for the inf-sup computation it is clamped
+# (u_D = 0) on all four sides, so that no boundary multipliers enter.
+#
+# **Discretisation.** The PEERS triple of Arnold, Brezzi and Douglas, eq. (3.61):
+# X_h = RT₀² ⊕ Curl(cubic bubbles)² for the two rows of σ, M_h = P₀² for u and
+# S_h = continuous P₁ for η, on the structured triangulations of Table 3.1.
+#
+# **What you will learn.**
+# 1. How many unknowns each PEERS space has, and why (Table 3.1).
+# 2. What the discrete inf-sup condition (Lemma 3.28) says, and how to *compute* the
+#    inf-sup constant β_h on small meshes as a generalised eigenvalue problem.
+# 3. Why the Curl bubbles are needed: without them β_h = 0.
+#
+# Tutorial 2 takes the same spaces to the incompressible limit ν → ½ (locking).
+#
+# **References.** M. Andres, *Dual-dual formulations for frictional contact problems in
+# mechanics*, PhD thesis, Leibniz Universität Hannover, 2011: Sections 3.1-3.2,
+# eq. (3.61), Lemma 3.28, Table 3.1. D. N. Arnold, F. Brezzi, J. Douglas Jr., *PEERS:
+# a new mixed finite element for plane elasticity*, Japan J. Appl. Math. 1 (1984).
+# D. Boffi, F. Brezzi, M. Fortin, *Mixed finite element methods and applications*,
+# Springer 2013, Chapter 3 (inf-sup constants as eigenvalues).
+#
+# Run as a script (`python tutorials/01_peers_spaces.py`) or as a notebook
+# (`ngdual tutorials --notebooks DIR`). `NGDUAL_QUICK=1` selects coarse settings.
+
+# %% [markdown]
+# ## Parameters
+# Quick mode (`NGDUAL_QUICK=1`) keeps every computation to a few seconds. This
+# tutorial looks *inside* the discretisation (spaces, matrices), so besides the public
+# API (`import ngdual as nd`) it imports the modules that build them.
+
+# %%
+import matplotlib.pyplot as plt
+import ngsolve as ngs
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+import ngdual as nd
+from ngdual import peers
+from ngdual.forms import assemble
+from ngdual.mesh import build_mesh
+from ngdual.studies.tutorials import (
+    output_dir,
+    plot_geometry,
+    quick_mode,
+    save_figure,
+    save_results,
+)
+
+QUICK = quick_mode()
+DOF_LEVELS = [1, 2, 3] if QUICK else [1, 2, 3, 4, 5]     # Table 3.1 rows to reproduce
+INF_SUP_LEVELS = [1, 2] if QUICK else [1, 2, 3, 4]       # meshes for the eigenvalue problem
+OUT = output_dir("01_peers_spaces")
+print(f"quick mode: {QUICK}; figures and results.json go to {OUT}")
+
+# %% [markdown]
+# ## The domain and the mesh
+#
+# Example 3.46: clamped ends Γ_D, a loaded top Γ_N and a contact part Γ_C at the bottom
+# (used from Tutorial 3 on). Level 1 is the coarsest mesh of Table 3.1; every level
+# halves h.
+
+# %%
+thesis = nd.load_scene("thesis-3.46-frictionless")
+save_figure(plot_geometry(thesis, level=1,
+                          title="Example 3.46, level 1: boundary parts and mesh"),
+            OUT / "geometry.png")
+
+# %% [markdown]
+# ## 1. The PEERS spaces and their degrees of freedom
+#
+# On a triangulation with V vertices, E edges and T triangles:
+#
+# * RT₀ has one dof per edge (the normal flux), and each row of σ adds one Curl
+#   bubble per triangle, so dim X_h = 2(E + T);
+# * dim M_h = 2T (a constant vector per triangle) and dim S_h = V.
+#
+# The structured mesh of Example 3.46 (`thesis_mesh`) reproduces Table 3.1 of the thesis:
+# 180, 64, 27 on level 1, and each uniform refinement multiplies T by four.
+
+# %%
+dof_rows = []
+for level in DOF_LEVELS:
+    mesh = build_mesh(thesis.geometry, level)
+    spaces = peers.peers_spaces(mesh)
+    X = sum(spaces[name].ndof for name in peers.STRESS)
+    M = spaces["u1"].ndof + spaces["u2"].ndof
+    S = spaces["eta"].ndof
+    assert (X, M, S) == (2 * (mesh.nedge + mesh.ne), 2 * mesh.ne, mesh.nv)
+    dof_rows.append({"level": level, "X": X, "M": M, "S": S})
+    print(f"level {level}:  dim X_h = {X:7d}   dim M_h = {M:7d}   dim S_h = {S:6d}")
+
+# %% [markdown]
+# ## 2. The discrete inf-sup condition
+#
+# Lemma 3.28 (from Arnold-Brezzi-Douglas, Lemma 4.4) states that there is β > 0,
+# independent of h, with
+#
+#     sup_{τ ∈ X_h} [b(v, τ) + s(ξ, τ)] / ‖τ‖_X  ≥  β ‖(v, ξ)‖_{L²}   for all (v, ξ) ∈ M_h × S_h,
+#
+# where ‖τ‖_X² = ‖τ‖² + ‖div τ‖² is the H(div) norm. With the Gram matrices X (of the
+# H(div) inner product on X_h) and Y (of L² on M_h × S_h) and the matrix B of b + s,
+# the supremum is attained at τ = X⁻¹By, so the best constant is
+#
+#     β_h² = min_y (yᵀ Bᵀ X⁻¹ B y) / (yᵀ Y y),
+#
+# the smallest eigenvalue of the pencil (BᵀX⁻¹B, Y): β_h is the smallest singular value
+# of B in these norms. If β_h stays away from zero under refinement the triple is stable.
+#
+# We take Example 3.46 with Dirichlet conditions on all four sides (no boundary
+# multipliers) and read B off the assembled system: its block K[σ, (u, η)] is exactly
+# b + s. We find the smallest eigenvalues by shift-invert Lanczos (`eigsh`), solving
+# with the saddle-point matrix [[X, B], [Bᵀ, σ₀Y]] so that X⁻¹ never becomes dense.
+
+# %%
+clamped = nd.load_scene("thesis-3.46-frictionless",
+                        ["boundary.dirichlet=['left', 'right', 'bottom', 'top']",
+                         "boundary.neumann=[]", "boundary.contact=[]"])
+save_figure(plot_geometry(clamped, level=1, title="Example 3.46 clamped on all sides"),
+            OUT / "geometry_clamped.png")
+
+
+def to_scipy(matrix) -> sp.csr_matrix:
+    """An assembled NGSolve matrix as a SciPy CSR matrix."""
+    rows, cols, vals = matrix.COO()
+    return sp.csr_matrix((np.asarray(vals), (np.asarray(rows), np.asarray(cols))),
+                         shape=(matrix.height, matrix.width))
+
+
+def gram_matrix(problem) -> sp.csr_matrix:
+    """Block-diagonal Gram matrix: H(div) on the stress rows, L² on u and η."""
+    trial = dict(zip(problem.names, problem.fes.TrialFunction()))
+    test = dict(zip(problem.names, problem.fes.TestFunction()))
+
+    def parts(f):
+        return (peers.stress(f["r1"], f["r2"], f["b1"], f["b2"]),
+                peers.stress_divergence(f["r1"], f["r2"]), ngs.CF((f["u1"], f["u2"])), f["eta"])
+
+    sigma, div_sigma, u, eta = parts(trial)
+    tau, div_tau, v, xi = parts(test)
+    form = ngs.BilinearForm(problem.fes)
+    form += (ngs.InnerProduct(sigma, tau) + div_sigma * div_tau + u * v + eta * xi) * ngs.dx
+    form.Assemble()
+    return to_scipy(form.mat)
+
+
+def smallest_singular_values(X, B, Y, k=3, shift=-1e-6) -> np.ndarray:
+    """The k smallest singular values of B from X-norm to Y-norm (sqrt of eigenvalues)."""
+    n, m = B.shape
+    saddle = spla.splu(sp.bmat([[X, B], [B.T, shift * Y]], format="csc"))
+    x_lu = spla.splu(X.tocsc())
+    schur = spla.LinearOperator((m, m), matvec=lambda y: B.T @ x_lu.solve(B @ y))
+    # (BᵀX⁻¹B − shift·Y)⁻¹ r is the second block of the saddle-point solution with rhs (0, −r)
+    inverse = spla.LinearOperator((m, m),
+                                  matvec=lambda r: saddle.solve(np.r_[np.zeros(n), -r])[n:])
+    values = spla.eigsh(schur, k=k, M=Y, sigma=shift, OPinv=inverse,
+                        return_eigenvectors=False)
+    return np.sqrt(np.maximum(np.sort(values), 0.0))
+
+
+inf_sup_rows = []
+for level in INF_SUP_LEVELS:
+    problem = assemble(clamped, build_mesh(clamped.geometry, level))
+    G = gram_matrix(problem)
+    stress, rt0, mult = problem.sigma, problem.index("r1", "r2"), problem.mult
+    Y = G[mult][:, mult]
+    peers_beta = smallest_singular_values(G[stress][:, stress], problem.block(stress, mult), Y)
+    bare_beta = smallest_singular_values(G[rt0][:, rt0], problem.block(rt0, mult), Y)
+    h = np.sqrt(2.0) * 2.0 ** (1 - level)
+    inf_sup_rows.append({"level": level, "h": h, "peers": peers_beta.tolist(),
+                         "rt0_only": bare_beta.tolist()})
+    print(f"level {level}  h = {h:.4f}   PEERS: beta_h = {peers_beta[0]:.4f}   "
+          f"RT0 without bubbles: three smallest = {np.array2string(bare_beta, precision=2)}")
+
+# %% [markdown]
+# PEERS keeps β_h ≈ 0.39 on every level: the discrete inf-sup condition holds with a
+# constant independent of h. Without the Curl bubbles two singular values are zero
+# (spurious (u, η) modes that no stress can "see") and the next one decays like h.
+# The bubbles are divergence free, so they do not change b(·,·); they enrich the
+# antisymmetric part of τ that s(ξ, τ) tests, which is exactly what the rotation needs.
+
+# %%
+fig, ax = plt.subplots(figsize=(6, 4))
+hs = [row["h"] for row in inf_sup_rows]
+ax.loglog(hs, [row["peers"][0] for row in inf_sup_rows], "o-", label="PEERS: RT₀ + Curl bubbles")
+ax.loglog(hs, [row["rt0_only"][2] for row in inf_sup_rows], "s--",
+          label="RT₀ alone: 3rd smallest (two are 0)")
+ax.set_xlabel("mesh size h")
+ax.set_ylabel(r"smallest singular value $\beta_h$")
+ax.set_title("Discrete inf-sup constant (Lemma 3.28)")
+ax.grid(True, which="both", alpha=0.3)
+ax.legend()
+save_figure(fig, OUT / "inf_sup.png")
+
+# %% [markdown]
+# Why the bubbles are divergence free: a bubble b_T vanishes on ∂T, so Curl b_T has zero
+# normal flux through every edge and div Curl b_T = 0. They leave b(·,·) alone and only
+# enrich the antisymmetric part of τ, which s(ξ, τ) tests.
+
+# %%
+results = {"quick": QUICK, "dofs": dof_rows, "inf_sup": inf_sup_rows}
+print(f"wrote {save_results('01_peers_spaces', results)}")
+
+# %% [markdown]
+# ## Exercises
+# Solutions: `tutorials/solutions/01_peers_spaces_solutions.py`.
+#
+# 1. **The norm matters.** Recompute the smallest *and* the largest singular value of B
+#    with the L² norm instead of the H(div) norm on X_h (drop ‖div τ‖² from the Gram
+#    matrix). Which of the two depends on h? Why do Lemma 3.28 and the error analysis
+#    work in ‖·‖_X?
+# 2. **Counting.** Use Euler's formula V − E + T = 1 to write dim X_h, dim M_h and
+#    dim S_h of Table 3.1 as functions of the level k of Example 3.46, and check them
+#    against `ngdual dofs thesis-3.46-frictionless --levels 1 2 3 4 5 6 7 8`.

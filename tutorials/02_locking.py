@@ -1,0 +1,266 @@
+# %% [markdown]
+# # Tutorial 2: Locking-free PEERS as ν → ½
+#
+# **Problem.** Plane-strain elasticity on the unit square, clamped (u = 0) on the whole
+# boundary, with a body force f manufactured from the divergence-free displacement
+# u = Curl ψ, ψ = x²(1 − x)² y²(1 − y)². Since div u = 0, σ = 2μ ε(u) and f = −μ Δu do
+# not depend on the Lamé constant λ: the *same* exact solution for every Poisson ratio ν
+# when μ is fixed. As ν → ½, λ/μ = 2ν/(1 − 2ν) → ∞ (nearly incompressible material).
+#
+# **Discretisation.** PEERS (3.61) for (σ, u, η), the subject of Tutorial 1, against the
+# standard primal method with continuous piecewise linear displacements (P1), on the
+# same netgen meshes of the square.
+#
+# **What you will learn.**
+# 1. What *locking* is: the P1 errors grow with λ/μ on a fixed mesh; the PEERS errors
+#    do not move (the constants of Theorem 3.35 do not depend on λ).
+# 2. How to see it: the P1 stress is polluted by a spurious pressure λ div u_h.
+# 3. PEERS converges at first order for every ν; P1 at ν ≈ ½ is far from its
+#    asymptotic regime on practical meshes.
+#
+# **References.** M. Andres, *Dual-dual formulations for frictional contact problems in
+# mechanics*, PhD thesis, Leibniz Universität Hannover, 2011: Sections 3.1-3.2, eq.
+# (3.61), Theorem 3.35. D. N. Arnold, F. Brezzi, J. Douglas Jr., *PEERS: a new mixed
+# finite element for plane elasticity*, Japan J. Appl. Math. 1 (1984). I. Babuška,
+# M. Suri, *Locking effects in the finite element approximation of elasticity
+# problems*, Numer. Math. 62 (1992).
+
+# %% [markdown]
+# ## Parameters
+
+# %%
+import matplotlib.pyplot as plt
+import ngsolve as ngs
+import numpy as np
+
+import ngdual as nd
+from ngdual.expr import Expression
+from ngdual.scene import Geometry, Loads, Material
+from ngdual.studies.tutorials import (
+    draw,
+    output_dir,
+    plot_geometry,
+    plot_von_mises,
+    quick_mode,
+    save_figure,
+    save_results,
+)
+
+QUICK = quick_mode()
+LOCKING_LEVELS = [1, 2] if QUICK else [1, 2, 3, 4]       # refinements of the square mesh
+NUS = [0.3, 0.45, 0.49, 0.499, 0.4999]                   # Poisson ratios of the sweep
+SHEAR_MODULUS = 1.0                                      # μ is kept fixed while ν -> 1/2
+MAXH = 0.25                                              # netgen mesh size of level 1
+OUT = output_dir("02_locking")
+print(f"quick mode: {QUICK}; figures and results.json go to {OUT}")
+
+# %% [markdown]
+# ## 1. The manufactured solution
+#
+# On the unit square with u = 0 on the whole boundary we manufacture a divergence-free
+# displacement u = Curl ψ = (∂₂ψ, −∂₁ψ), ψ = p(x) p(y), p(t) = t²(1 − t)².
+# Since div u = 0, σ = 2μ ε(u) and f = −div σ = −μ Δu do not depend on λ: the same
+# exact solution for every ν when μ is fixed. A robust method must give the same
+# errors for ν = 0.3 and ν = 0.4999 (λ/μ ≈ 5000).
+#
+# The primal competitor is the standard P1 method: find u_h ∈ VectorH1(order=1) with
+# ∫ 2μ ε(u_h) : ε(v) + λ div u_h div v = ∫ f · v. As λ → ∞ the term λ div u_h div v
+# forces div u_h ≈ 0, which continuous P1 fields can barely satisfy: the method *locks*.
+#
+# The formulas below are scene expressions in x and y (see `ngdual.expr`).
+
+# %%
+P = {"p": "(T**2*(1 - T)**2)", "dp": "(2*T - 6*T**2 + 4*T**3)",
+     "d2p": "(2 - 12*T + 12*T**2)", "d3p": "(24*T - 12)"}
+
+
+def term(first: str, second: str) -> str:
+    """The product first(x) * second(y) of derivatives of p."""
+    return P[first].replace("T", "x") + "*" + P[second].replace("T", "y")
+
+
+mu = SHEAR_MODULUS
+EXACT_U = [term("p", "dp"), f"-{term('dp', 'p')}"]
+shear = f"{mu}*({term('p', 'd2p')} - {term('d2p', 'p')})"
+EXACT_SIGMA = [[f"{2 * mu}*{term('dp', 'dp')}", shear], [shear, f"-{2 * mu}*{term('dp', 'dp')}"]]
+BODY_FORCE = [f"-{mu}*({term('d2p', 'dp')} + {term('p', 'd3p')})",
+              f"{mu}*({term('d3p', 'p')} + {term('dp', 'd2p')})"]
+SIDES = ["bottom", "right", "top", "left"]
+
+
+def cf(formula: str) -> ngs.CoefficientFunction:
+    return Expression(formula).coefficient()
+
+
+u_exact = ngs.CF(tuple(cf(c) for c in EXACT_U))
+sigma_exact = ngs.CF(tuple(cf(c) for row in EXACT_SIGMA for c in row), dims=(2, 2))
+
+
+def square_scene(nu: float) -> nd.Scene:
+    """The unit square, clamped everywhere, with E chosen so that μ stays fixed."""
+    scene = nd.Scene(name=f"square-nu{nu}",
+                     geometry=Geometry(kind="polygon", points=[[0, 0], [1, 0], [1, 1], [0, 1]],
+                                       labels=SIDES, maxh=MAXH),
+                     boundary={"dirichlet": SIDES},
+                     material=Material(E=2 * mu * (1 + nu), nu=nu),
+                     loads=Loads(body_force=BODY_FORCE))
+    nd.validate(scene)
+    return scene
+
+
+save_figure(plot_geometry(square_scene(NUS[0]), level=LOCKING_LEVELS[-1],
+                          title=f"Unit square, clamped, level {LOCKING_LEVELS[-1]}"),
+            OUT / "geometry.png")
+
+
+def relative_l2(error, exact, mesh) -> float:
+    def norm(c):
+        return np.sqrt(ngs.Integrate(ngs.InnerProduct(c, c), mesh, order=10))
+    return float(norm(error) / norm(exact))
+
+
+def solve_p1(mesh, material: Material):
+    """Primal P1 displacement method; returns (u_h, σ_h = C ε(u_h))."""
+    lam, shear_modulus = material.lame
+    space = ngs.VectorH1(mesh, order=1, dirichlet="|".join(SIDES))
+    u, v = space.TnT()
+    a = ngs.BilinearForm(2 * shear_modulus * ngs.InnerProduct(ngs.Sym(ngs.Grad(u)),
+                                                              ngs.Sym(ngs.Grad(v))) * ngs.dx
+                         + lam * ngs.div(u) * ngs.div(v) * ngs.dx).Assemble()
+    force = ngs.CF(tuple(cf(c) for c in BODY_FORCE))
+    rhs = ngs.LinearForm(force * v * ngs.dx(bonus_intorder=4)).Assemble()
+    uh = ngs.GridFunction(space)
+    uh.vec.data = a.mat.Inverse(space.FreeDofs(), inverse="umfpack") * rhs.vec
+    return uh, 2 * shear_modulus * ngs.Sym(ngs.Grad(uh)) + lam * ngs.div(uh) * ngs.Id(2)
+
+
+def errors(nu: float, level: int) -> dict:
+    """Relative L² errors of u and σ for PEERS and P1 on the same mesh."""
+    scene = square_scene(nu)
+    solution = nd.solve(scene, level)
+    mesh = solution.problem.fes.mesh
+    f = nd.fields(solution)
+    uh, sigma_h = solve_p1(mesh, scene.material)
+    return {"nu": nu, "level": level, "triangles": mesh.ne,
+            "peers_u": relative_l2(f.u - u_exact, u_exact, mesh),
+            "peers_sigma": relative_l2(f.sigma - sigma_exact, sigma_exact, mesh),
+            "p1_u": relative_l2(uh - u_exact, u_exact, mesh),
+            "p1_sigma": relative_l2(sigma_h - sigma_exact, sigma_exact, mesh)}
+
+
+# %% [markdown]
+# ## 2. The sweep ν → ½ on a fixed mesh
+
+# %%
+print(f"{'nu':>7} {'PEERS u':>9} {'PEERS σ':>9} {'P1 u':>9} {'P1 σ':>9}   "
+      f"(relative L² errors, level {LOCKING_LEVELS[-1]})")
+sweep = [errors(nu, LOCKING_LEVELS[-1]) for nu in NUS]
+for row in sweep:
+    print(f"{row['nu']:7.4f} {row['peers_u']:9.3e} {row['peers_sigma']:9.3e} "
+          f"{row['p1_u']:9.3e} {row['p1_sigma']:9.3e}")
+
+# %% [markdown]
+# PEERS errors do not move as ν → ½; the P1 errors grow with λ/μ. The ratio of the
+# errors at ν = 0.4999 and ν = 0.3 condenses this into one number per method:
+
+# %%
+first, last = sweep[0], sweep[-1]
+ratios = {key: last[key] / first[key] for key in ("peers_u", "peers_sigma", "p1_u", "p1_sigma")}
+for key, value in ratios.items():
+    print(f"error(nu = {last['nu']}) / error(nu = {first['nu']}) for {key:11s}: {value:8.2f}")
+
+fig, ax = plt.subplots(figsize=(6, 4))
+lam_over_mu = [Material(2 * mu * (1 + nu), nu).lame[0] / mu for nu in NUS]
+for key, style, label in (("peers_sigma", "o-", "PEERS σ"), ("peers_u", "o--", "PEERS u"),
+                          ("p1_sigma", "s-", "P1 σ"), ("p1_u", "s--", "P1 u")):
+    ax.loglog(lam_over_mu, [row[key] for row in sweep], style, label=label)
+ax.set_xlabel(r"$\lambda/\mu$")
+ax.set_ylabel("relative $L^2$ error")
+ax.set_title(f"Locking on the unit square, level {LOCKING_LEVELS[-1]}")
+ax.grid(True, which="both", alpha=0.3)
+ax.legend()
+save_figure(fig, OUT / "locking.png")
+
+# %% [markdown]
+# ## 3. Under refinement
+#
+# Refining the mesh: PEERS converges at first order (Theorem 3.35) for both ν; P1 at
+# ν = 0.4999 is far from its asymptotic regime on these meshes.
+
+# %%
+convergence = [errors(nu, level) for nu in (NUS[0], NUS[-1]) for level in LOCKING_LEVELS]
+print(f"{'nu':>7} {'level':>5} {'triangles':>9} {'PEERS σ':>9} {'P1 σ':>9}")
+for row in convergence:
+    print(f"{row['nu']:7.4f} {row['level']:5d} {row['triangles']:9d} "
+          f"{row['peers_sigma']:9.3e} {row['p1_sigma']:9.3e}")
+
+# %% [markdown]
+# ## 4. What locking looks like
+#
+# The von Mises stress at ν = 0.4999 on the finest mesh, exact, PEERS and P1, on one
+# colour scale (the exact maximum). PEERS reproduces the picture. P1 is *locked*: the
+# constraint div u_h ≈ 0 leaves almost no admissible P1 fields (Exercise 2), so u_h is
+# far too small, and so is the deviatoric stress that von Mises measures.
+
+# %%
+nu_max, level_max = NUS[-1], LOCKING_LEVELS[-1]
+incompressible = nd.solve(square_scene(nu_max), level_max)
+mesh = incompressible.problem.fes.mesh
+p1_u, p1_sigma = solve_p1(mesh, square_scene(nu_max).material)
+peers_sigma = nd.fields(incompressible).sigma
+top = float(np.max(nd.post.element_values(mesh, nd.post.von_mises(sigma_exact, nu_max))[2]))
+for name, field in (("exact", sigma_exact), ("PEERS", peers_sigma), ("P1", p1_sigma)):
+    save_figure(plot_von_mises(mesh, field, nu_max, f"{name}: von Mises stress, ν = {nu_max}, "
+                               f"level {level_max}", vmax=top),
+                OUT / f"von_mises_{name.lower()}.png")
+
+# %% [markdown]
+# Where the large P1 stress *error* of Section 2 sits: in the mean stress
+# p = (σ₁₁ + σ₂₂)/2, which is zero for the exact solution (σ₂₂ = −σ₁₁). For P1 it is
+# (μ + λ) div u_h: a tiny divergence times λ = 5000 μ, oscillating from triangle to
+# triangle. For PEERS p_h is as small as its discretisation error.
+
+# %%
+mean_stress = {}
+points, triangles, _ = nd.post.element_values(mesh, ngs.CF(0))
+for name, field in (("PEERS", peers_sigma), ("P1", p1_sigma)):
+    mean_stress[name] = nd.post.element_values(mesh, 0.5 * (field[0, 0] + field[1, 1]))[2]
+scale = float(np.max(np.abs(mean_stress["P1"])))
+fig, axes = plt.subplots(1, 2, figsize=(11, 4.8))
+for ax, (name, values) in zip(axes, mean_stress.items()):
+    art = ax.tripcolor(points[:, 0], points[:, 1], triangles, facecolors=values,
+                       cmap="RdBu_r", vmin=-scale, vmax=scale, edgecolors="none")
+    ax.set_aspect("equal")
+    ax.set_xlabel("$x_1$")
+    ax.set_ylabel("$x_2$")
+    ax.set_title(f"{name}: max |p_h| = {np.max(np.abs(values)):.2g}")
+fig.colorbar(art, ax=axes, label="mean stress $p_h = (\\sigma_{11} + \\sigma_{22})/2$ "
+             "(exact: 0)")
+fig.suptitle(f"Mean stress at ν = {nu_max}, level {level_max}, one colour scale")
+save_figure(fig, OUT / "mean_stress.png")
+mean_stress_max = {name: float(np.max(np.abs(v))) for name, v in mean_stress.items()}
+
+# %% [markdown]
+# In a notebook, NGSolve's webgui shows the PEERS stress interactively as well; as a
+# script this cell draws nothing.
+
+# %%
+draw(nd.post.von_mises(peers_sigma, nu_max), mesh, "von_mises")
+
+# %%
+results = {"quick": QUICK, "locking_sweep": sweep, "convergence": convergence, "ratios": ratios,
+           "mean_stress_max": mean_stress_max}
+print(f"wrote {save_results('02_locking', results)}")
+
+# %% [markdown]
+# ## Exercises
+# Solutions: `tutorials/solutions/02_locking_solutions.py`.
+#
+# 1. **Higher order does not cure locking by itself.** Replace the P1 method by P2
+#    (`VectorH1(order=2)`). Compute the error ratio between ν = 0.4999 and ν = 0.3 for
+#    the stress. Is P2 locking-free on these meshes?
+# 2. **Counting divergence-free fields.** As λ → ∞ the P1 solution is driven into the
+#    subspace {v_h ∈ P1, v_h = 0 on ∂Ω, div v_h = 0 on every triangle}. Assemble the
+#    matrix that maps the 2V_int nodal values to the T elementwise divergences and
+#    compute the dimension of its kernel on the meshes of this tutorial. Compare with
+#    the count 2V_int − T. What does the answer say about the P1 solution at ν → ½?

@@ -1,0 +1,216 @@
+# %% [markdown]
+# # Tutorial 5: Why ĥ = 2h̃: the inf-sup condition of the friction multiplier
+#
+# **Problem.** Example 3.46 with Coulomb friction and *no* initial gap, g ≡ 0: the whole
+# of Γ_C touches the foundation, so the friction zone A_C = supp 𝓕 reaches the ends of
+# Γ_C. Is the friction multiplier ν of (3.62) (Tutorial 4) then still determined by the
+# discrete problem?
+#
+# **Discretisation.** PEERS for (σ, u, η), P1 multipliers λ_t, λ_n on the mesh h̃ = 2h of
+# Γ_C (vanishing at the ends of Γ_C), and ν piecewise constant on a mesh ĥ of Γ_C; ĥ = h̃
+# or ĥ = 2h̃ (`contact.hhat_factor` 1 or 2). ν enters only through
+# q(κ, μ) = ∫_{Γ_C} 𝓕 κ μ ds, i.e. through the matrix Q_𝓕 of (3.95).
+#
+# **What you will learn.**
+# 1. A counting argument: with ĥ = h̃ there is one ν more than there are hats to test
+#    it, so Q_𝓕ᵀ has a kernel, the checkerboard ν = (+1, −1, +1, …).
+# 2. How to compute the discrete inf-sup constant of q (3.72) as a smallest singular
+#    value, and that it is bounded below for ĥ = 2h̃ (Lemma 3.29), or for ĥ = h̃ when 𝓕
+#    vanishes near the ends of Γ_C (assumption (3.73), Lemma 3.31).
+# 3. What the solver sees: without the inf-sup condition the nested Uzawa algorithm
+#    needs many more steps or stalls, and its error message names the remedy.
+#
+# **References.** M. Andres, *Dual-dual formulations for frictional contact problems in
+# mechanics*, PhD thesis, Leibniz Universität Hannover, 2011: Sections 3.2.2 and 3.3.3:
+# eqs. (3.72)-(3.74), (3.95), Lemmas 3.29 and 3.31, Remark 3.30, Algorithm 3.41, Example 3.46, Figs.
+# 3.24-3.28. F. Brezzi, M. Fortin, *Mixed and hybrid finite element methods*, Springer
+# 1991, Chapter II (discrete inf-sup conditions).
+
+# %% [markdown]
+# ## Parameters
+
+# %%
+import matplotlib.pyplot as plt
+import numpy as np
+
+import ngdual as nd
+from ngdual.forms import assemble
+from ngdual.friction import build_friction_forms
+from ngdual.mesh import build_mesh
+from ngdual.solvers.nested import nested_uzawa
+from ngdual.solvers.projections import metric_matrix
+from ngdual.solvers.result import ConvergenceError
+from ngdual.solvers.settings import NestedUzawaSettings
+from ngdual.studies.tutorials import (
+    output_dir,
+    plot_geometry,
+    quick_mode,
+    save_figure,
+    save_results,
+)
+
+QUICK = quick_mode()
+GAP0_LEVELS = [1, 2, 3] if QUICK else [1, 2, 3, 4]  # levels of the g = 0 study
+OUT = output_dir("05_friction_inf_sup")
+print(f"quick mode: {QUICK}; levels {GAP0_LEVELS}; output in {OUT}")
+
+# %% [markdown]
+# ## The scene
+#
+# The g = 0 variant of Example 3.46 with Coulomb friction: Γ_D the clamped ends, Γ_N the
+# loaded top, Γ_C the bottom, now in contact along its whole length.
+
+# %%
+gap0 = {factor: nd.load_scene("thesis-3.46-coulomb-gap0", [f"contact.hhat_factor={factor}"])
+        for factor in (1, 2)}
+save_figure(plot_geometry(gap0[2], level=GAP0_LEVELS[0],
+                          title=f"Example 3.46, g = 0: boundary parts and mesh, "
+                                f"level {GAP0_LEVELS[0]}"),
+            OUT / "geometry.png")
+
+# %% [markdown]
+# ## 1. Counting: why ĥ = 2h̃
+#
+# With g = 0 the whole of Γ_C touches, A_C = Γ_C, and assumption (3.73) (A_C keeps a
+# distance from ∂Γ_C) fails. Count: λ_t vanishes at the ends of Γ_C, so C_h̃ has N_C
+# interior hats, while L_ĥ with ĥ = h̃ has one ν per h̃ edge, N_A = N_C + 1. Then
+# Q_𝓕ᵀ: ℝ^{N_A} → ℝ^{N_C} *must* have a kernel. For 𝓕 ≡ 1 it is the checkerboard
+# κ = (+1, −1, +1, …): every hat covers two neighbouring edges of equal length and sees
+# ∫μ_iκ = (h̃/2)(κ_i + κ_{i+1}) = 0. Such a ν changes nothing in (3.62)₅, so ν is not
+# unique and the discrete inf-sup condition (3.74) fails. With ĥ = 2h̃ every ĥ edge has an
+# h̃ node in its middle whose hat lies inside it (proof of Lemma 3.29); the constant of
+# (3.72), measured in W (H^{1/2} on C_h̃) and ‖κ‖²_{−1/2,ĥ} = ĥ‖κ‖²_{L²} (Remark 3.30), is
+# then the smallest singular value of (ĥM)^{−1/2} Q_𝓕 W^{−1/2}.
+
+
+# %%
+def inf_sup(problem, F=None) -> dict:
+    """Discrete inf-sup constant of q (3.72) for F (default 1 on Gamma_C), and the kernel."""
+    fr = build_friction_forms(problem)
+    F = np.ones(len(fr.lengths)) if F is None else F
+    rows = fr.per_hat_edge(F) > 0                                # the h^ edges of A_C
+    Q = fr.q_matrix(F).toarray()[rows]
+    W = metric_matrix(problem.spaces.contact, 2.0, "h12")        # ||mu||^2 ~ mu^T W mu
+    values, vectors = np.linalg.eigh(W)
+    W_inv_root = (vectors / np.sqrt(values)) @ vectors.T
+    scaled = (Q / fr.hat_lengths[rows, None]) @ W_inv_root
+    singular = np.linalg.svd(scaled, compute_uv=False)
+    n_a, n_c = Q.shape
+    kernel = np.linalg.svd(Q.T)[2][-1] if n_a > n_c else np.zeros(n_a)
+    return {"N_A": n_a, "N_C": n_c, "beta": float(singular[-1]) if n_a <= n_c else 0.0,
+            "kernel": np.round(kernel / (np.max(np.abs(kernel)) or 1.0), 6).tolist()}
+
+
+inf_sup_rows = []
+for level in GAP0_LEVELS:
+    row = {"level": level}
+    for factor, scene in gap0.items():
+        row[factor] = inf_sup(assemble(scene, build_mesh(scene.geometry, level)))
+    inf_sup_rows.append(row)
+    print(f"level {level}: h^ = h~: N_A = {row[1]['N_A']:3d} > N_C = {row[1]['N_C']:3d}, "
+          f"beta = 0; h^ = 2h~: N_A = {row[2]['N_A']:3d}, beta = {row[2]['beta']:.4f}")
+print("kernel of Q_F^T for h^ = h~ on level 1:", inf_sup_rows[0][1]["kernel"])
+
+# %% [markdown]
+# A picture of the kernel on level 1: every hat μ_i of C_h̃ covers two ĥ = h̃ edges of
+# equal length with opposite ν, so ∫ 𝓕 μ_i ν = 0 for all i.
+
+# %%
+kernel = np.array(inf_sup_rows[0][1]["kernel"])
+problem_1 = assemble(gap0[1], build_mesh(gap0[1].geometry, GAP0_LEVELS[0]))
+fr_1 = build_friction_forms(problem_1)
+ends = np.sort(np.unique(np.round(np.r_[fr_1.midpoints[:, 0] - fr_1.lengths / 2,
+                                        fr_1.midpoints[:, 0] + fr_1.lengths / 2], 12)))
+hat_ends = ends[::2]                                    # the h~ nodes (every other fine node)
+fig, ax = plt.subplots(figsize=(9, 3.2))
+ax.stairs(kernel, hat_ends, lw=2, label=r"kernel of $Q_\mathcal{F}^T$: $\nu$ per $\hat h$ edge")
+for left, middle, right in zip(hat_ends[:-2], hat_ends[1:-1], hat_ends[2:]):
+    ax.plot([left, middle, right], [0, 0.8, 0], color="0.6", lw=0.8)
+ax.plot([], [], color="0.6", lw=0.8, label=r"hats $\mu_i$ of $C_{\tilde h}$ (scaled)")
+ax.set_xlabel(r"$x_1$ on $\Gamma_C$")
+ax.set_ylabel(r"$\nu$")
+ax.set_ylim(-1.4, 1.4)
+ax.set_title(r"$\hat h = \tilde h$, $\mathcal{F} \equiv 1$: the checkerboard $\nu$ no hat can see")
+ax.legend(fontsize=8, loc="lower right")
+ax.grid(alpha=0.3)
+save_figure(fig, OUT / "checkerboard.png")
+
+# %% [markdown]
+# β stays the same on every level for ĥ = 2h̃ (in the mesh-dependent norm of Lemma 3.29).
+# If instead 𝓕 vanishes near the ends of Γ_C (assumption (3.73)), the hats next to the
+# ends of A_C pin the checkerboard and ĥ = h̃ is fine (Lemma 3.31):
+
+# %%
+scene = gap0[1]
+problem_inner = assemble(scene, build_mesh(scene.geometry, GAP0_LEVELS[-1]))
+fr_inner = build_friction_forms(problem_inner)
+inner = inf_sup(problem_inner, (np.abs(fr_inner.midpoints[:, 0]) < 1.5).astype(float))
+print(f"h^ = h~, F = 1 on |x1| < 1.5 only: N_A = {inner['N_A']} <= N_C = {inner['N_C']}, "
+      f"beta = {inner['beta']:.3f}")
+
+# %% [markdown]
+# ## 2. What the solver sees
+#
+# What the solver sees: the nested Uzawa iteration on the g = 0 scene with both choices.
+# With ĥ = h̃ it needs many more outer steps where it converges at all, and on some
+# levels it stalls: then `nested_uzawa` raises `ConvergenceError`, whose message names
+# the remedy `contact.hhat_factor = 2`.
+
+# %%
+gap0_runs = {1: [], 2: []}
+failure_messages = []
+for level in GAP0_LEVELS:
+    for factor, scene in gap0.items():
+        problem = assemble(scene, build_mesh(scene.geometry, level))
+        try:
+            solution = nested_uzawa(problem, NestedUzawaSettings.from_scene(scene))
+            gap0_runs[factor].append({"level": level, "outer": solution.iterations["outer"],
+                                      "inner": solution.iterations["inner"],
+                                      "converged": solution.converged})
+        except ConvergenceError as error:
+            failure_messages.append(f"level {level}, h^ = {factor} h~: {error}")
+            gap0_runs[factor].append({"level": level, "outer": len(error.history),
+                                      "inner": None, "converged": False})
+    print(f"level {level}: outer iterations h^ = h~: {gap0_runs[1][-1]['outer']:5d} "
+          f"(converged {gap0_runs[1][-1]['converged']}), h^ = 2h~: "
+          f"{gap0_runs[2][-1]['outer']:4d} (converged {gap0_runs[2][-1]['converged']})")
+for message in failure_messages:
+    print(message)
+
+fig, ax = plt.subplots(figsize=(6, 4))
+for factor, marker in ((1, "s--"), (2, "o-")):
+    rows = gap0_runs[factor]
+    ax.semilogy([r["level"] for r in rows], [r["outer"] for r in rows], marker,
+                label=f"ĥ = {factor}h̃" if factor > 1 else "ĥ = h̃")
+    failed = [r for r in rows if not r["converged"]]
+    ax.semilogy([r["level"] for r in failed], [r["outer"] for r in failed], "rx", ms=12)
+ax.set_xlabel("level")
+ax.set_ylabel("outer iterations (x: ConvergenceError)")
+ax.set_xticks(GAP0_LEVELS)
+ax.set_title("Coulomb, g = 0: nested Uzawa")
+ax.grid(True, which="both", alpha=0.3)
+ax.legend()
+save_figure(fig, OUT / "gap0_iterations.png")
+
+# %%
+results = {
+    "quick": QUICK,
+    "inf_sup": [{"level": r["level"], "hhat_h": {k: r[1][k] for k in ("N_A", "N_C", "beta")},
+                 "hhat_2h": {k: r[2][k] for k in ("N_A", "N_C", "beta")},
+                 "kernel_hhat_h": r[1]["kernel"]} for r in inf_sup_rows],
+    "inf_sup_inner": {k: inner[k] for k in ("N_A", "N_C", "beta")},
+    "gap0": {"hhat_h": gap0_runs[1], "hhat_2h": gap0_runs[2]},
+    "failure_messages": failure_messages,
+}
+print(f"wrote {save_results('05_friction_inf_sup', results)}")
+
+# %% [markdown]
+# ## Exercises
+# Solutions: `tutorials/solutions/05_friction_inf_sup_solutions.py`.
+#
+# 1. **ĥ = h̃ is fine under (3.73).** Solve `thesis-3.46-coulomb-gap-abs` (g = |x₁|) with
+#    `contact.hhat_factor` 1 and 2 on level 4 and compare λ_n, λ_t and ν (Figs. 3.26-3.28).
+#    Why do both converge here, unlike for g = 0?
+# 2. **A variable friction bound.** Compute the kernel of Q_𝓕ᵀ for ĥ = h̃ and
+#    𝓕 = 1 + x₁² (`inf_sup(problem, F)` above) on level 2. Is it still a checkerboard?
+#    Why can no choice of 𝓕 > 0 on all of Γ_C remove the kernel?

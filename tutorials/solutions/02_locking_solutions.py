@@ -1,0 +1,129 @@
+# %% [markdown]
+# # Solutions to Tutorial 2: Locking-free PEERS as ν → ½
+#
+# Each exercise is one section; all run in seconds with `NGDUAL_QUICK=1`.
+
+# %%
+import matplotlib.pyplot as plt
+import ngsolve as ngs
+import numpy as np
+
+from ngdual.expr import Expression
+from ngdual.mesh import mesh_arrays, polygon_mesh
+from ngdual.scene import Material
+from ngdual.studies.tutorials import output_dir, quick_mode, save_figure, save_results
+
+QUICK = quick_mode()
+LEVELS = [1, 2] if QUICK else [1, 2, 3, 4]
+NUS = [0.3, 0.49, 0.499, 0.4999]
+OUT = output_dir("02_locking_solutions")
+
+# %% [markdown]
+# ## Exercise 1: P2 on the same meshes
+#
+# We reuse the manufactured divergence-free solution of the tutorial. P2 is much better
+# than P1, but on general triangulations it is still not robust in λ: the error ratio
+# between ν = 0.4999 and ν = 0.3 exceeds one noticeably (locking-free conforming
+# Lagrange elements need degree ≥ 4 with special meshes, Scott-Vogelius).
+
+# %%
+P = {"p": "(T**2*(1 - T)**2)", "dp": "(2*T - 6*T**2 + 4*T**3)",
+     "d2p": "(2 - 12*T + 12*T**2)", "d3p": "(24*T - 12)"}
+
+
+def term(first: str, second: str) -> str:
+    return P[first].replace("T", "x") + "*" + P[second].replace("T", "y")
+
+
+def cf(formula: str):
+    return Expression(formula).coefficient()
+
+
+mu = 1.0
+shear = f"{mu}*({term('p', 'd2p')} - {term('d2p', 'p')})"
+sigma_exact = ngs.CF((cf(f"{2 * mu}*{term('dp', 'dp')}"), cf(shear), cf(shear),
+                      cf(f"-{2 * mu}*{term('dp', 'dp')}")), dims=(2, 2))
+force = ngs.CF((cf(f"-{mu}*({term('d2p', 'dp')} + {term('p', 'd3p')})"),
+                cf(f"{mu}*({term('d3p', 'p')} + {term('dp', 'd2p')})")))
+SIDES = ["bottom", "right", "top", "left"]
+
+
+def primal_stress_error(mesh, nu: float, order: int) -> float:
+    lam, shear_modulus = Material(2 * mu * (1 + nu), nu).lame
+    space = ngs.VectorH1(mesh, order=order, dirichlet="|".join(SIDES))
+    u, v = space.TnT()
+    eps_u, eps_v = ngs.Sym(ngs.Grad(u)), ngs.Sym(ngs.Grad(v))
+    a = ngs.BilinearForm(2 * shear_modulus * ngs.InnerProduct(eps_u, eps_v) * ngs.dx
+                         + lam * ngs.div(u) * ngs.div(v) * ngs.dx).Assemble()
+    rhs = ngs.LinearForm(force * v * ngs.dx(bonus_intorder=4)).Assemble()
+    uh = ngs.GridFunction(space)
+    uh.vec.data = a.mat.Inverse(space.FreeDofs(), inverse="umfpack") * rhs.vec
+    sigma_h = 2 * shear_modulus * ngs.Sym(ngs.Grad(uh)) + lam * ngs.div(uh) * ngs.Id(2)
+    error = sigma_h - sigma_exact
+    return float(np.sqrt(ngs.Integrate(ngs.InnerProduct(error, error), mesh, order=10)
+                         / ngs.Integrate(ngs.InnerProduct(sigma_exact, sigma_exact), mesh,
+                                         order=10)))
+
+
+mesh = polygon_mesh([[0, 0], [1, 0], [1, 1], [0, 1]], SIDES, maxh=0.25, level=LEVELS[-1])
+ratios, primal_errors = {}, {}
+for order in (1, 2):
+    primal_errors[order] = [primal_stress_error(mesh, nu, order) for nu in NUS]
+    errors = primal_errors[order]
+    ratios[f"P{order}"] = errors[-1] / errors[0]
+    print(f"P{order}: stress error {errors[0]:.3e} (nu = {NUS[0]}), {errors[-1]:.3e} "
+          f"(nu = {NUS[-1]}), ratio {ratios[f'P{order}']:.2f}")
+
+fig, ax = plt.subplots(figsize=(6, 4))
+lam_over_mu = [2 * nu / (1 - 2 * nu) for nu in NUS]
+for order, marker in ((1, "s-"), (2, "o-")):
+    ax.loglog(lam_over_mu, primal_errors[order], marker, label=f"P{order}")
+ax.set_xlabel(r"$\lambda/\mu$")
+ax.set_ylabel(r"relative $L^2$ error of $\sigma$")
+ax.set_title(f"Primal methods on the clamped square, level {LEVELS[-1]}")
+ax.grid(True, which="both", alpha=0.3)
+ax.legend()
+save_figure(fig, OUT / "primal_locking.png")
+
+# %% [markdown]
+# ## Exercise 2: how many divergence-free P1 fields are there?
+#
+# On a triangle with vertices a_k and barycentric gradients ∇φ_k, a P1 field
+# v = Σ v_k φ_k has the constant divergence Σ_k ∇φ_k · v_k. Stacking these rows for all
+# T triangles over the 2V_int unknowns (v = 0 on ∂Ω) gives a T × 2V_int matrix D; its
+# kernel is the space the P1 solution is pushed into as λ → ∞. By Euler's formula
+# T = 2V − V_∂ − 2 on a triangulation of a polygon with V_∂ boundary vertices, so
+# 2V_int − T = −V_∂ + 2 < 0: there are more constraints than unknowns, and unless the
+# mesh is special (criss-cross) the only divergence-free P1 field is v = 0. The
+# λ-limit of the P1 solution is u_h = 0, whatever f: that is locking.
+
+# %%
+def divergence_matrix(mesh) -> tuple[np.ndarray, int]:
+    """D (T x 2 V_int): elementwise divergence of P1 fields vanishing on the boundary."""
+    points, triangles = mesh_arrays(mesh)
+    boundary = {v.nr for el in mesh.Elements(ngs.BND) for v in el.vertices}
+    interior = [k for k in range(len(points)) if k not in boundary]
+    column = {k: i for i, k in enumerate(interior)}
+    D = np.zeros((len(triangles), 2 * len(interior)))
+    for t, tri in enumerate(triangles):
+        corners = points[tri]
+        gradients = np.linalg.inv(np.c_[np.ones(3), corners])[1:].T   # grad phi_k as rows
+        for k, g in zip(tri, gradients):
+            if k in column:
+                D[t, 2 * column[k]: 2 * column[k] + 2] = g
+    return D, len(interior)
+
+
+divergence_free = []
+for level in LEVELS:
+    square = polygon_mesh([[0, 0], [1, 0], [1, 1], [0, 1]], SIDES, maxh=0.25, level=level)
+    D, n_interior = divergence_matrix(square)
+    rank = np.linalg.matrix_rank(D)
+    row = {"level": level, "T": D.shape[0], "unknowns": D.shape[1],
+           "kernel": int(D.shape[1] - rank), "count": int(D.shape[1] - D.shape[0])}
+    divergence_free.append(row)
+    print(f"level {level}: T = {row['T']:4d}, 2 V_int = {row['unknowns']:4d}, "
+          f"2 V_int - T = {row['count']:4d}, divergence-free P1 fields: {row['kernel']}")
+
+# %%
+save_results("02_locking_solutions", {"primal_ratios": ratios, "divergence_free": divergence_free})
