@@ -2,31 +2,33 @@
 
 For a discrete solution of (3.62), with w_h := C^{-1} sigma_h + eta_h (eta_h
 read as the skew tensor [[0, eta_h], [-eta_h, 0]], so w_h approximates grad u)
-and t = (n_2, -n_1) the tangent of (3.24) and of the proof of Theorem 4.2:
+and t = (n_2, -n_1) the tangent of (3.24) and of the proof of Theorem 4.2, the terms,
+squared, per element T, are::
 
-eta_{sigma,T}^2 (4.15)
-    ``residual``        ||f + div sigma_h||_T^2
-    ``asymmetry``       ||as(sigma_h)||_T^2 (``asymmetry="l2"``, the default, as in
-                        Carstensen-Dolzmann [22], Gatica [46]) or ||as(sigma_h)||_{H(div,T)}^2
-                        (``"hdiv"``, as printed in (4.15); it does not decrease for PEERS)
-    ``curl``            h_T^2 ||curl w_h||_T^2
-    ``jump_interior``   sum_{e in E^T, interior}  h_e ||[w_h t]||_e^2
-    ``jump_dirichlet``  sum_{e in E^T on Gamma_D} h_e ||w_h t - du_D/dt||_e^2
-    ``jump_neumann``    sum_{e in E^T on Gamma_N} h_e ||w_h t + dphi/dt||_e^2
-    ``jump_contact``    sum_{e in E^T on Gamma_C} h_e ||w_h t + dlam_t/dt t + d(lam_n-g)/dt n||^2
-eta_{u,T}^2 (4.31)
-    ``u_volume``        h_T^2 ||w_h||_T^2
-    ``u_dirichlet``     sum h_e ||u_Gamma - u_D||_e^2
-    ``u_neumann``       sum h_e ||phi + u_Gamma||_e^2
-    ``u_contact``       sum h_e ||lam_t t + (lam_n - g) n + u_Gamma||_e^2
-the friction and Neumann terms of (4.50)
-    ``friction``        sum_{e in E^T on A_C} h~_e ||sigma_t - F nu||_e^2,  A_C = supp F
-    ``neumann``         log(1 + C~_N) sum_{e in E^T on Gamma_N} h~_e ||sigma_h n - t0||_e^2
+    eta_{sigma,T}^2 (4.15)
+        ``residual``        ||f + div sigma_h||_T^2
+        ``asymmetry``       ||as(sigma_h)||_T^2 (``asymmetry="l2"``, the default, as in
+                            Carstensen-Dolzmann [22], Gatica [46]) or ||as(sigma_h)||_{H(div,T)}^2
+                            (``"hdiv"``, as printed in (4.15); it does not decrease for PEERS)
+        ``curl``            h_T^2 ||curl w_h||_T^2
+        ``jump_interior``   sum_{e in E^T, interior}  h_e ||[w_h t]||_e^2
+        ``jump_dirichlet``  sum_{e in E^T on Gamma_D} h_e ||w_h t - du_D/dt||_e^2
+        ``jump_neumann``    sum_{e in E^T on Gamma_N} h_e ||w_h t + dphi/dt||_e^2
+        ``jump_contact``    sum_{e in E^T on Gamma_C}
+                            h_e ||w_h t + dlam_t/dt t + d(lam_n-g)/dt n||^2
+    eta_{u,T}^2 (4.31)
+        ``u_volume``        h_T^2 ||w_h||_T^2
+        ``u_dirichlet``     sum h_e ||u_Gamma - u_D||_e^2
+        ``u_neumann``       sum h_e ||phi + u_Gamma||_e^2
+        ``u_contact``       sum h_e ||lam_t t + (lam_n - g) n + u_Gamma||_e^2
+    the friction and Neumann terms of (4.50)
+        ``friction``        sum_{e in E^T on A_C} h~_e ||sigma_t - F nu||_e^2,  A_C = supp F
+        ``neumann``         log(1 + C~_N) sum_{e in E^T on Gamma_N} h~_e ||sigma_h n - t0||_e^2
 
 u_Gamma is the value of the piecewise constant u_h of the element at the edge
 (4.29). The thesis has u_D = 0; the ``du_D/dt`` and ``- u_D`` parts are the
 same terms for non-homogeneous Dirichlet data (w_h t approximates du/dt, and
-u = u_D on Gamma_D). h_T = diam T and h_e = |e| stand for the equivalent
+u = u_D on Gamma_D). h_T = diam T and h_e = length(e) stand for the equivalent
 patch diameters of (3.60); h~_e is the length of the coarse (h~) edge holding e.
 
 Every term is an NGSolve integral: element integrals, element-boundary
