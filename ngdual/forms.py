@@ -260,14 +260,17 @@ def assemble(scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes | None = None
         offset += p.shape[1]
     P = sp.block_diag(blocks_p, format="csr")
     # the PEERS unknowns come first and are not prolonged: their block is a's matrix as it is
+    # (shared, not copied: the sum below or the copy makes K's own arrays)
     n_peers = sum(spaces.components[c].ndof for c in peers.PEERS)
-    K = _leading_block(to_scipy(a.mat), n_peers, P.shape[1])
+    volume = _leading_block(to_scipy(a.mat, copy=False), n_peers, P.shape[1])
     lift = _end_lift(scene, spaces, fes, names)
     F = P.T @ rhs.vec.FV().NumPy()
     if d is not None:
         D = to_scipy(d.mat)
-        K = K + P.T @ D @ P
+        K = volume + P.T @ D @ P
         F -= P.T @ (D @ lift)  # a has no entries in the multipliers' columns, where lift lives
+    else:
+        K = volume.copy()
     K.eliminate_zeros()
     return DiscreteProblem(scene, spaces, fes, names, P, K, F, blocks, lift,
                            time.perf_counter() - start)

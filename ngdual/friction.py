@@ -27,6 +27,7 @@ from . import peers
 from .contact import ContactBoundary
 from .expr import Expression
 from .forms import DiscreteProblem, boundary_regex
+from .sparse import to_scipy
 from .tolerances import friction_vanishes
 
 GAUSS = (np.array([0.5 - np.sqrt(15) / 10, 0.5, 0.5 + np.sqrt(15) / 10]),
@@ -170,10 +171,7 @@ def _edge_functionals(problem: DiscreteProblem) -> tuple[sp.csr_matrix, sp.csr_m
         form = ngs.BilinearForm(trialspace=fes, testspace=space)
         form += (direction * traction) * test * ds
         form.Assemble()
-        rows, cols, vals = form.mat.COO()
-        fine = sp.csr_matrix((np.asarray(vals), (np.asarray(rows), np.asarray(cols))),
-                             shape=(space.ndof, fes.ndof))
-        mats.append((ends @ fine @ problem.P).tocsr())
+        mats.append((ends @ to_scipy(form.mat) @ problem.P).tocsr())
     return mats[0], mats[1]
 
 

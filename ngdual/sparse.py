@@ -6,11 +6,13 @@ import numpy as np
 import scipy.sparse as sp
 
 
-def to_scipy(matrix) -> sp.csr_matrix:
+def to_scipy(matrix, copy: bool = True) -> sp.csr_matrix:
     """An assembled NGSolve sparse matrix as a SciPy CSR matrix.
 
-    Copies NGSolve's own CSR arrays (``matrix.CSR()``, rows already sorted by column):
-    no COO triplets to sort, and the copy outlives the bilinear form that owns ``matrix``.
+    Made from NGSolve's own CSR arrays (``matrix.CSR()``, rows already sorted by column):
+    no COO triplets to sort. The copy outlives the bilinear form that owns ``matrix``;
+    ``copy=False`` shares its values and columns instead, valid only while the form lives
+    (for a matrix that is about to be combined into a new one).
 
     >>> import ngsolve as ngs
     >>> from ngdual.mesh import thesis_mesh
@@ -20,6 +22,6 @@ def to_scipy(matrix) -> sp.csr_matrix:
     16.0
     """
     values, columns, row_starts = matrix.CSR()
-    return sp.csr_matrix((np.array(values), np.array(columns),
+    return sp.csr_matrix((np.array(values, copy=copy), np.array(columns, copy=copy),
                           np.array(row_starts, dtype=np.int64)),
                          shape=(matrix.height, matrix.width))
