@@ -333,7 +333,7 @@ results = {
                        "errors": kept["errors"], "etas": [r["estimator"] for r in kept["history"]],
                        "rates": l_rates[name], "effectivity": effectivity_l[name]}
                 for name, kept in l_runs.items()},
-    "thesis": {name: [{k: r[k] for k in ("step", "elements", "eta", "e_tot", "effectivity",
+    "thesis": {name: [{k: r[k] for k in ("step", "elements", "estimator", "e_tot", "effectivity",
                                          "marked", "converged")}
                       | {"ndof": r["dofs"]["total"]} for r in kept["history"]]
                for name, kept in thesis_runs.items()},
