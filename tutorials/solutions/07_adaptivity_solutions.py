@@ -105,7 +105,7 @@ for indicator in ("eta", "eta_sigma"):
                              max_steps=THESIS_STEPS)
     by_indicator[indicator] = {"elements": mesh.ne, "top_edges": edges_on(mesh, "top"),
                                "bottom_edges": edges_on(mesh, "bottom"),
-                               "eta": [r["estimator"] for r in rows]}
+                               "eta": [r["eta"] for r in rows]}
     row = by_indicator[indicator]
     print(f"marking with {indicator:9s}: {row['elements']} triangles, {row['top_edges']} "
           f"edges on Gamma_N, {row['bottom_edges']} on Gamma_C; eta_tot "
