@@ -109,8 +109,8 @@ def run(ctx):
                              facecolors=arrays["von_mises"], cmap="viridis", vmin=0, vmax=vmax,
                              edgecolors="none", rasterized=True)
         fig.colorbar(art, ax=ax_f, extend="max",
-                     label=plot.unit_label(r"von Mises stress $\sigma_0$", scene.units.stress)
-                     + f"\ncolour scale clipped at its {CLIP:g}th percentile near $\\Gamma_C$")
+                     label=plot.unit_label(r"$\sigma_0$", scene.units.stress)
+                     + f", clipped at its {CLIP:g}th percentile")
         ax_f.set_xlim(box[0], box[1])
         ax_f.set_ylim(box[2], box[3])
         ax_f.set_aspect("equal")

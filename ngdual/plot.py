@@ -94,9 +94,18 @@ def _coordinates(ax, units) -> None:
     ax.set_ylabel(unit_label(r"$x_2$", _length(units)))
 
 
-def _colorbar(fig, art, ax, label: str, extend: str, note: str, **kwargs) -> None:
-    fig.colorbar(art, ax=ax, label=f"{label}\n{note}" if note else label, extend=extend,
-                 **kwargs)
+def _colorbar(fig, art, ax, label: str, extend: str, note: str, wide: bool) -> None:
+    """A colour bar labelled ``label`` and the clipping ``note``: below a wide domain (the
+    label then has room for both on one line), to the right of a tall one."""
+    if wide:
+        fig.colorbar(art, ax=ax, label=f"{label}; {note}" if note else label, extend=extend,
+                     location="bottom", shrink=0.6, aspect=40)
+    else:
+        fig.colorbar(art, ax=ax, label=f"{label}\n{note}" if note else label, extend=extend)
+
+
+def _is_wide(points: np.ndarray) -> bool:
+    return float(np.ptp(points[:, 1])) < 0.6 * float(np.ptp(points[:, 0]))
 
 
 def plot_contact_traces(traces, title: str = "", units=None,
@@ -146,12 +155,12 @@ def plot_element_field(points: np.ndarray, triangles: np.ndarray, values: np.nda
     with corner singularities); the colour bar states the clipping.
     """
     aspect = float(np.ptp(points[:, 1])) / max(float(np.ptp(points[:, 0])), 1e-300)
-    fig, ax = plt.subplots(figsize=(11, min(9 * aspect, 12.0) + 1.6), constrained_layout=True)
+    fig, ax = plt.subplots(figsize=(11, min(9 * aspect, 12.0) + 2.0), constrained_layout=True)
     tri = mtri.Triangulation(points[:, 0], points[:, 1], triangles)
     vmin, vmax, extend, note = clipped_scale(values, clip)
     art = ax.tripcolor(tri, facecolors=values, cmap="viridis", vmin=vmin, vmax=vmax,
                        edgecolors="none")
-    _colorbar(fig, art, ax, label, extend, note)
+    _colorbar(fig, art, ax, label, extend, note, _is_wide(points))
     _coordinates(ax, units)
     ax.set_title(title)
     return fig
@@ -246,7 +255,7 @@ def plot_field_pair(points: np.ndarray, triangles: np.ndarray, values: list[np.n
     ``clip``: the colour scale ends at this percentile of all values (the colour bar is
     extended and says so), so that corner singularities do not wash out the rest.
     """
-    fig, axes = plt.subplots(1, len(values), figsize=(6.2 * len(values), 2.8),
+    fig, axes = plt.subplots(1, len(values), figsize=(6.2 * len(values), 3.4),
                              constrained_layout=True)
     axes = np.atleast_1d(axes)
     tri = mtri.Triangulation(points[:, 0], points[:, 1], triangles)
@@ -256,7 +265,7 @@ def plot_field_pair(points: np.ndarray, triangles: np.ndarray, values: list[np.n
                            edgecolors="none", rasterized=True)
         _coordinates(ax, units)
         ax.set_title(title)
-    _colorbar(fig, art, list(axes), label, extend, note, shrink=0.9)
+    _colorbar(fig, art, list(axes), label, extend, note, _is_wide(points))
     fig.suptitle(suptitle)
     return fig
 
