@@ -173,6 +173,7 @@ def plot_mesh(points: np.ndarray, triangles: np.ndarray, title: str = "",
     ``marked``: one flag per triangle (the MARK step of the adaptive loop); the legend
     counts them.
     """
+    from matplotlib.colors import ListedColormap
     from matplotlib.patches import Patch
 
     width = max(float(np.ptp(points[:, 0])), 1e-300)
@@ -181,11 +182,13 @@ def plot_mesh(points: np.ndarray, triangles: np.ndarray, title: str = "",
     tri = mtri.Triangulation(points[:, 0], points[:, 1], triangles)
     handles = []
     if marked is not None and np.any(marked):
-        marked = np.asarray(marked, float)
-        ax.tripcolor(tri, facecolors=marked, cmap="Oranges", vmin=0, vmax=1.6,
+        marked = np.asarray(marked, bool)
+        colour = plt.get_cmap("Oranges")(0.6)
+        ax.tripcolor(mtri.Triangulation(points[:, 0], points[:, 1], triangles[marked]),
+                     facecolors=np.ones(int(marked.sum())), cmap=ListedColormap([colour]),
                      edgecolors="none", rasterized=True)
-        handles.append(Patch(color=plt.get_cmap("Oranges")(1 / 1.6),
-                             label=f"{int(np.count_nonzero(marked))} marked for refinement"))
+        handles.append(Patch(color=colour,
+                             label=f"{int(marked.sum())} marked for refinement"))
     ax.triplot(tri, color="k", lw=0.25, label=f"{len(triangles)} triangles")
     _coordinates(ax, units)
     ax.set_title(title or f"{len(triangles)} triangles")
