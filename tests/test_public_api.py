@@ -72,8 +72,7 @@ def test_the_readme_example_solves_example_3_46_with_coulomb_friction():
     force = nd.force_balance(solution, traces).multiplier_force  # on the h~ hats, n = (0, -1)
     # the foundation pushes up; the load and gap are even in x, but the diagonals of the
     # structured mesh of Example 3.46 all lean one way (it is not mirror-symmetric), so the
-    # discrete friction force is
-    # not exactly zero (0.7 % of the normal force on level 2)
+    # discrete friction force is not exactly zero (0.7 % of the normal force on level 2)
     assert force[1] > 0 and abs(force[0]) < 0.02 * force[1]
     assert traces.lam_n.min() >= -1e-12                      # lambda_n >= 0 (3.62)
 
