@@ -295,6 +295,16 @@ def test_theory_page_has_numbered_equations_typeset(browser, server):
 def test_a_tutorial_page_in_a_browser(browser, server, site):
     first = tutorial_pages(site)[0]
     result = open_page(browser, server, f"tutorials/{first.name}", "tutorial")
-    assert_reads_well(result, server, min_math=0, min_images=1)   # maths, if any, typeset
+    assert_reads_well(result, server, min_math=20, min_images=1)
     for name in ("tutorial.png", "tutorial-first-figure.png"):
         assert (SCREENSHOTS / name).stat().st_size > 10_000, name
+
+
+def test_every_tutorial_page_has_its_mathematics_typeset(browser, server, site):
+    """The markdown cells write LaTeX: MathJax typesets all of it, without an error."""
+    for path in tutorial_pages(site):
+        result = open_page(browser, server, f"tutorials/{path.name}")
+        try:
+            assert_reads_well(result, server, min_math=20, min_images=1)
+        except AssertionError as err:
+            raise AssertionError(f"{path.name}: {err}") from None

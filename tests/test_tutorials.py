@@ -284,8 +284,10 @@ def test_tutorial_runs_headless_in_quick_mode(tutorial, tmp_path):
 
 
 @pytest.mark.parametrize("solution", SOLUTIONS, ids=lambda t: t.name)
-def test_solutions_run_in_quick_mode(solution, tmp_path):
+def test_solutions_run_in_quick_mode_and_show_their_answers(solution, tmp_path):
     check_solutions(solution.number, run_script(solution, tmp_path))
+    pictures = list((tmp_path / "out" / solution.name).glob("*.png"))
+    assert pictures and all(p.stat().st_size > 10_000 for p in pictures), pictures
 
 
 def test_notebooks_execute_cleanly_with_nbconvert(tmp_path):

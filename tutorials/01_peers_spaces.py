@@ -1,30 +1,39 @@
 # %% [markdown]
 # # Tutorial 1: The PEERS spaces, their unknowns and the discrete inf-sup condition
 #
-# **Problem.** Plane-strain linear elasticity on a polygon Ω, written for the *stress*
-# σ as the primary unknown (thesis Ch. 3.1, Hellinger-Reissner form with weakly imposed
-# symmetry): find σ, the displacement u and the rotation η = ½(∂₂u₁ − ∂₁u₂) with
+# **Problem.** Plane-strain linear elasticity on a polygon $\Omega$, written for the
+# *stress* $\sigma$ as the primary unknown (thesis Ch. 3.1, Hellinger-Reissner form with
+# weakly imposed symmetry): find $\sigma$, the displacement $u$ and the rotation
+# $\eta = \frac12(\partial_2 u_1 - \partial_1 u_2)$ with
 #
-#     ã(σ, τ) + b(u, τ) + s(η, τ) = ⟨u_D, τn⟩   for all τ   (C⁻¹σ = ε(u), tested)
-#     b(v, σ)                     = −f(v)      for all v   (div σ = −f)
-#     s(ξ, σ)                     = 0          for all ξ   (σ is symmetric)
+# $$
+# \begin{aligned}
+# \tilde a(\sigma, \tau) + b(u, \tau) + s(\eta, \tau) &= \langle u_D, \tau n\rangle
+#   && \forall \tau && (\mathbb{C}^{-1}\sigma = \varepsilon(u) \text{, tested}),\\
+# b(v, \sigma) &= -f(v) && \forall v && (\operatorname{div}\sigma = -f),\\
+# s(\xi, \sigma) &= 0 && \forall \xi && (\sigma \text{ is symmetric}),
+# \end{aligned}
+# $$
 #
-# with ã(σ, τ) = ∫ C⁻¹σ : τ, b(v, τ) = ∫ v · div τ and s(ξ, τ) = ∫ ξ (τ₁₂ − τ₂₁)
+# with $\tilde a(\sigma, \tau) = \int_\Omega \mathbb{C}^{-1}\sigma : \tau\,dx$,
+# $b(v, \tau) = \int_\Omega v \cdot \operatorname{div}\tau\,dx$ and
+# $s(\xi, \tau) = \int_\Omega \xi\,(\tau_{12} - \tau_{21})\,dx$
 # (eqs. (3.12), (3.24), (3.32); the first three rows of (3.62)). The domain is the
-# block [−4,4]×[−1,1] of Example 3.46; for the inf-sup computation it is clamped
-# (u_D = 0) on all four sides, so that no boundary multipliers enter.
+# block $[-4,4]\times[-1,1]$ of Example 3.46; for the inf-sup computation it is clamped
+# ($u_D = 0$) on all four sides, so that no boundary multipliers enter.
 #
 # **Discretisation.** The PEERS triple of Arnold, Brezzi and Douglas, eq. (3.61):
-# X_h = RT₀² ⊕ Curl(cubic bubbles)² for the two rows of σ, M_h = P₀² for u and
-# S_h = continuous P₁ for η, on the structured triangulations of Table 3.1.
+# $X_h = RT_0^2 \oplus \operatorname{Curl}(\text{cubic bubbles})^2$ for the two rows of
+# $\sigma$, $M_h = P_0^2$ for $u$ and $S_h$ = continuous $P_1$ for $\eta$, on the
+# structured triangulations of Table 3.1.
 #
 # **What you will learn.**
 # 1. How many unknowns each PEERS space has, and why (Table 3.1).
 # 2. What the discrete inf-sup condition (Lemma 3.28) says, and how to *compute* the
-#    inf-sup constant β_h on small meshes as a generalised eigenvalue problem.
-# 3. Why the Curl bubbles are needed: without them β_h = 0.
+#    inf-sup constant $\beta_h$ on small meshes as a generalised eigenvalue problem.
+# 3. Why the Curl bubbles are needed: without them $\beta_h = 0$.
 #
-# Tutorial 2 takes the same spaces to the incompressible limit ν → ½ (locking).
+# Tutorial 2 takes the same spaces to the incompressible limit $\nu \to \frac12$ (locking).
 #
 # **References.** M. Andres, *Dual-dual formulations for frictional contact problems in
 # mechanics*, PhD thesis, Leibniz Universität Hannover, 2011: Sections 3.1-3.2,
@@ -70,9 +79,9 @@ print(f"quick mode: {QUICK}; figures and results.json go to {OUT}")
 # %% [markdown]
 # ## The domain and the mesh
 #
-# Example 3.46: clamped ends Γ_D, a loaded top Γ_N and a contact part Γ_C at the bottom
-# (used from Tutorial 3 on). Level 1 is the coarsest mesh of Table 3.1; every level
-# halves h.
+# Example 3.46: clamped ends $\Gamma_D$, a loaded top $\Gamma_N$ and a contact part
+# $\Gamma_C$ at the bottom (used from Tutorial 3 on). Level 1 is the coarsest mesh of
+# Table 3.1; every level halves $h$.
 
 # %%
 thesis = nd.load_scene("thesis-3.46-frictionless")
@@ -83,14 +92,14 @@ save_figure(plot_geometry(thesis, level=1,
 # %% [markdown]
 # ## 1. The PEERS spaces and their degrees of freedom
 #
-# On a triangulation with V vertices, E edges and T triangles:
+# On a triangulation with $V$ vertices, $E$ edges and $T$ triangles:
 #
-# * RT₀ has one dof per edge (the normal flux), and each row of σ adds one Curl
-#   bubble per triangle, so dim X_h = 2(E + T);
-# * dim M_h = 2T (a constant vector per triangle) and dim S_h = V.
+# * $RT_0$ has one dof per edge (the normal flux), and each row of $\sigma$ adds one Curl
+#   bubble per triangle, so $\dim X_h = 2(E + T)$;
+# * $\dim M_h = 2T$ (a constant vector per triangle) and $\dim S_h = V$.
 #
 # The structured mesh of Example 3.46 (`thesis_mesh`) reproduces Table 3.1 of the thesis:
-# 180, 64, 27 on level 1, and each uniform refinement multiplies T by four.
+# 180, 64, 27 on level 1, and each uniform refinement multiplies $T$ by four.
 
 # %%
 dof_rows = []
@@ -107,24 +116,33 @@ for level in DOF_LEVELS:
 # %% [markdown]
 # ## 2. The discrete inf-sup condition
 #
-# Lemma 3.28 (from Arnold-Brezzi-Douglas, Lemma 4.4) states that there is β > 0,
-# independent of h, with
+# Lemma 3.28 (from Arnold-Brezzi-Douglas, Lemma 4.4) states that there is $\beta > 0$,
+# independent of $h$, with
 #
-#     sup_{τ ∈ X_h} [b(v, τ) + s(ξ, τ)] / ‖τ‖_X  ≥  β ‖(v, ξ)‖_{L²}   for all (v, ξ) ∈ M_h × S_h,
+# $$
+# \sup_{\tau \in X_h} \frac{b(v, \tau) + s(\xi, \tau)}{\|\tau\|_X}
+#   \ge \beta\, \|(v, \xi)\|_{L^2} \qquad \forall (v, \xi) \in M_h \times S_h,
+# $$
 #
-# where ‖τ‖_X² = ‖τ‖² + ‖div τ‖² is the H(div) norm. With the Gram matrices X (of the
-# H(div) inner product on X_h) and Y (of L² on M_h × S_h) and the matrix B of b + s,
-# the supremum is attained at τ = X⁻¹By, so the best constant is
+# where $\|\tau\|_X^2 = \|\tau\|^2 + \|\operatorname{div}\tau\|^2$ is the
+# $H(\operatorname{div})$ norm. With the Gram matrices $X$ (of the $H(\operatorname{div})$
+# inner product on $X_h$) and $Y$ (of $L^2$ on $M_h \times S_h$) and the matrix $B$ of
+# $b + s$, the supremum is attained at $\tau = X^{-1}By$, so the best constant is
 #
-#     β_h² = min_y (yᵀ Bᵀ X⁻¹ B y) / (yᵀ Y y),
+# $$
+# \beta_h^2 = \min_y \frac{y^\top B^\top X^{-1} B y}{y^\top Y y},
+# $$
 #
-# the smallest eigenvalue of the pencil (BᵀX⁻¹B, Y): β_h is the smallest singular value
-# of B in these norms. If β_h stays away from zero under refinement the triple is stable.
+# the smallest eigenvalue of the pencil $(B^\top X^{-1} B, Y)$: $\beta_h$ is the smallest
+# singular value of $B$ in these norms. If $\beta_h$ stays away from zero under refinement
+# the triple is stable.
 #
 # We take Example 3.46 with Dirichlet conditions on all four sides (no boundary
-# multipliers) and read B off the assembled system: its block K[σ, (u, η)] is exactly
-# b + s. We find the smallest eigenvalues by shift-invert Lanczos (`eigsh`), solving
-# with the saddle-point matrix [[X, B], [Bᵀ, σ₀Y]] so that X⁻¹ never becomes dense.
+# multipliers) and read $B$ off the assembled system: its block $K[\sigma, (u, \eta)]$ is
+# exactly $b + s$. We find the smallest eigenvalues by shift-invert Lanczos (`eigsh`),
+# solving with the saddle-point matrix
+# $\begin{pmatrix} X & B \\ B^\top & \sigma_0 Y \end{pmatrix}$ so that $X^{-1}$ never
+# becomes dense.
 
 # %%
 clamped = nd.load_scene("thesis-3.46-frictionless",
@@ -187,11 +205,12 @@ for level in INF_SUP_LEVELS:
           f"RT0 without bubbles: three smallest = {np.array2string(bare_beta, precision=2)}")
 
 # %% [markdown]
-# PEERS keeps β_h ≈ 0.39 on every level: the discrete inf-sup condition holds with a
-# constant independent of h. Without the Curl bubbles two singular values are zero
-# (spurious (u, η) modes that no stress can "see") and the next one decays like h.
-# The bubbles are divergence free, so they do not change b(·,·); they enrich the
-# antisymmetric part of τ that s(ξ, τ) tests, which is exactly what the rotation needs.
+# PEERS keeps $\beta_h \approx 0.39$ on every level: the discrete inf-sup condition holds
+# with a constant independent of $h$. Without the Curl bubbles two singular values are zero
+# (spurious $(u, \eta)$ modes that no stress can "see") and the next one decays like $h$.
+# The bubbles are divergence free, so they do not change $b(\cdot,\cdot)$; they enrich the
+# antisymmetric part of $\tau$ that $s(\xi, \tau)$ tests, which is exactly what the
+# rotation needs.
 
 # %%
 fig, ax = plt.subplots(figsize=(6, 4))
@@ -207,9 +226,10 @@ ax.legend()
 save_figure(fig, OUT / "inf_sup.png")
 
 # %% [markdown]
-# Why the bubbles are divergence free: a bubble b_T vanishes on ∂T, so Curl b_T has zero
-# normal flux through every edge and div Curl b_T = 0. They leave b(·,·) alone and only
-# enrich the antisymmetric part of τ, which s(ξ, τ) tests.
+# Why the bubbles are divergence free: a bubble $b_T$ vanishes on $\partial T$, so
+# $\operatorname{Curl} b_T$ has zero normal flux through every edge and
+# $\operatorname{div}\operatorname{Curl} b_T = 0$. They leave $b(\cdot,\cdot)$ alone and
+# only enrich the antisymmetric part of $\tau$, which $s(\xi, \tau)$ tests.
 
 # %%
 results = {"quick": QUICK, "dofs": dof_rows, "inf_sup": inf_sup_rows}
@@ -219,10 +239,10 @@ print(f"wrote {save_results('01_peers_spaces', results)}")
 # ## Exercises
 # Solutions: `tutorials/solutions/01_peers_spaces_solutions.py`.
 #
-# 1. **The norm matters.** Recompute the smallest *and* the largest singular value of B
-#    with the L² norm instead of the H(div) norm on X_h (drop ‖div τ‖² from the Gram
-#    matrix). Which of the two depends on h? Why do Lemma 3.28 and the error analysis
-#    work in ‖·‖_X?
-# 2. **Counting.** Use Euler's formula V − E + T = 1 to write dim X_h, dim M_h and
-#    dim S_h of Table 3.1 as functions of the level k of Example 3.46, and check them
+# 1. **The norm matters.** Recompute the smallest *and* the largest singular value of $B$
+#    with the $L^2$ norm instead of the $H(\operatorname{div})$ norm on $X_h$ (drop
+#    $\|\operatorname{div}\tau\|^2$ from the Gram matrix). Which of the two depends on
+#    $h$? Why do Lemma 3.28 and the error analysis work in $\|\cdot\|_X$?
+# 2. **Counting.** Use Euler's formula $V - E + T = 1$ to write $\dim X_h$, $\dim M_h$ and
+#    $\dim S_h$ of Table 3.1 as functions of the level $k$ of Example 3.46, and check them
 #    against `ngdual dofs thesis-3.46-frictionless --levels 1 2 3 4 5 6 7 8`.

@@ -1,22 +1,25 @@
 # %% [markdown]
 # # Tutorial 2: Locking-free PEERS as ν → ½
 #
-# **Problem.** Plane-strain elasticity on the unit square, clamped (u = 0) on the whole
-# boundary, with a body force f manufactured from the divergence-free displacement
-# u = Curl ψ, ψ = x²(1 − x)² y²(1 − y)². Since div u = 0, σ = 2μ ε(u) and f = −μ Δu do
-# not depend on the Lamé constant λ: the *same* exact solution for every Poisson ratio ν
-# when μ is fixed. As ν → ½, λ/μ = 2ν/(1 − 2ν) → ∞ (nearly incompressible material).
+# **Problem.** Plane-strain elasticity on the unit square, clamped ($u = 0$) on the whole
+# boundary, with a body force $f$ manufactured from the divergence-free displacement
+# $u = \operatorname{Curl}\psi$, $\psi = x^2(1 - x)^2 y^2(1 - y)^2$. Since
+# $\operatorname{div} u = 0$, $\sigma = 2\mu\,\varepsilon(u)$ and $f = -\mu\,\Delta u$ do
+# not depend on the Lamé constant $\lambda$: the *same* exact solution for every Poisson
+# ratio $\nu$ when $\mu$ is fixed. As $\nu \to \frac12$,
+# $\lambda/\mu = 2\nu/(1 - 2\nu) \to \infty$ (nearly incompressible material).
 #
-# **Discretisation.** PEERS (3.61) for (σ, u, η), the subject of Tutorial 1, against the
-# standard primal method with continuous piecewise linear displacements (P1), on the
-# same netgen meshes of the square.
+# **Discretisation.** PEERS (3.61) for $(\sigma, u, \eta)$, the subject of Tutorial 1,
+# against the standard primal method with continuous piecewise linear displacements
+# ($P_1$), on the same netgen meshes of the square.
 #
 # **What you will learn.**
-# 1. What *locking* is: the P1 errors grow with λ/μ on a fixed mesh; the PEERS errors
-#    do not move (the constants of Theorem 3.35 do not depend on λ).
-# 2. How to see it: the P1 stress is polluted by a spurious pressure λ div u_h.
-# 3. PEERS converges at first order for every ν; P1 at ν ≈ ½ is far from its
-#    asymptotic regime on practical meshes.
+# 1. What *locking* is: the $P_1$ errors grow with $\lambda/\mu$ on a fixed mesh; the
+#    PEERS errors do not move (the constants of Theorem 3.35 do not depend on $\lambda$).
+# 2. How to see it: the $P_1$ stress is polluted by a spurious pressure
+#    $\lambda \operatorname{div} u_h$.
+# 3. PEERS converges at first order for every $\nu$; $P_1$ at $\nu \approx \frac12$ is far
+#    from its asymptotic regime on practical meshes.
 #
 # **References.** M. Andres, *Dual-dual formulations for frictional contact problems in
 # mechanics*, PhD thesis, Leibniz Universität Hannover, 2011: Sections 3.1-3.2, eq.
@@ -57,17 +60,33 @@ print(f"quick mode: {QUICK}; figures and results.json go to {OUT}")
 # %% [markdown]
 # ## 1. The manufactured solution
 #
-# On the unit square with u = 0 on the whole boundary we manufacture a divergence-free
-# displacement u = Curl ψ = (∂₂ψ, −∂₁ψ), ψ = p(x) p(y), p(t) = t²(1 − t)².
-# Since div u = 0, σ = 2μ ε(u) and f = −div σ = −μ Δu do not depend on λ: the same
-# exact solution for every ν when μ is fixed. A robust method must give the same
-# errors for ν = 0.3 and ν = 0.4999 (λ/μ ≈ 5000).
+# On the unit square with $u = 0$ on the whole boundary we manufacture a divergence-free
+# displacement
 #
-# The primal competitor is the standard P1 method: find u_h ∈ VectorH1(order=1) with
-# ∫ 2μ ε(u_h) : ε(v) + λ div u_h div v = ∫ f · v. As λ → ∞ the term λ div u_h div v
-# forces div u_h ≈ 0, which continuous P1 fields can barely satisfy: the method *locks*.
+# $$
+# u = \operatorname{Curl}\psi = (\partial_2\psi, -\partial_1\psi), \qquad
+# \psi = p(x)\,p(y), \qquad p(t) = t^2(1 - t)^2 .
+# $$
 #
-# The formulas below are scene expressions in x and y (see `ngdual.expr`).
+# Since $\operatorname{div} u = 0$, $\sigma = 2\mu\,\varepsilon(u)$ and
+# $f = -\operatorname{div}\sigma = -\mu\,\Delta u$ do not depend on $\lambda$: the same
+# exact solution for every $\nu$ when $\mu$ is fixed. A robust method must give the same
+# errors for $\nu = 0.3$ and $\nu = 0.4999$ ($\lambda/\mu \approx 5000$).
+#
+# The primal competitor is the standard $P_1$ method: find $u_h \in$ `VectorH1(order=1)`
+# with
+#
+# $$
+# \int_\Omega 2\mu\,\varepsilon(u_h) : \varepsilon(v)
+#   + \lambda \operatorname{div} u_h \operatorname{div} v \,dx = \int_\Omega f \cdot v \,dx
+#   \qquad \forall v .
+# $$
+#
+# As $\lambda \to \infty$ the term $\lambda \operatorname{div} u_h \operatorname{div} v$
+# forces $\operatorname{div} u_h \approx 0$, which continuous $P_1$ fields can barely
+# satisfy: the method *locks*.
+#
+# The formulas below are scene expressions in `x` and `y` (see `ngdual.expr`).
 
 # %%
 P = {"p": "(T**2*(1 - T)**2)", "dp": "(2*T - 6*T**2 + 4*T**3)",
@@ -149,7 +168,7 @@ def errors(nu: float, level: int) -> dict:
 
 
 # %% [markdown]
-# ## 2. The sweep ν → ½ on a fixed mesh
+# ## 2. The sweep $\nu \to \frac12$ on a fixed mesh
 
 # %%
 print(f"{'nu':>7} {'PEERS u':>9} {'PEERS σ':>9} {'P1 u':>9} {'P1 σ':>9}   "
@@ -160,8 +179,9 @@ for row in sweep:
           f"{row['p1_u']:9.3e} {row['p1_sigma']:9.3e}")
 
 # %% [markdown]
-# PEERS errors do not move as ν → ½; the P1 errors grow with λ/μ. The ratio of the
-# errors at ν = 0.4999 and ν = 0.3 condenses this into one number per method:
+# PEERS errors do not move as $\nu \to \frac12$; the $P_1$ errors grow with
+# $\lambda/\mu$. The ratio of the errors at $\nu = 0.4999$ and $\nu = 0.3$ condenses this
+# into one number per method:
 
 # %%
 first, last = sweep[0], sweep[-1]
@@ -184,8 +204,8 @@ save_figure(fig, OUT / "locking.png")
 # %% [markdown]
 # ## 3. Under refinement
 #
-# Refining the mesh: PEERS converges at first order (Theorem 3.35) for both ν; P1 at
-# ν = 0.4999 is far from its asymptotic regime on these meshes.
+# Refining the mesh: PEERS converges at first order (Theorem 3.35) for both $\nu$; $P_1$
+# at $\nu = 0.4999$ is far from its asymptotic regime on these meshes.
 
 # %%
 convergence = [errors(nu, level) for nu in (NUS[0], NUS[-1]) for level in LOCKING_LEVELS]
@@ -197,10 +217,11 @@ for row in convergence:
 # %% [markdown]
 # ## 4. What locking looks like
 #
-# The von Mises stress at ν = 0.4999 on the finest mesh, exact, PEERS and P1, on one
-# colour scale (the exact maximum). PEERS reproduces the picture. P1 is *locked*: the
-# constraint div u_h ≈ 0 leaves almost no admissible P1 fields (Exercise 2), so u_h is
-# far too small, and so is the deviatoric stress that von Mises measures.
+# The von Mises stress at $\nu = 0.4999$ on the finest mesh, exact, PEERS and $P_1$, on
+# one colour scale (the exact maximum). PEERS reproduces the picture. $P_1$ is *locked*:
+# the constraint $\operatorname{div} u_h \approx 0$ leaves almost no admissible $P_1$
+# fields (Exercise 2), so $u_h$ is far too small, and so is the deviatoric stress that
+# von Mises measures.
 
 # %%
 nu_max, level_max = NUS[-1], LOCKING_LEVELS[-1]
@@ -215,10 +236,11 @@ for name, field in (("exact", sigma_exact), ("PEERS", peers_sigma), ("P1", p1_si
                 OUT / f"von_mises_{name.lower()}.png")
 
 # %% [markdown]
-# Where the large P1 stress *error* of Section 2 sits: in the mean stress
-# p = (σ₁₁ + σ₂₂)/2, which is zero for the exact solution (σ₂₂ = −σ₁₁). For P1 it is
-# (μ + λ) div u_h: a tiny divergence times λ = 5000 μ, oscillating from triangle to
-# triangle. For PEERS p_h is as small as its discretisation error.
+# Where the large $P_1$ stress *error* of Section 2 sits: in the mean stress
+# $p = (\sigma_{11} + \sigma_{22})/2$, which is zero for the exact solution
+# ($\sigma_{22} = -\sigma_{11}$). For $P_1$ it is $(\mu + \lambda)\operatorname{div} u_h$:
+# a tiny divergence times $\lambda = 5000\mu$, oscillating from triangle to triangle. For
+# PEERS $p_h$ is as small as its discretisation error.
 
 # %%
 mean_stress = {}
@@ -256,11 +278,13 @@ print(f"wrote {save_results('02_locking', results)}")
 # ## Exercises
 # Solutions: `tutorials/solutions/02_locking_solutions.py`.
 #
-# 1. **Higher order does not cure locking by itself.** Replace the P1 method by P2
-#    (`VectorH1(order=2)`). Compute the error ratio between ν = 0.4999 and ν = 0.3 for
-#    the stress. Is P2 locking-free on these meshes?
-# 2. **Counting divergence-free fields.** As λ → ∞ the P1 solution is driven into the
-#    subspace {v_h ∈ P1, v_h = 0 on ∂Ω, div v_h = 0 on every triangle}. Assemble the
-#    matrix that maps the 2V_int nodal values to the T elementwise divergences and
-#    compute the dimension of its kernel on the meshes of this tutorial. Compare with
-#    the count 2V_int − T. What does the answer say about the P1 solution at ν → ½?
+# 1. **Higher order does not cure locking by itself.** Replace the $P_1$ method by $P_2$
+#    (`VectorH1(order=2)`). Compute the error ratio between $\nu = 0.4999$ and
+#    $\nu = 0.3$ for the stress. Is $P_2$ locking-free on these meshes?
+# 2. **Counting divergence-free fields.** As $\lambda \to \infty$ the $P_1$ solution is
+#    driven into the subspace
+#    $\{v_h \in P_1 : v_h = 0 \text{ on } \partial\Omega,\ \operatorname{div} v_h = 0
+#    \text{ on every triangle}\}$. Assemble the matrix that maps the $2V_{\mathrm{int}}$
+#    nodal values to the $T$ elementwise divergences and compute the dimension of its
+#    kernel on the meshes of this tutorial. Compare with the count $2V_{\mathrm{int}} - T$.
+#    What does the answer say about the $P_1$ solution at $\nu \to \frac12$?

@@ -1,25 +1,37 @@
 # %% [markdown]
 # # Tutorial 3: Signorini contact and the Uzawa algorithm
 #
-# **Problem.** Example 3.46 of the thesis without friction: the block [−4,4]×[−1,1] is
-# clamped at its ends, pressed down by a parabolic traction on top and may touch a
-# rigid foundation at distance g = 0.01 below Γ_C (the bottom). In the dual-dual form
-# the contact conditions become a sign condition on the multiplier λ_n = g − u_n
-# (the remaining gap): find σ and (u, η, φ, λ_t) and λ_n ∈ C⁺_h̃ with (eq. (3.103))
+# **Problem.** Example 3.46 of the thesis without friction: the block
+# $[-4,4]\times[-1,1]$ is clamped at its ends, pressed down by a parabolic traction on top
+# and may touch a rigid foundation at distance $g = 0.01$ below $\Gamma_C$ (the bottom).
+# In the dual-dual form the contact conditions become a sign condition on the multiplier
+# $\lambda_n = g - u_n$ (the remaining gap): find $\sigma$ and
+# $(u, \eta, \varphi, \lambda_t)$ and $\lambda_n \in C^+_{\tilde h}$ with
 #
-#     A σ + B (u, η, φ, λ_t) + C_n λ_n = g,      Bᵀ σ = b,
-#     λ_n ≥ 0,   C_nᵀ σ ≤ 0,   λ_nᵀ C_nᵀ σ = 0          (gap ≥ 0, σ_n ≤ 0, complementarity)
+# \begin{equation*}
+# \begin{aligned}
+# A\sigma + B\,(u, \eta, \varphi, \lambda_t) + C_n\lambda_n &= g, &
+# B^\top\sigma &= b, \\
+# \lambda_n \ge 0, \quad C_n^\top\sigma &\le 0, &
+# \lambda_n^\top C_n^\top\sigma &= 0
+# \end{aligned}
+# \tag{3.103}
+# \end{equation*}
 #
-# **Discretisation.** PEERS for (σ, u, η), P1 multipliers φ on Γ_N and λ_t, λ_n on Γ_C on
-# the coarser boundary mesh h̃ = 2h (eq. (3.61)).
+# (gap $\ge 0$, $\sigma_n \le 0$, complementarity).
+#
+# **Discretisation.** PEERS for $(\sigma, u, \eta)$, $P_1$ multipliers $\varphi$ on
+# $\Gamma_N$ and $\lambda_t$, $\lambda_n$ on $\Gamma_C$ on the coarser boundary mesh
+# $\tilde h = 2h$ (eq. (3.61)).
 #
 # **What you will learn.**
 # 1. Algorithm 3.38 (Uzawa): one linear saddle-point solve with a fixed matrix per step,
-#    then a projection of λ_n onto the cone λ_n ≥ 0.
-# 2. The projection P⁺ as a small convex quadratic program posed in cvxpy, and why its
-#    metric W matters (Remark 3.40): P⁺ is *not* componentwise clipping.
-# 3. How the step length ρ and the metric (`"h12"` vs `"euclidean"`) change the number
-#    of iterations, on one mesh and under refinement, and what a too large ρ does.
+#    then a projection of $\lambda_n$ onto the cone $\lambda_n \ge 0$.
+# 2. The projection $P^+$ as a small convex quadratic program posed in cvxpy, and why its
+#    metric $W$ matters (Remark 3.40): $P^+$ is *not* componentwise clipping.
+# 3. How the step length $\rho$ and the metric (`"h12"` vs `"euclidean"`) change the
+#    number of iterations, on one mesh and under refinement, and what a too large $\rho$
+#    does.
 # 4. How to check the result against an independent solver (one convex QP, `solve_qp`).
 #
 # **References.** M. Andres, *Dual-dual formulations for frictional contact problems in
@@ -75,12 +87,13 @@ print(f"quick mode: {QUICK}; level {LEVEL}; output in {OUT}")
 # %% [markdown]
 # ## 1. The algebraic problem
 #
-# The block [−4,4]×[−1,1]: Γ_D the clamped ends, Γ_N the top with the parabolic
-# traction, Γ_C the bottom above the foundation.
+# The block $[-4,4]\times[-1,1]$: $\Gamma_D$ the clamped ends, $\Gamma_N$ the top with the
+# parabolic traction, $\Gamma_C$ the bottom above the foundation.
 #
 # `assemble` builds the matrix of (3.103) once. The unknown vector is ordered
-# [σ | u, η, φ, λ_t | λ_n]; `problem.sigma`, `problem.mult` and `problem.lam_n` index the
-# three groups, and `problem.block(rows, cols)` cuts out A, B and C_n.
+# $[\sigma \mid u, \eta, \varphi, \lambda_t \mid \lambda_n]$; `problem.sigma`,
+# `problem.mult` and `problem.lam_n` index the three groups, and
+# `problem.block(rows, cols)` cuts out $A$, $B$ and $C_n$.
 
 # %%
 scene = nd.load_scene("thesis-3.46-frictionless")
@@ -95,12 +108,12 @@ print(f"dofs per space (Table 3.1): {problem.spaces.dofs()}")
 print(f"A: {A.shape}, B: {B.shape}, C_n: {C_n.shape}")
 
 # %% [markdown]
-# ## 2. One Uzawa step by hand, and the projection P⁺ as a QP
+# ## 2. One Uzawa step by hand, and the projection $P^+$ as a QP
 #
-# Algorithm 3.38 starts from λ_n⁰ = 0. Step 3 then solves the saddle-point system
+# Algorithm 3.38 starts from $\lambda_n^0 = 0$. Step 3 then solves the saddle-point system
 # without contact forces: the body falls through the foundation. `solve_linear` does
-# exactly this solve. The vector C_nᵀσ¹ tests σ_n with the coarse hat functions;
-# positive entries are where the contact condition is violated.
+# exactly this solve. The vector $C_n^\top\sigma^1$ tests $\sigma_n$ with the coarse hat
+# functions; positive entries are where the contact condition is violated.
 
 # %%
 first = solve_linear(problem)
@@ -108,14 +121,18 @@ traction = C_n.T @ first.part(*peers.STRESS)
 print(f"C_n^T sigma^1: {np.sum(traction > 0)} of {len(traction)} coarse nodes violate sigma_n <= 0")
 
 # %% [markdown]
-# Step 4 sets λ_n¹ = P⁺(λ_n⁰ + ρ Φ(σ¹)), where Φ represents d_{C,n}(·, σ) in the metric W
-# (3.105) and P⁺ is the W-orthogonal projection onto the cone (3.104). Remark 3.40 and
-# (3.106)-(3.107) turn this into the convex QP
+# Step 4 sets $\lambda_n^1 = P^+(\lambda_n^0 + \rho\,\Phi(\sigma^1))$, where $\Phi$
+# represents $d_{C,n}(\cdot, \sigma)$ in the metric $W$ (3.105) and $P^+$ is the
+# $W$-orthogonal projection onto the cone (3.104). Remark 3.40 and (3.106)-(3.107) turn
+# this into the convex QP
 #
-#     λ_n¹ = argmin_{χ ≥ 0}  ½ χᵀ W χ − χᵀ c,      c = W λ_n⁰ + ρ C_nᵀ σ¹,
+# $$
+# \lambda_n^1 = \operatorname*{argmin}_{\chi \ge 0}\ \tfrac12\,\chi^\top W\chi - \chi^\top c,
+# \qquad c = W\lambda_n^0 + \rho\, C_n^\top\sigma^1,
+# $$
 #
-# so Φ never has to be computed. In cvxpy it is four lines. W is the discrete
-# H^{1/2}(Γ_C) metric `metric_matrix(..., "h12")`: dense, not diagonal.
+# so $\Phi$ never has to be computed. In cvxpy it is four lines. $W$ is the discrete
+# $H^{1/2}(\Gamma_C)$ metric `metric_matrix(..., "h12")`: dense, not diagonal.
 
 # %%
 rho = 1.0
@@ -147,17 +164,17 @@ for key, value in projection_check.items():
 # %% [markdown]
 # cvxpy and ngdual agree (an interior-point solver stops at a tolerance, hence the tight
 # settings; ngdual also re-solves exactly on the active set it finds), and the KKT
-# conditions of the QP (Wλ − c ≥ 0, complementary to λ ≥ 0) hold. Clipping W⁻¹c at
-# zero gives a different vector: in a non-diagonal metric the projection couples the
-# nodes. For the diagonal `"euclidean"` metric W = (E*/2) I the QP has the closed form
-# max(0, c/w), which ngdual uses.
+# conditions of the QP ($W\lambda - c \ge 0$, complementary to $\lambda \ge 0$) hold.
+# Clipping $W^{-1}c$ at zero gives a different vector: in a non-diagonal metric the
+# projection couples the nodes. For the diagonal `"euclidean"` metric
+# $W = (E^*/2)\,I$ the QP has the closed form $\max(0, c/w)$, which ngdual uses.
 #
-# ## 3. The step length ρ and the metric
+# ## 3. The step length $\rho$ and the metric
 #
-# Theorem 3.39: the iteration converges for 0 < ρ < 2α (α the ellipticity constant of
-# ã). ngdual scales W with the plane-strain modulus E*, so ρ is dimensionless and
-# values around 1 work for any E. `uzawa` returns a `Solution` whose `history` holds the
-# relative increment of step 5 for every iteration.
+# Theorem 3.39: the iteration converges for $0 < \rho < 2\alpha$ ($\alpha$ the ellipticity
+# constant of $\tilde a$). ngdual scales $W$ with the plane-strain modulus $E^*$, so
+# $\rho$ is dimensionless and values around 1 work for any $E$. `uzawa` returns a
+# `Solution` whose `history` holds the relative increment of step 5 for every iteration.
 
 # %%
 runs = {}
@@ -170,16 +187,17 @@ for metric in METRICS:
               f"iterations, converged {solution.converged}")
 
 # %% [markdown]
-# For small ρ the contraction factor is about 1 − cρ, so halving ρ doubles the number of
-# iterations.
+# For small $\rho$ the contraction factor is about $1 - c\rho$, so halving $\rho$ doubles
+# the number of iterations.
 #
 # Too large a step and the iteration no longer contracts. A short run is enough to see
-# it: with ρ = 3 the increments stop decreasing after a few steps and the iteration
+# it: with $\rho = 3$ the increments stop decreasing after a few steps and the iteration
 # oscillates (or diverges, in which case `uzawa` raises `ConvergenceError`). Theorem 3.39
-# explains why: λ ↦ P⁺(λ + ρΦ(σ(λ))) is a contraction only for ρ below a bound set by
-# the ellipticity of ã (in ngdual's scaling about 2; where exactly depends on the mesh:
-# on level 4, ρ = 2 already stalls). ngdual reports this through `converged`; it never
-# passes an unconverged iterate off as a solution.
+# explains why: $\lambda \mapsto P^+(\lambda + \rho\,\Phi(\sigma(\lambda)))$ is a
+# contraction only for $\rho$ below a bound set by the ellipticity of $\tilde a$ (in
+# ngdual's scaling about 2; where exactly depends on the mesh: on level 4, $\rho = 2$
+# already stalls). ngdual reports this through `converged`; it never passes an
+# unconverged iterate off as a solution.
 
 # %%
 overshoot = uzawa(problem, UzawaSettings.from_scene(scene, rho=TOO_LARGE_RHO, eps=EPS, metric="h12",
@@ -204,11 +222,11 @@ save_figure(fig, OUT / "uzawa_histories.png")
 # %% [markdown]
 # ## 4. Iterations under refinement (Remark 3.40)
 #
-# The convergence proof works in the H^{1/2}(Γ_C) inner product and carries over to any
-# metric W whose norm is *equivalent* to it; if the equivalence constants do not depend
-# on h, neither does the contraction factor. The `"h12"` metric (a discrete H^{1/2}_{00}
-# interpolation norm) is such a metric. The Euclidean one is not: its equivalence
-# constants degrade like 1/h, and the iteration count grows accordingly.
+# The convergence proof works in the $H^{1/2}(\Gamma_C)$ inner product and carries over to
+# any metric $W$ whose norm is *equivalent* to it; if the equivalence constants do not
+# depend on $h$, neither does the contraction factor. The `"h12"` metric (a discrete
+# $H^{1/2}_{00}$ interpolation norm) is such a metric. The Euclidean one is not: its
+# equivalence constants degrade like $1/h$, and the iteration count grows accordingly.
 
 # %%
 by_level = {metric: [] for metric in METRICS}
@@ -234,9 +252,15 @@ save_figure(fig, OUT / "iterations_per_level.png")
 # %% [markdown]
 # ## 5. An independent check: the whole problem as one QP
 #
-# (3.103) is the KKT system of min ½σᵀAσ − gᵀσ subject to Bᵀσ = b and C_nᵀσ ≤ 0, with
-# λ_n the multiplier of the inequality. `solve_qp` hands this QP to Clarabel through
-# cvxpy and shares nothing with the Uzawa loop but the matrices. Both must agree.
+# (3.103) is the KKT system of
+#
+# $$
+# \min_\sigma\ \tfrac12\,\sigma^\top A\sigma - g^\top\sigma
+# \quad\text{subject to}\quad B^\top\sigma = b,\quad C_n^\top\sigma \le 0,
+# $$
+#
+# with $\lambda_n$ the multiplier of the inequality. `solve_qp` hands this QP to Clarabel
+# through cvxpy and shares nothing with the Uzawa loop but the matrices. Both must agree.
 
 # %%
 tight = uzawa(problem, UzawaSettings.from_scene(scene, rho=1.0, eps=EPS_COMPARE, metric="h12"))
@@ -259,8 +283,8 @@ print("contact residuals of the Uzawa solution:",
       {k: f"{v:.1e}" for k, v in tight.residuals.items()})
 
 # %% [markdown]
-# The traces on Γ_C: σ_n ≤ 0 everywhere, and λ_n − g = −u_n reaches −g (gap closed,
-# λ_n = 0) exactly where σ_n < 0.
+# The traces on $\Gamma_C$: $\sigma_n \le 0$ everywhere, and $\lambda_n - g = -u_n$
+# reaches $-g$ (gap closed, $\lambda_n = 0$) exactly where $\sigma_n < 0$.
 
 # %%
 save_figure(plot_traces(nd.contact_traces(tight),
@@ -269,9 +293,9 @@ save_figure(plot_traces(nd.contact_traces(tight),
 
 # %% [markdown]
 # The stress in the body: the von Mises stress of the Uzawa solution. The corners where
-# the clamped ends meet Γ_C are singular (Tutorial 6), so the colour scale is clipped at
-# the 97th percentile of the element values (stated on the colour bar). In a notebook,
-# NGSolve's webgui adds an interactive view.
+# the clamped ends meet $\Gamma_C$ are singular (Tutorial 6), so the colour scale is
+# clipped at the 97th percentile of the element values (stated on the colour bar). In a
+# notebook, NGSolve's webgui adds an interactive view.
 
 # %%
 mesh = problem.fes.mesh
@@ -300,12 +324,14 @@ print(f"wrote {save_results('03_signorini_uzawa', results)}")
 # ## Exercises
 # Solutions: `tutorials/solutions/03_signorini_uzawa_solutions.py`.
 #
-# 1. **Optimal ρ.** For levels 1-4 and both metrics find the ρ ∈ [0.25, 2.5] with the
-#    fewest iterations (compare Table 3.5 of the thesis). How does ρ_opt move with h?
-# 2. **An L² metric.** Pose P⁺ in the mass-matrix metric W = (E*/2) M / h̃ (scaled so
-#    that it has the units of the others) and run the Uzawa loop with it. Is the mass
-#    matrix H^{1/2}-equivalent? What do the iteration counts do under refinement?
-# 3. **Other gaps.** Solve with g = |x₁| and with g = 0.005 + 0.002 x₁²
+# 1. **Optimal $\rho$.** For levels 1-4 and both metrics find the $\rho \in [0.25, 2.5]$
+#    with the fewest iterations (compare Table 3.5 of the thesis). How does
+#    $\rho_{\mathrm{opt}}$ move with $h$?
+# 2. **An $L^2$ metric.** Pose $P^+$ in the mass-matrix metric
+#    $W = (E^*/2)\,M/\tilde h$ (scaled so that it has the units of the others) and run the
+#    Uzawa loop with it. Is the mass matrix $H^{1/2}$-equivalent? What do the iteration
+#    counts do under refinement?
+# 3. **Other gaps.** Solve with $g = |x_1|$ and with $g = 0.005 + 0.002\,x_1^2$
 #    (`nd.load_scene(..., ["contact.gap='abs(x)'"])`) on level 3 and compare the number of
 #    nodes in contact of the Uzawa and the QP solution. Why does the body not touch the
-#    foundation g = |x₁| at all on level 2?
+#    foundation $g = |x_1|$ at all on level 2?

@@ -1,34 +1,44 @@
 # %% [markdown]
 # # Tutorial 4: Tresca and Coulomb friction, the nested Uzawa algorithm
 #
-# **Problem.** Example 3.46 of the thesis *with* friction: the block [−4,4]×[−1,1],
+# **Problem.** Example 3.46 of the thesis *with* friction: the block $[-4,4]\times[-1,1]$,
 # clamped at its ends, pressed by a parabolic traction on top onto a rigid foundation
-# at distance g below Γ_C. On the contact part the body may stick or slip. With a
-# friction bound 𝓕 ≥ 0 (Tresca: given; Coulomb: 𝓕 = μ_f |σ_n|) the conditions read
+# at distance $g$ below $\Gamma_C$. On the contact part the body may stick or slip. With a
+# friction bound $\mathcal{F} \ge 0$ (Tresca: given; Coulomb:
+# $\mathcal{F} = \mu_f|\sigma_n|$) the conditions read
 #
-#     |σ_t| ≤ 𝓕,   |σ_t| < 𝓕 ⇒ u_t = 0 (stick),   |σ_t| = 𝓕 ⇒ u_t = −κ σ_t, κ ≥ 0 (slip).
+# $$
+# |\sigma_t| \le \mathcal{F}, \qquad
+# |\sigma_t| < \mathcal{F} \Rightarrow u_t = 0 \ \text{(stick)}, \qquad
+# |\sigma_t| = \mathcal{F} \Rightarrow u_t = -\kappa\,\sigma_t,\ \kappa \ge 0 \ \text{(slip)}.
+# $$
 #
 # The dual-dual formulation (3.41) removes the non-differentiable friction work
-# j(λ_t) = ∫ 𝓕|λ_t| with one more multiplier ν ∈ Λ = {|ν| ≤ 1} on A_C = supp 𝓕,
-# "the sign of λ_t" (Remark 3.15): ν λ_t = |λ_t|, σ_t = 𝓕 ν.
+# $j(\lambda_t) = \int_{\Gamma_C} \mathcal{F}|\lambda_t|\,ds$ with one more multiplier
+# $\nu \in \Lambda = \{|\nu| \le 1\}$ on $A_C = \operatorname{supp}\mathcal{F}$, "the sign
+# of $\lambda_t$" (Remark 3.15): $\nu\lambda_t = |\lambda_t|$, $\sigma_t = \mathcal{F}\nu$.
 #
-# **Discretisation.** PEERS for (σ, u, η), P1 multipliers φ on Γ_N and λ_t, λ_n on the
-# coarse mesh h̃ = 2h of Γ_C, and ν piecewise constant on a mesh ĥ = 2h̃ of Γ_C with
-# |ν| ≤ 1: the discrete variational inequality (3.62) with q(κ, μ) = ∫_{Γ_C} 𝓕 κ μ ds.
-# (Why ĥ = 2h̃ and not ĥ = h̃ is the subject of Tutorial 5.)
+# **Discretisation.** PEERS for $(\sigma, u, \eta)$, $P_1$ multipliers $\varphi$ on
+# $\Gamma_N$ and $\lambda_t$, $\lambda_n$ on the coarse mesh $\tilde h = 2h$ of
+# $\Gamma_C$, and $\nu$ piecewise constant on a mesh $\hat h = 2\tilde h$ of $\Gamma_C$
+# with $|\nu| \le 1$: the discrete variational inequality (3.62) with
+# $q(\kappa, \mu) = \int_{\Gamma_C} \mathcal{F}\kappa\mu\,ds$. (Why $\hat h = 2\tilde h$
+# and not $\hat h = \tilde h$ is the subject of Tutorial 5.)
 #
 # **What you will learn.**
-# 1. Algorithm 3.41: an inner Uzawa loop for λ_n (the Signorini problem of Tutorial 3
-#    with a prescribed tangential load) inside an outer loop for ν, and the exchanged
-#    loop order of Remark 3.43; the box projection P^Λ of Remark 3.44.
-# 2. Coulomb friction as a fixed point on 𝓕 = μ_f|σ_n| (Remark 3.45, (3.123)), computed
-#    inside the same outer loop, and a check against an independent QP solver.
-# 3. How to read stick, slip and separation on Γ_C, and why ν is the sign of λ_t.
+# 1. Algorithm 3.41: an inner Uzawa loop for $\lambda_n$ (the Signorini problem of
+#    Tutorial 3 with a prescribed tangential load) inside an outer loop for $\nu$, and the
+#    exchanged loop order of Remark 3.43; the box projection $P^\Lambda$ of Remark 3.44.
+# 2. Coulomb friction as a fixed point on $\mathcal{F} = \mu_f|\sigma_n|$ (Remark 3.45,
+#    (3.123)), computed inside the same outer loop, and a check against an independent
+#    QP solver.
+# 3. How to read stick, slip and separation on $\Gamma_C$, and why $\nu$ is the sign of
+#    $\lambda_t$.
 #
 # **References.** M. Andres, *Dual-dual formulations for frictional contact problems in
-# mechanics*, PhD thesis, Leibniz Universität Hannover, 2011: Sections 3.1.4, 3.2.2 and 3.3.3: eqs.
-# (3.41), (3.42), (3.62), (3.95), (3.123), Algorithm 3.41, Theorem 3.42, Remarks
-# 3.43-3.45, Example 3.46, Figs. 3.19-3.23. M. Maischak, *FEM/BEM methods for
+# mechanics*, PhD thesis, Leibniz Universität Hannover, 2011: Sections 3.1.4, 3.2.2 and
+# 3.3.3: eqs. (3.41), (3.42), (3.62), (3.95), (3.123), Algorithm 3.41, Theorem 3.42,
+# Remarks 3.43-3.45, Example 3.46, Figs. 3.19-3.23. M. Maischak, *FEM/BEM methods for
 # Signorini-type problems* (Habilitation, Hannover 2004), Section 5.3. R. Glowinski,
 # *Numerical methods for nonlinear variational problems* (1984), Chapter II.5.
 
@@ -68,18 +78,26 @@ OUT = output_dir("04_friction")
 print(f"quick mode: {QUICK}; level {LEVEL}; output in {OUT}")
 
 # %% [markdown]
-# ## 1. The friction multiplier ν and the matrix Q_𝓕
+# ## 1. The friction multiplier $\nu$ and the matrix $Q_{\mathcal{F}}$
 #
 # Compared with Tutorial 3, (3.62) has two more lines:
 #
-#     d_{C,t}(μ_t, σ) − q(μ_t, ν) = 0      for all μ_t ∈ C_h̃      (σ_t = 𝓕ν, tested)
-#     q(κ − ν, λ_t) ≤ 0                   for all κ ∈ Λ_ĥ        (ν λ_t = |λ_t|)
+# $$
+# \begin{aligned}
+# d_{C,t}(\mu_t, \sigma) - q(\mu_t, \nu) &= 0 && \forall \mu_t \in C_{\tilde h}
+#   && (\sigma_t = \mathcal{F}\nu \text{, tested}),\\
+# q(\kappa - \nu, \lambda_t) &\le 0 && \forall \kappa \in \Lambda_{\hat h}
+#   && (\nu\lambda_t = |\lambda_t|).
+# \end{aligned}
+# $$
 #
-# In matrices (3.95)-(3.97): the λ_t rows of the saddle-point system get the load
-# Q_𝓕ᵀν, where (Q_𝓕)_{ji} = q(μ_i, κ_j) couples the h̃ hat μ_i with the indicator κ_j
-# of the ĥ edge j. `build_friction_forms` provides everything on Γ_C: σ_n and σ_t on the
-# fine edges as matrices (`T_n @ x`), the ĥ edge of every fine edge, and `q_matrix(F)`.
-# The Tresca scene has the constant bound 𝓕 = 100 (σ_n reaches about −500 under the load).
+# In matrices (3.95)-(3.97): the $\lambda_t$ rows of the saddle-point system get the load
+# $Q_{\mathcal{F}}^\top\nu$, where $(Q_{\mathcal{F}})_{ji} = q(\mu_i, \kappa_j)$ couples the
+# $\tilde h$ hat $\mu_i$ with the indicator $\kappa_j$ of the $\hat h$ edge $j$.
+# `build_friction_forms` provides everything on $\Gamma_C$: $\sigma_n$ and $\sigma_t$ on
+# the fine edges as matrices (`T_n @ x`), the $\hat h$ edge of every fine edge, and
+# `q_matrix(F)`. The Tresca scene has the constant bound $\mathcal{F} = 100$ ($\sigma_n$
+# reaches about $-500$ under the load).
 
 # %%
 tresca = nd.load_scene("thesis-3.46-tresca")
@@ -100,16 +118,20 @@ print(f"fine edges on Gamma_C: {len(forms.lengths)}, h^ edges (nu): {forms.n_nu}
 #
 # The nested Uzawa algorithm alternates two projections:
 #
-# * **inner loop** (steps 4-7): for fixed ν, Algorithm 3.38 on λ_n: solve the saddle
-#   point system with the loads −C_nλ_n and Q_𝓕ᵀν, then λ_n ← P⁺(λ_n + ρ₁Φ(σ));
-# * **outer step** (step 8): ν ← P^Λ(ν + ρ₂ Φ^Λ λ_t), a projected gradient step for ν.
+# * **inner loop** (steps 4-7): for fixed $\nu$, Algorithm 3.38 on $\lambda_n$: solve the
+#   saddle point system with the loads $-C_n\lambda_n$ and $Q_{\mathcal{F}}^\top\nu$, then
+#   $\lambda_n \leftarrow P^+(\lambda_n + \rho_1\Phi(\sigma))$;
+# * **outer step** (step 8): $\nu \leftarrow P^\Lambda(\nu + \rho_2\,\Phi^\Lambda\lambda_t)$,
+#   a projected gradient step for $\nu$.
 #
-# Remark 3.44 poses P^Λ like P⁺ (Remark 3.40) as a QP in the mass matrix M of L_ĥ:
-# ν = argmin_{|ψ_j| ≤ 1} ½ψᵀMψ − ψᵀb. ν is piecewise constant, so M is *diagonal* and
-# the QP decouples into clip(b/M, −1, 1); unlike P⁺ in the dense H^{1/2} metric W,
-# here clipping is exact. ngdual uses the closed form (by default with M scaled by the
-# diagonal of the ν operator, `friction_metric="jacobi"`, still diagonal); the cvxpy QP
-# agrees.
+# Remark 3.44 poses $P^\Lambda$ like $P^+$ (Remark 3.40) as a QP in the mass matrix $M$ of
+# $L_{\hat h}$:
+# $\nu = \operatorname{argmin}_{|\psi_j| \le 1} \tfrac12\psi^\top M\psi - \psi^\top b$.
+# $\nu$ is piecewise constant, so $M$ is *diagonal* and the QP decouples into
+# $\operatorname{clip}(b/M, -1, 1)$; unlike $P^+$ in the dense $H^{1/2}$ metric $W$, here
+# clipping is exact. ngdual uses the closed form (by default with $M$ scaled by the
+# diagonal of the $\nu$ operator, `friction_metric="jacobi"`, still diagonal); the cvxpy
+# QP agrees.
 
 # %%
 rng = np.random.default_rng(3)
@@ -120,10 +142,11 @@ print(f"P^Lambda: |cvxpy QP - clip(b / M, -1, 1)| = {box_qp_difference:.1e}")
 
 # %% [markdown]
 # `nested_uzawa` runs Algorithm 3.41 (`loop_order="friction-outer"`) or, with the loops
-# exchanged (Remark 3.43), an inner loop for ν at fixed λ_n inside an outer loop for
-# λ_n (`"contact-outer"`). ρ₂ is dimensionless (relative to the computed stability
-# bound of the ν step, see `FrictionStep`), so 0 < ρ₂ < 2 converges for any E and load.
-# It stops only when the increments *and* the residual of ν λ_t = |λ_t| are below ε₂.
+# exchanged (Remark 3.43), an inner loop for $\nu$ at fixed $\lambda_n$ inside an outer
+# loop for $\lambda_n$ (`"contact-outer"`). $\rho_2$ is dimensionless (relative to the
+# computed stability bound of the $\nu$ step, see `FrictionStep`), so $0 < \rho_2 < 2$
+# converges for any $E$ and load. It stops only when the increments *and* the residual of
+# $\nu\lambda_t = |\lambda_t|$ are below $\varepsilon_2$.
 
 # %%
 tresca_runs = {order: nested_uzawa(problem_t, NestedUzawaSettings.from_scene(
@@ -134,9 +157,10 @@ for order, solution in tresca_runs.items():
           f"{solution.iterations['inner']:5d} inner iterations, converged {solution.converged}")
 
 # %% [markdown]
-# With ν outside (Algorithm 3.41) each outer step solves a whole contact problem, so
-# there are few outer and many inner steps; exchanged, the cheap ν iteration runs inside.
-# Both reach the same discrete solution: (3.62) has a unique σ, and with ĥ = 2h̃ a unique ν.
+# With $\nu$ outside (Algorithm 3.41) each outer step solves a whole contact problem, so
+# there are few outer and many inner steps; exchanged, the cheap $\nu$ iteration runs
+# inside. Both reach the same discrete solution: (3.62) has a unique $\sigma$, and with
+# $\hat h = 2\tilde h$ a unique $\nu$.
 
 # %%
 def relative(a, b) -> float:
@@ -148,15 +172,21 @@ loop_order_difference = {"tresca": relative(second.x, first.x)}
 print(f"Tresca: the two loop orders differ by {loop_order_difference['tresca']:.1e} (relative)")
 
 # %% [markdown]
-# ## 3. An independent check: one QP in (σ, ν)
+# ## 3. An independent check: one QP in $(\sigma, \nu)$
 #
-# For a *given* 𝓕, (3.62) is the KKT system of
+# For a *given* $\mathcal{F}$, (3.62) is the KKT system of
 #
-#     min ½σᵀAσ − gᵀσ   subject to   Bᵀσ − (0, 0, 0, Q_𝓕ᵀν) = b,   C_nᵀσ ≤ 0,   |ν_j| ≤ 1,
+# $$
+# \min_{\sigma, \nu}\ \tfrac12\,\sigma^\top A\sigma - g^\top\sigma
+# \quad\text{subject to}\quad
+# B^\top\sigma - (0, 0, 0, Q_{\mathcal{F}}^\top\nu) = b, \quad
+# C_n^\top\sigma \le 0, \quad |\nu_j| \le 1,
+# $$
 #
-# whose multipliers are (u, η, φ, λ_t) and λ_n ≥ 0; stationarity in ν is exactly
-# ν_j = sign(Q_𝓕λ_t)_j, i.e. (3.62)₇. `solve_qp_friction` hands this QP to Clarabel.
-# It shares only the matrices with the nested Uzawa loops.
+# whose multipliers are $(u, \eta, \varphi, \lambda_t)$ and $\lambda_n \ge 0$;
+# stationarity in $\nu$ is exactly $\nu_j = \operatorname{sign}(Q_{\mathcal{F}}\lambda_t)_j$,
+# i.e. $(3.62)_7$. `solve_qp_friction` hands this QP to Clarabel. It shares only the
+# matrices with the nested Uzawa loops.
 
 
 # %%
@@ -178,15 +208,17 @@ agreement = {"tresca": compare(tresca_runs["friction-outer"], qp_tresca)}
 print("nested Uzawa vs QP, Tresca:", {k: f"{v:.1e}" for k, v in agreement["tresca"].items()})
 
 # %% [markdown]
-# ## 4. Coulomb friction: a fixed point on 𝓕
+# ## 4. Coulomb friction: a fixed point on $\mathcal{F}$
 #
-# Coulomb's law makes the bound depend on the solution, 𝓕 = μ_f|σ_n|: a quasi-variational
-# inequality. Solving Tresca problems for 𝓕ᵏ⁺¹ = μ_f|σ_nᵏ| in turn would add a third loop.
-# Remark 3.45 instead updates 𝓕 *inside* the outer loop of Algorithm 3.41, before each
-# ν step (steps 8'-10'), starting from the frictionless solution. 𝓕 must live in L_ĥ,
-# so (3.123) averages |σ_n| over every ĥ edge: `forms.coulomb_bound_of(sigma_n, mu_f)`.
-# (ngdual uses by default the σ_n that the contact conditions actually see, its
-# projection onto the h̃ hats, so that 𝓕 vanishes where the body separates; see
+# Coulomb's law makes the bound depend on the solution, $\mathcal{F} = \mu_f|\sigma_n|$:
+# a quasi-variational inequality. Solving Tresca problems for
+# $\mathcal{F}^{k+1} = \mu_f|\sigma_n^k|$ in turn would add a third loop. Remark 3.45
+# instead updates $\mathcal{F}$ *inside* the outer loop of Algorithm 3.41, before each
+# $\nu$ step (steps 8'-10'), starting from the frictionless solution. $\mathcal{F}$ must
+# live in $L_{\hat h}$, so (3.123) averages $|\sigma_n|$ over every $\hat h$ edge:
+# `forms.coulomb_bound_of(sigma_n, mu_f)`. (ngdual uses by default the $\sigma_n$ that the
+# contact conditions actually see, its projection onto the $\tilde h$ hats, so that
+# $\mathcal{F}$ vanishes where the body separates; see
 # `ngdual.scene.Friction.normal_stress`.)
 
 # %%
@@ -201,8 +233,8 @@ loop_order_difference["coulomb"] = relative(second.x, first.x)
 coulomb_solution = coulomb_runs["friction-outer"]
 
 # %% [markdown]
-# At convergence 𝓕 is a fixed point: recomputing it from the final σ_n returns the
-# 𝓕 the final solution was computed with.
+# At convergence $\mathcal{F}$ is a fixed point: recomputing it from the final $\sigma_n$
+# returns the $\mathcal{F}$ the final solution was computed with.
 
 # %%
 forms_c = build_friction_forms(problem_c)
@@ -213,8 +245,9 @@ fixed_point_residual = float(np.max(np.abs(F_again - coulomb_solution.friction_b
 print(f"max |F(sigma_n) - F| / max F = {fixed_point_residual:.1e}")
 
 # %% [markdown]
-# The reference solver iterates the QP of Section 3 on 𝓕 by successive substitution,
-# a genuinely *third* loop. Its history shows how fast the fixed point contracts.
+# The reference solver iterates the QP of Section 3 on $\mathcal{F}$ by successive
+# substitution, a genuinely *third* loop. Its history shows how fast the fixed point
+# contracts.
 
 # %%
 qp_coulomb = solve_qp_friction(problem_c, Model.of(coulomb))
@@ -225,8 +258,9 @@ print("nested Uzawa vs QP, Coulomb:", {k: f"{v:.1e}" for k, v in agreement["coul
 
 # %% [markdown]
 # A third route to the same discrete solution: ngdual's default solver (`solve_problem`
-# with `solver.method = "auto"`) condenses (3.62) onto Γ_C and solves the small contact
-# problem there by a semismooth Newton method, with the same fixed point on 𝓕. It is
+# with `solver.method = "auto"`) condenses (3.62) onto $\Gamma_C$ and solves the small
+# contact problem there by a semismooth Newton method, with the same fixed point on
+# $\mathcal{F}$. It is
 # the faster choice in practice; the nested Uzawa algorithm is what the thesis analyses
 # (Theorem 3.42), and what this tutorial is about.
 
@@ -253,18 +287,23 @@ ax.legend(fontsize=8)
 save_figure(fig, OUT / "outer_histories.png")
 
 # %% [markdown]
-# ## 5. Stick, slip and separation on Γ_C
+# ## 5. Stick, slip and separation on $\Gamma_C$
 #
-# What the discrete solution satisfies, tested with the h̃ hats μ_i (Proposition 3.25):
+# What the discrete solution satisfies, tested with the $\tilde h$ hats $\mu_i$
+# (Proposition 3.25):
 #
-# * λ_n ≥ 0 (no penetration), ∫σ_nμ_i ≤ 0 (compression only), λ_n·∫σ_nμ_i = 0;
-# * |∫σ_tμ_i| ≤ ∫𝓕μ_i (the friction cone, tested), and ∫σ_tμ_i = q(μ_i, ν) exactly;
-# * |ν| ≤ 1 and ν = sign(Q_𝓕λ_t) wherever Q_𝓕λ_t ≠ 0 ((3.62)₇, Remark 3.15).
+# * $\lambda_n \ge 0$ (no penetration), $\int\sigma_n\mu_i \le 0$ (compression only),
+#   $\lambda_n \cdot \int\sigma_n\mu_i = 0$;
+# * $|\int\sigma_t\mu_i| \le \int\mathcal{F}\mu_i$ (the friction cone, tested), and
+#   $\int\sigma_t\mu_i = q(\mu_i, \nu)$ exactly;
+# * $|\nu| \le 1$ and $\nu = \operatorname{sign}(Q_{\mathcal{F}}\lambda_t)$ wherever
+#   $Q_{\mathcal{F}}\lambda_t \ne 0$ ($(3.62)_7$, Remark 3.15).
 #
-# The pointwise σ_n of the fine edges is *not* constrained: the RT₀ normal trace of
-# PEERS oscillates on the fine scale, and only its hat moments enter (3.62). A node is
-# in **separation** where λ_n > 0 (gap open), in **slip** where |ν| = 1 on an ĥ edge
-# under its hat, else in **stick**. `post.friction_diagnostics` classifies them.
+# The pointwise $\sigma_n$ of the fine edges is *not* constrained: the $RT_0$ normal trace
+# of PEERS oscillates on the fine scale, and only its hat moments enter (3.62). A node is
+# in **separation** where $\lambda_n > 0$ (gap open), in **slip** where $|\nu| = 1$ on an
+# $\hat h$ edge under its hat, else in **stick**. `post.friction_diagnostics` classifies
+# them.
 
 
 # %%
@@ -314,11 +353,13 @@ for law, summary in summaries.items():
           f"F_abs = {summary['F_abs']:.1f}")
 
 # %% [markdown]
-# Along Γ_C: the hat-averaged stresses (markers) against the bound ±𝓕, the sign ν, and
-# the multipliers with the status of every h̃ node. ν = ±1 where the body slips, with
-# the sign of λ_t = −u_t (Fig. 3.21(b)); in the stick zone λ_t ≈ 0 and ν = σ_t/𝓕 lies
-# strictly inside (−1, 1) (3.43). Tresca's bound acts even where the body does not touch
-# the foundation, a known weakness of the model; Coulomb's 𝓕 = μ_f|σ_n| vanishes there.
+# Along $\Gamma_C$: the hat-averaged stresses (markers) against the bound
+# $\pm\mathcal{F}$, the sign $\nu$, and the multipliers with the status of every
+# $\tilde h$ node. $\nu = \pm 1$ where the body slips, with the sign of
+# $\lambda_t = -u_t$ (Fig. 3.21(b)); in the stick zone $\lambda_t \approx 0$ and
+# $\nu = \sigma_t/\mathcal{F}$ lies strictly inside $(-1, 1)$ (3.43). Tresca's bound acts
+# even where the body does not touch the foundation, a known weakness of the model;
+# Coulomb's $\mathcal{F} = \mu_f|\sigma_n|$ vanishes there.
 
 # %%
 STATUS_COLOURS = {"separation": "0.6", "stick": "tab:blue", "slip": "tab:red"}
@@ -374,9 +415,9 @@ plot_zones(tresca_runs["friction-outer"], f"Tresca, F = 100, level {LEVEL}",
 plot_zones(coulomb_solution, f"Coulomb, mu_f = {mu_f}, level {LEVEL}", OUT / "zones_coulomb.png")
 
 # %% [markdown]
-# The stress in the body under Coulomb friction (von Mises; the corners where Γ_D meets
-# Γ_C are singular, so the colour scale is clipped at the 97th percentile, as stated on
-# the colour bar). In a notebook the webgui view follows.
+# The stress in the body under Coulomb friction (von Mises; the corners where $\Gamma_D$
+# meets $\Gamma_C$ are singular, so the colour scale is clipped at the 97th percentile, as
+# stated on the colour bar). In a notebook the webgui view follows.
 
 # %%
 sigma_c = nd.fields(coulomb_solution).sigma
@@ -408,10 +449,12 @@ print(f"wrote {save_results('04_friction', results)}")
 # Solutions: `tutorials/solutions/04_friction_solutions.py`.
 #
 # 1. **Step lengths.** For Coulomb friction on level 3, count the outer and inner
-#    iterations of both loop orders for ρ₁ ∈ {0.5, 1, 1.5} and ρ₂ ∈ {0.25, 0.5, 1, 1.5}
-#    (cf. Fig. 3.23). Which loop order is cheaper, counted in inner iterations (each is
-#    one solve)? What happens for ρ₂ = 2.5, beyond the bound of Theorem 3.42?
-# 2. **The friction coefficient.** Solve the Coulomb scene for μ_f ∈ {0, 0.1, 0.25, 0.5,
-#    1} (`friction.mu`). How do the numbers of stick and slip nodes and the total force
-#    F_abs = ∫_{A_C}|σ_n| + |σ_t| change? Check that μ_f = 0 reproduces the frictionless
-#    Uzawa solution of Tutorial 3.
+#    iterations of both loop orders for $\rho_1 \in \{0.5, 1, 1.5\}$ and
+#    $\rho_2 \in \{0.25, 0.5, 1, 1.5\}$ (cf. Fig. 3.23). Which loop order is cheaper,
+#    counted in inner iterations (each is one solve)? What happens for $\rho_2 = 2.5$,
+#    beyond the bound of Theorem 3.42?
+# 2. **The friction coefficient.** Solve the Coulomb scene for
+#    $\mu_f \in \{0, 0.1, 0.25, 0.5, 1\}$ (`friction.mu`). How do the numbers of stick and
+#    slip nodes and the total force
+#    $F_{\mathrm{abs}} = \int_{A_C}|\sigma_n| + |\sigma_t|\,ds$ change? Check that
+#    $\mu_f = 0$ reproduces the frictionless Uzawa solution of Tutorial 3.

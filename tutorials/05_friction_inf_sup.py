@@ -1,30 +1,34 @@
 # %% [markdown]
 # # Tutorial 5: Why ĥ = 2h̃: the inf-sup condition of the friction multiplier
 #
-# **Problem.** Example 3.46 with Coulomb friction and *no* initial gap, g ≡ 0: the whole
-# of Γ_C touches the foundation, so the friction zone A_C = supp 𝓕 reaches the ends of
-# Γ_C. Is the friction multiplier ν of (3.62) (Tutorial 4) then still determined by the
-# discrete problem?
+# **Problem.** Example 3.46 with Coulomb friction and *no* initial gap, $g \equiv 0$: the
+# whole of $\Gamma_C$ touches the foundation, so the friction zone
+# $A_C = \operatorname{supp}\mathcal{F}$ reaches the ends of $\Gamma_C$. Is the friction
+# multiplier $\nu$ of (3.62) (Tutorial 4) then still determined by the discrete problem?
 #
-# **Discretisation.** PEERS for (σ, u, η), P1 multipliers λ_t, λ_n on the mesh h̃ = 2h of
-# Γ_C (vanishing at the ends of Γ_C), and ν piecewise constant on a mesh ĥ of Γ_C; ĥ = h̃
-# or ĥ = 2h̃ (`contact.hhat_factor` 1 or 2). ν enters only through
-# q(κ, μ) = ∫_{Γ_C} 𝓕 κ μ ds, i.e. through the matrix Q_𝓕 of (3.95).
+# **Discretisation.** PEERS for $(\sigma, u, \eta)$, $P_1$ multipliers $\lambda_t$,
+# $\lambda_n$ on the mesh $\tilde h = 2h$ of $\Gamma_C$ (vanishing at the ends of
+# $\Gamma_C$), and $\nu$ piecewise constant on a mesh $\hat h$ of $\Gamma_C$;
+# $\hat h = \tilde h$ or $\hat h = 2\tilde h$ (`contact.hhat_factor` 1 or 2). $\nu$ enters
+# only through $q(\kappa, \mu) = \int_{\Gamma_C} \mathcal{F}\kappa\mu\,ds$, i.e. through
+# the matrix $Q_{\mathcal{F}}$ of (3.95).
 #
 # **What you will learn.**
-# 1. A counting argument: with ĥ = h̃ there is one ν more than there are hats to test
-#    it, so Q_𝓕ᵀ has a kernel, the checkerboard ν = (+1, −1, +1, …).
-# 2. How to compute the discrete inf-sup constant of q (3.72) as a smallest singular
-#    value, and that it is bounded below for ĥ = 2h̃ (Lemma 3.29), or for ĥ = h̃ when 𝓕
-#    vanishes near the ends of Γ_C (assumption (3.73), Lemma 3.31).
+# 1. A counting argument: with $\hat h = \tilde h$ there is one $\nu$ more than there are
+#    hats to test it, so $Q_{\mathcal{F}}^\top$ has a kernel, the checkerboard
+#    $\nu = (+1, -1, +1, \dots)$.
+# 2. How to compute the discrete inf-sup constant of $q$ (3.72) as a smallest singular
+#    value, and that it is bounded below for $\hat h = 2\tilde h$ (Lemma 3.29), or for
+#    $\hat h = \tilde h$ when $\mathcal{F}$ vanishes near the ends of $\Gamma_C$
+#    (assumption (3.73), Lemma 3.31).
 # 3. What the solver sees: without the inf-sup condition the nested Uzawa algorithm
 #    needs many more steps or stalls, and its error message names the remedy.
 #
 # **References.** M. Andres, *Dual-dual formulations for frictional contact problems in
 # mechanics*, PhD thesis, Leibniz Universität Hannover, 2011: Sections 3.2.2 and 3.3.3:
-# eqs. (3.72)-(3.74), (3.95), Lemmas 3.29 and 3.31, Remark 3.30, Algorithm 3.41, Example 3.46, Figs.
-# 3.24-3.28. F. Brezzi, M. Fortin, *Mixed and hybrid finite element methods*, Springer
-# 1991, Chapter II (discrete inf-sup conditions).
+# eqs. (3.72)-(3.74), (3.95), Lemmas 3.29 and 3.31, Remark 3.30, Algorithm 3.41,
+# Example 3.46, Figs. 3.24-3.28. F. Brezzi, M. Fortin, *Mixed and hybrid finite element
+# methods*, Springer 1991, Chapter II (discrete inf-sup conditions).
 
 # %% [markdown]
 # ## Parameters
@@ -57,8 +61,8 @@ print(f"quick mode: {QUICK}; levels {GAP0_LEVELS}; output in {OUT}")
 # %% [markdown]
 # ## The scene
 #
-# The g = 0 variant of Example 3.46 with Coulomb friction: Γ_D the clamped ends, Γ_N the
-# loaded top, Γ_C the bottom, now in contact along its whole length.
+# The $g = 0$ variant of Example 3.46 with Coulomb friction: $\Gamma_D$ the clamped ends,
+# $\Gamma_N$ the loaded top, $\Gamma_C$ the bottom, now in contact along its whole length.
 
 # %%
 gap0 = {factor: nd.load_scene("thesis-3.46-coulomb-gap0", [f"contact.hhat_factor={factor}"])
@@ -69,18 +73,26 @@ save_figure(plot_geometry(gap0[2], level=GAP0_LEVELS[0],
             OUT / "geometry.png")
 
 # %% [markdown]
-# ## 1. Counting: why ĥ = 2h̃
+# ## 1. Counting: why $\hat h = 2\tilde h$
 #
-# With g = 0 the whole of Γ_C touches, A_C = Γ_C, and assumption (3.73) (A_C keeps a
-# distance from ∂Γ_C) fails. Count: λ_t vanishes at the ends of Γ_C, so C_h̃ has N_C
-# interior hats, while L_ĥ with ĥ = h̃ has one ν per h̃ edge, N_A = N_C + 1. Then
-# Q_𝓕ᵀ: ℝ^{N_A} → ℝ^{N_C} *must* have a kernel. For 𝓕 ≡ 1 it is the checkerboard
-# κ = (+1, −1, +1, …): every hat covers two neighbouring edges of equal length and sees
-# ∫μ_iκ = (h̃/2)(κ_i + κ_{i+1}) = 0. Such a ν changes nothing in (3.62)₅, so ν is not
-# unique and the discrete inf-sup condition (3.74) fails. With ĥ = 2h̃ every ĥ edge has an
-# h̃ node in its middle whose hat lies inside it (proof of Lemma 3.29); the constant of
-# (3.72), measured in W (H^{1/2} on C_h̃) and ‖κ‖²_{−1/2,ĥ} = ĥ‖κ‖²_{L²} (Remark 3.30), is
-# then the smallest singular value of (ĥM)^{−1/2} Q_𝓕 W^{−1/2}.
+# With $g = 0$ the whole of $\Gamma_C$ touches, $A_C = \Gamma_C$, and assumption (3.73)
+# ($A_C$ keeps a distance from $\partial\Gamma_C$) fails. Count: $\lambda_t$ vanishes at
+# the ends of $\Gamma_C$, so $C_{\tilde h}$ has $N_C$ interior hats, while $L_{\hat h}$
+# with $\hat h = \tilde h$ has one $\nu$ per $\tilde h$ edge, $N_A = N_C + 1$. Then
+# $Q_{\mathcal{F}}^\top : \mathbb{R}^{N_A} \to \mathbb{R}^{N_C}$ *must* have a kernel. For
+# $\mathcal{F} \equiv 1$ it is the checkerboard $\kappa = (+1, -1, +1, \dots)$: every hat
+# covers two neighbouring edges of equal length and sees
+#
+# $$
+# \int_{\Gamma_C} \mu_i\kappa\,ds = \frac{\tilde h}{2}\,(\kappa_i + \kappa_{i+1}) = 0 .
+# $$
+#
+# Such a $\nu$ changes nothing in $(3.62)_5$, so $\nu$ is not unique and the discrete
+# inf-sup condition (3.74) fails. With $\hat h = 2\tilde h$ every $\hat h$ edge has an
+# $\tilde h$ node in its middle whose hat lies inside it (proof of Lemma 3.29); the
+# constant of (3.72), measured in $W$ ($H^{1/2}$ on $C_{\tilde h}$) and
+# $\|\kappa\|^2_{-1/2,\hat h} = \hat h\,\|\kappa\|^2_{L^2}$ (Remark 3.30), is then the
+# smallest singular value of $(\hat h M)^{-1/2} Q_{\mathcal{F}} W^{-1/2}$.
 
 
 # %%
@@ -112,8 +124,9 @@ for level in GAP0_LEVELS:
 print("kernel of Q_F^T for h^ = h~ on level 1:", inf_sup_rows[0][1]["kernel"])
 
 # %% [markdown]
-# A picture of the kernel on level 1: every hat μ_i of C_h̃ covers two ĥ = h̃ edges of
-# equal length with opposite ν, so ∫ 𝓕 μ_i ν = 0 for all i.
+# A picture of the kernel on level 1: every hat $\mu_i$ of $C_{\tilde h}$ covers two
+# $\hat h = \tilde h$ edges of equal length with opposite $\nu$, so
+# $\int \mathcal{F}\mu_i\nu\,ds = 0$ for all $i$.
 
 # %%
 kernel = np.array(inf_sup_rows[0][1]["kernel"])
@@ -136,9 +149,10 @@ ax.grid(alpha=0.3)
 save_figure(fig, OUT / "checkerboard.png")
 
 # %% [markdown]
-# β stays the same on every level for ĥ = 2h̃ (in the mesh-dependent norm of Lemma 3.29).
-# If instead 𝓕 vanishes near the ends of Γ_C (assumption (3.73)), the hats next to the
-# ends of A_C pin the checkerboard and ĥ = h̃ is fine (Lemma 3.31):
+# $\beta$ stays the same on every level for $\hat h = 2\tilde h$ (in the mesh-dependent
+# norm of Lemma 3.29). If instead $\mathcal{F}$ vanishes near the ends of $\Gamma_C$
+# (assumption (3.73)), the hats next to the ends of $A_C$ pin the checkerboard and
+# $\hat h = \tilde h$ is fine (Lemma 3.31):
 
 # %%
 scene = gap0[1]
@@ -151,10 +165,10 @@ print(f"h^ = h~, F = 1 on |x1| < 1.5 only: N_A = {inner['N_A']} <= N_C = {inner[
 # %% [markdown]
 # ## 2. What the solver sees
 #
-# What the solver sees: the nested Uzawa iteration on the g = 0 scene with both choices.
-# With ĥ = h̃ it needs many more outer steps where it converges at all, and on some
-# levels it stalls: then `nested_uzawa` raises `ConvergenceError`, whose message names
-# the remedy `contact.hhat_factor = 2`.
+# What the solver sees: the nested Uzawa iteration on the $g = 0$ scene with both
+# choices. With $\hat h = \tilde h$ it needs many more outer steps where it converges at
+# all, and on some levels it stalls: then `nested_uzawa` raises `ConvergenceError`, whose
+# message names the remedy `contact.hhat_factor = 2`.
 
 # %%
 gap0_runs = {1: [], 2: []}
@@ -208,9 +222,11 @@ print(f"wrote {save_results('05_friction_inf_sup', results)}")
 # ## Exercises
 # Solutions: `tutorials/solutions/05_friction_inf_sup_solutions.py`.
 #
-# 1. **ĥ = h̃ is fine under (3.73).** Solve `thesis-3.46-coulomb-gap-abs` (g = |x₁|) with
-#    `contact.hhat_factor` 1 and 2 on level 4 and compare λ_n, λ_t and ν (Figs. 3.26-3.28).
-#    Why do both converge here, unlike for g = 0?
-# 2. **A variable friction bound.** Compute the kernel of Q_𝓕ᵀ for ĥ = h̃ and
-#    𝓕 = 1 + x₁² (`inf_sup(problem, F)` above) on level 2. Is it still a checkerboard?
-#    Why can no choice of 𝓕 > 0 on all of Γ_C remove the kernel?
+# 1. **$\hat h = \tilde h$ is fine under (3.73).** Solve `thesis-3.46-coulomb-gap-abs`
+#    ($g = |x_1|$) with `contact.hhat_factor` 1 and 2 on level 4 and compare $\lambda_n$,
+#    $\lambda_t$ and $\nu$ (Figs. 3.26-3.28). Why do both converge here, unlike for
+#    $g = 0$?
+# 2. **A variable friction bound.** Compute the kernel of $Q_{\mathcal{F}}^\top$ for
+#    $\hat h = \tilde h$ and $\mathcal{F} = 1 + x_1^2$ (`inf_sup(problem, F)` above) on
+#    level 2. Is it still a checkerboard? Why can no choice of $\mathcal{F} > 0$ on all of
+#    $\Gamma_C$ remove the kernel?

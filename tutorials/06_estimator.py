@@ -1,31 +1,39 @@
 # %% [markdown]
 # # Tutorial 6: The a posteriori error estimator of Chapter 4
 #
-# **Problem.** Given a discrete solution (σ_h, ν_h; u_h, η_h, φ_h, λ_t, λ_n) of (3.62),
-# how large is its error, and *where* is it made? Theorem 4.8 bounds the error in
-# X × H^{-1/2}(A_C) × Ỹ by computable local quantities,
+# **Problem.** Given a discrete solution
+# $(\sigma_h, \nu_h; u_h, \eta_h, \varphi_h, \lambda_t, \lambda_n)$ of (3.62), how large is
+# its error, and *where* is it made? Theorem 4.8 bounds the error in
+# $X \times H^{-1/2}(A_C) \times \tilde Y$ by computable local quantities,
 #
-#     ‖error‖ ≤ C Σ_T η_{tot,T},   η²_{tot,T} = η²_{σ,T} + η²_{u,T} + η²_{𝓕,T} + η²_{N,T}
+# \begin{equation*}
+# \|\text{error}\| \le C \sum_T \eta_{tot,T}, \qquad
+# \eta_{tot,T}^2 = \eta_{\sigma,T}^2 + \eta_{u,T}^2 + \eta_{\mathcal{F},T}^2 + \eta_{N,T}^2
+# \tag{4.50}
+# \end{equation*}
 #
-# ((4.49)-(4.50))
+# (with (4.49)), with $\eta_{\sigma,T}$ of (4.15) (residuals of the stress equations),
+# $\eta_{u,T}$ of (4.31) (residuals of the displacement), the friction term
+# $\hat h\,\|\sigma_t - \mathcal{F}\nu\|^2$ on $A_C$ and the Neumann term
+# $\log(1 + \tilde C_N)\,\tilde h\,\|\sigma n - t_0\|^2$ on $\Gamma_N$.
 #
-# with η_{σ,T} of (4.15) (residuals of the stress equations), η_{u,T} of (4.31)
-# (residuals of the displacement), the friction term ĥ‖σ_t − 𝓕ν‖² on A_C and the
-# Neumann term log(1 + C̃_N) h̃‖σn − t₀‖² on Γ_N.
-#
-# **Discretisation.** PEERS (3.61) on the fine mesh, P1 multipliers on the coarse
+# **Discretisation.** PEERS (3.61) on the fine mesh, $P_1$ multipliers on the coarse
 # boundary meshes. The indicators are element and edge integrals of the discrete fields;
-# `w_h = C⁻¹σ_h + η_h` (the rotation as a skew tensor) approximates ∇u.
+# $w_h = \mathbb{C}^{-1}\sigma_h + \eta_h$ (the rotation as a skew tensor) approximates
+# $\nabla u$.
 #
 # **What you will learn.**
 # 1. Every term of (4.50): what residual it measures, and where on the mesh it lives
-#    (Example 3.46 with Coulomb friction: corners, Γ_N, the ends of Γ_C, A_C).
+#    (Example 3.46 with Coulomb friction: corners, $\Gamma_N$, the ends of $\Gamma_C$,
+#    $A_C$).
 # 2. `ngdual.estimator.estimate` returns one array per term and element (an
 #    `Estimate`); how to sum, split and plot it.
-# 3. The *effectivity index* η / error on a smooth problem with known solution: it stays
-#    in a narrow band, and η decreases at the rate of the error.
-# 4. Why ngdual measures the asymmetry as(σ_h) in L² and not in H(div) as printed in
-#    (4.15): for PEERS ‖div as(σ_h)‖ does not tend to zero (cf. Table 4.2).
+# 3. The *effectivity index* $\eta/e$ on a smooth problem with known solution: it stays
+#    in a narrow band, and $\eta$ decreases at the rate of the error.
+# 4. Why ngdual measures the asymmetry $\operatorname{as}(\sigma_h)$ in $L^2$ and not in
+#    $H(\operatorname{div})$ as printed in (4.15): for PEERS
+#    $\|\operatorname{div}\operatorname{as}(\sigma_h)\|$ does not tend to zero
+#    (cf. Table 4.2).
 #
 # **References.** M. Andres, *Dual-dual formulations for frictional contact problems in
 # mechanics*, PhD thesis, Leibniz Universität Hannover, 2011:
@@ -72,25 +80,33 @@ print(f"quick mode: {QUICK}; output in {OUT}")
 # %% [markdown]
 # ## 1. The terms of (4.50)
 #
-# With t the unit tangent, [·] the jump across an interior edge, u_Γ the value of the
-# piecewise constant u_h at a boundary edge and h̃_e the coarse edge holding e:
+# With $t$ the unit tangent, $[\cdot]$ the jump across an interior edge, $u_\Gamma$ the
+# value of the piecewise constant $u_h$ at a boundary edge and $\tilde h_e$ the coarse
+# edge holding $e$:
 #
-# | name | formula | residual of |
-# |---|---|---|
-# | `residual` | ‖f + div σ_h‖²_T | equilibrium div σ = −f |
-# | `asymmetry` | ‖as(σ_h)‖²_T | symmetry of σ (see Section 4) |
-# | `curl` | h_T² ‖curl w_h‖²_T | w_h = ∇u is a gradient |
-# | `jump_interior` | Σ h_e ‖[w_h t]‖²_e | tangential continuity of ∇u |
-# | `jump_dirichlet` | Σ h_e ‖w_h t − ∂_t u_D‖²_e | u = u_D on Γ_D |
-# | `jump_neumann` | Σ h_e ‖w_h t + ∂_t φ‖²_e | φ = −u on Γ_N |
-# | `jump_contact` | Σ h_e ‖w_h t + ∂_tλ_t t + ∂_t(λ_n − g) n‖²_e | λ = −u on Γ_C (λ_n − g = −u_n) |
-# | `u_volume` | h_T² ‖w_h‖²_T | (4.31): u_h against ∇u |
-# | `u_dirichlet`, `u_neumann`, `u_contact` | Σ h_e ‖…‖²_e | the same traces for u_Γ itself |
-# | `friction` | Σ h̃_e ‖σ_t − 𝓕ν‖²_e on A_C | (3.62)₅ pointwise |
-# | `neumann` | log(1+C̃_N) Σ h̃_e ‖σn − t₀‖²_e | the traction t₀ on Γ_N |
+# * `residual`: $\|f + \operatorname{div}\sigma_h\|_T^2$, the equilibrium
+#   $\operatorname{div}\sigma = -f$;
+# * `asymmetry`: $\|\operatorname{as}(\sigma_h)\|_T^2$, the symmetry of $\sigma$ (see
+#   Section 5);
+# * `curl`: $h_T^2\,\|\operatorname{curl} w_h\|_T^2$, $w_h = \nabla u$ is a gradient;
+# * `jump_interior`: $\sum_e h_e\,\|[w_h t]\|_e^2$, the tangential continuity of $\nabla u$;
+# * `jump_dirichlet`: $\sum_e h_e\,\|w_h t - \partial_t u_D\|_e^2$, $u = u_D$ on $\Gamma_D$;
+# * `jump_neumann`: $\sum_e h_e\,\|w_h t + \partial_t\varphi\|_e^2$, $\varphi = -u$ on
+#   $\Gamma_N$;
+# * `jump_contact`:
+#   $\sum_e h_e\,\|w_h t + \partial_t\lambda_t\,t + \partial_t(\lambda_n - g)\,n\|_e^2$,
+#   $\lambda = -u$ on $\Gamma_C$ ($\lambda_n - g = -u_n$);
+# * `u_volume`: $h_T^2\,\|w_h\|_T^2$, (4.31): $u_h$ against $\nabla u$;
+# * `u_dirichlet`, `u_neumann`, `u_contact`: $\sum_e h_e\,\|\dots\|_e^2$, the same traces
+#   for $u_\Gamma$ itself;
+# * `friction`: $\sum_e \tilde h_e\,\|\sigma_t - \mathcal{F}\nu\|_e^2$ on $A_C$, $(3.62)_5$
+#   pointwise;
+# * `neumann`: $\log(1+\tilde C_N)\sum_e \tilde h_e\,\|\sigma n - t_0\|_e^2$, the traction
+#   $t_0$ on $\Gamma_N$.
 #
-# The first seven make η_{σ,T} (4.15), the next four η_{u,T} (4.31). Every array of an
-# `Estimate` holds the *squared* contribution per element, so η²_{tot,T} is their sum.
+# The first seven make $\eta_{\sigma,T}$ (4.15), the next four $\eta_{u,T}$ (4.31). Every
+# array of an `Estimate` holds the *squared* contribution per element, so
+# $\eta_{tot,T}^2$ is their sum.
 
 # %%
 print("sigma terms (4.15):", SIGMA_TERMS)
@@ -101,7 +117,7 @@ print("others of (4.50):  ", OTHER_TERMS)
 # ## 2. Every term on Example 3.46 with Coulomb friction
 #
 # One solve, one call of `estimate`. The squared terms summed over the mesh show which
-# of them dominate η; the pictures show where.
+# of them dominate $\eta$; the pictures show where.
 
 # %%
 thesis = nd.load_scene("thesis-3.46-coulomb")
@@ -121,12 +137,14 @@ assert np.allclose(est.eta**2, sum(est.terms.values()))
 
 
 # %% [markdown]
-# Two observations. `residual` vanishes: f = 0 is piecewise constant, and div σ_h = −Π₀f
-# holds exactly in PEERS (the second row of (3.62)). And η mixes units: the terms in σ
-# (`asymmetry`, `friction`, `neumann`) are stresses, of the size of t₀ ≈ 800, while the
-# terms in w_h ≈ ∇u are strains, about E ≈ 2·10⁵ times smaller. The stress terms decide
-# where η is large, as the thesis observed for Figs. 4.1-4.8. The pictures use one
-# logarithmic colour scale per term; white elements have a zero (or round-off) indicator.
+# Two observations. `residual` vanishes: $f = 0$ is piecewise constant, and
+# $\operatorname{div}\sigma_h = -\Pi_0 f$ holds exactly in PEERS (the second row of
+# (3.62)). And $\eta$ mixes units: the terms in $\sigma$ (`asymmetry`, `friction`,
+# `neumann`) are stresses, of the size of $t_0 \approx 800$, while the terms in
+# $w_h \approx \nabla u$ are strains, about $E \approx 2\cdot 10^5$ times smaller. The
+# stress terms decide where $\eta$ is large, as the thesis observed for Figs. 4.1-4.8. The
+# pictures use one logarithmic colour scale per term; white elements have a zero (or
+# round-off) indicator.
 
 # %%
 def mesh_arrays(mesh: ngs.Mesh) -> mtri.Triangulation:
@@ -176,30 +194,36 @@ draw(eta_gf, mesh, "eta_tot")
 # What the pictures show (compare the discussion of Figs. 4.1-4.8):
 #
 # * `asymmetry`, `curl` and the jumps peak in the corners, where the boundary
-#   conditions change and σ is singular. `asymmetry` is largest in the two lower
-#   corners, where Γ_D meets Γ_C (Table 4.2). There λ_n ∈ C_h̃ must vanish, i.e.
-#   u_n = g = 0.01, while u = 0 on Γ_D: the data jump, σ ~ 1/r is not square
-#   integrable, and these indicators do not decrease under refinement (Exercise 3,
-#   Tutorial 7).
-# * `neumann` and `jump_neumann` live on the elements at Γ_N, largest where the
-#   traction t₀ switches off (x₁ = ±2) and at the ends of Γ_N.
-# * `friction` lives on the elements along Γ_C (A_C = supp 𝓕), where it measures how
-#   far the pointwise σ_t is from 𝓕ν: (3.62)₅ holds only tested with the hats.
-# * `jump_contact` and `u_contact` live on Γ_C too, the former largest at the ends of
-#   Γ_C, where λ_n must vanish (C_h̃ of (3.61)) while the body hangs above the gap.
+#   conditions change and $\sigma$ is singular. `asymmetry` is largest in the two lower
+#   corners, where $\Gamma_D$ meets $\Gamma_C$ (Table 4.2). There
+#   $\lambda_n \in C_{\tilde h}$ must vanish, i.e. $u_n = g = 0.01$, while $u = 0$ on
+#   $\Gamma_D$: the data jump, $\sigma \sim 1/r$ is not square integrable, and these
+#   indicators do not decrease under refinement (Exercise 3, Tutorial 7).
+# * `neumann` and `jump_neumann` live on the elements at $\Gamma_N$, largest where the
+#   traction $t_0$ switches off ($x_1 = \pm 2$) and at the ends of $\Gamma_N$.
+# * `friction` lives on the elements along $\Gamma_C$ ($A_C = \operatorname{supp}\mathcal{F}$),
+#   where it measures how far the pointwise $\sigma_t$ is from $\mathcal{F}\nu$:
+#   $(3.62)_5$ holds only tested with the hats.
+# * `jump_contact` and `u_contact` live on $\Gamma_C$ too, the former largest at the ends
+#   of $\Gamma_C$, where $\lambda_n$ must vanish ($C_{\tilde h}$ of (3.61)) while the body
+#   hangs above the gap.
 #
 # ## 3. A smooth problem with a known solution
 #
-# To measure the effectivity index η/e we need the exact error e. The manufactured
+# To measure the effectivity index $\eta/e$ we need the exact error $e$. The manufactured
 # problem of `tests/test_manufactured_convergence.py`: the convex pentagon with corners
-# (0,0), (2,0), (2,1), (1,2), (0,1), Neumann side from (2,1) to (1,2), Dirichlet
-# elsewhere, and the polynomial displacement
+# $(0,0)$, $(2,0)$, $(2,1)$, $(1,2)$, $(0,1)$, Neumann side from $(2,1)$ to $(1,2)$,
+# Dirichlet elsewhere, and the polynomial displacement
 #
-#     u = Curl ψ + w/λ,   ψ = |x − p₁|²|x − p₂|²,   w = (x² − 3x + y² − 3y + 4, x² + xy − 3x),
+# $$
+# u = \operatorname{Curl}\psi + w/\lambda, \qquad
+# \psi = |x - p_1|^2\,|x - p_2|^2, \qquad
+# w = (x^2 - 3x + y^2 - 3y + 4,\ x^2 + xy - 3x),
+# $$
 #
-# p₁ = (2,1), p₂ = (1,2): u, σ, f and t₀ are polynomials, u vanishes at the ends of Γ_N.
-# A few lines of exact polynomial arithmetic (2-D NumPy coefficient arrays c[i, j] of
-# xⁱyʲ) produce the scene formulas.
+# $p_1 = (2,1)$, $p_2 = (1,2)$: $u$, $\sigma$, $f$ and $t_0$ are polynomials, $u$
+# vanishes at the ends of $\Gamma_N$. A few lines of exact polynomial arithmetic (2-D
+# NumPy coefficient arrays `c[i, j]` of $x^i y^j$) produce the scene formulas.
 
 # %%
 P2 = np.polynomial.polynomial
@@ -292,9 +316,10 @@ print(f"u_1 = {text(u[0])[:90]}...")
 # %% [markdown]
 # ## 4. Effectivity under uniform refinement
 #
-# For each level: the exact error e, the estimator η = (Σ_T η²_{tot,T})^{1/2} and the
-# effectivity index η/e. Reliability (Theorem 4.8) says η/e is bounded below; a good
-# estimator is also *efficient*, η/e bounded above, so that the index stays in a band.
+# For each level: the exact error $e$, the estimator
+# $\eta = (\sum_T \eta_{tot,T}^2)^{1/2}$ and the effectivity index $\eta/e$. Reliability
+# (Theorem 4.8) says $\eta/e$ is bounded below; a good estimator is also *efficient*,
+# $\eta/e$ bounded above, so that the index stays in a band.
 
 # %%
 rows = []
@@ -321,10 +346,10 @@ for row, eff in zip(rows, effectivity):
 print(f"effectivity band: [{min(effectivity):.3f}, {max(effectivity):.3f}]")
 
 # %% [markdown]
-# The error halves with h (first order, Theorem 3.35), and so does η: the effectivity
-# index hardly moves. Which terms make up η here? No contact, so the contact and
-# friction terms vanish; the rates (`ngdual.rates.observed_rates` between the last two
-# levels) show that every term decays at first order:
+# The error halves with $h$ (first order, Theorem 3.35), and so does $\eta$: the
+# effectivity index hardly moves. Which terms make up $\eta$ here? No contact, so the
+# contact and friction terms vanish; the rates (`ngdual.rates.observed_rates` between the
+# last two levels) show that every term decays at first order:
 
 # %%
 active_terms = [k for k in TERMS if rows[-1]["terms"][k] > 1e-12 * rows[-1]["eta"]]
@@ -349,18 +374,25 @@ ax.legend(fontsize=8)
 save_figure(fig, OUT / "effectivity.png")
 
 # %% [markdown]
-# ## 5. Why as(σ_h) is measured in L²
+# ## 5. Why $\operatorname{as}(\sigma_h)$ is measured in $L^2$
 #
-# (4.15) as printed uses ‖as(σ_h)‖²_{H(div,T)} = ‖as(σ_h)‖²_T + ‖div as(σ_h)‖²_T. For
-# the skew part as(σ_h) = [[0, a], [−a, 0]], a = (σ₁₂ − σ₂₁)/2, div as(σ_h) = ∇a up to a
-# rotation. Now look at the RT₀ part of a PEERS row on T: r_i = p_i + c_i(x − x_T), with
-# div r_i = 2c_i = −f̄_i (the mean of f on T, by the second row of (3.62)). Then
-# σ₁₂ − σ₂₁ contains c₁(y − y_T) − c₂(x − x_T), whose gradient (−c₂, c₁) has length
-# |f̄|/2: |∇a| ≈ |f̄_T|/4 on *every* element, whatever h. The Curl bubbles do not remove
-# it. So ‖div as(σ_h)‖ stays of the size ‖f‖/4 although as(σ) = 0, and η with the
-# H(div) norm stalls while the error keeps decreasing: its effectivity index grows like
-# 1/h. With the L² norm (Carstensen-Dolzmann, Gatica et al.) the asymmetry decreases at
-# first order like every other term. This is `asymmetry="l2"`, the default.
+# (4.15) as printed uses
+# $\|\operatorname{as}(\sigma_h)\|^2_{H(\operatorname{div},T)} =
+# \|\operatorname{as}(\sigma_h)\|^2_T + \|\operatorname{div}\operatorname{as}(\sigma_h)\|^2_T$.
+# For the skew part
+# $\operatorname{as}(\sigma_h) = \begin{pmatrix} 0 & a \\ -a & 0 \end{pmatrix}$,
+# $a = (\sigma_{12} - \sigma_{21})/2$, $\operatorname{div}\operatorname{as}(\sigma_h) = \nabla a$
+# up to a rotation. Now look at the $RT_0$ part of a PEERS row on $T$:
+# $r_i = p_i + c_i(x - x_T)$, with $\operatorname{div} r_i = 2c_i = -\bar f_i$ (the mean of
+# $f$ on $T$, by the second row of (3.62)). Then $\sigma_{12} - \sigma_{21}$ contains
+# $c_1(y - y_T) - c_2(x - x_T)$, whose gradient $(-c_2, c_1)$ has length $|\bar f|/2$:
+# $|\nabla a| \approx |\bar f_T|/4$ on *every* element, whatever $h$. The Curl bubbles do
+# not remove it. So $\|\operatorname{div}\operatorname{as}(\sigma_h)\|$ stays of the size
+# $\|f\|/4$ although $\operatorname{as}(\sigma) = 0$, and $\eta$ with the
+# $H(\operatorname{div})$ norm stalls while the error keeps decreasing: its effectivity
+# index grows like $1/h$. With the $L^2$ norm (Carstensen-Dolzmann, Gatica et al.) the
+# asymmetry decreases at first order like every other term. This is `asymmetry="l2"`,
+# the default.
 
 # %%
 mesh1 = nd.solve(smooth, LEVELS[0]).problem.fes.mesh
@@ -374,10 +406,11 @@ for row, ratio in zip(rows, hdiv_ratio):
           f"{row['as_hdiv'] / quarter_f:11.2f} {ratio:10.2f}")
 
 # %% [markdown]
-# ‖as(σ_h)‖_{H(div)} stays at about ‖f‖/4 on every level (the bubbles add a little),
-# while ‖as(σ_h)‖_{L²} halves with h. The H(div) effectivity index
-# roughly doubles per level. This is the growth of η_as^max that the thesis observed in
-# Table 4.2 and blamed for the poor effectivity indices of Table 4.4.
+# $\|\operatorname{as}(\sigma_h)\|_{H(\operatorname{div})}$ stays at about $\|f\|/4$ on
+# every level (the bubbles add a little), while $\|\operatorname{as}(\sigma_h)\|_{L^2}$
+# halves with $h$. The $H(\operatorname{div})$ effectivity index roughly doubles per
+# level. This is the growth of $\eta_{as}^{\max}$ that the thesis observed in Table 4.2
+# and blamed for the poor effectivity indices of Table 4.4.
 
 # %%
 results = {
@@ -396,16 +429,18 @@ print(f"wrote {save_results('06_estimator', results)}")
 # ## Exercises
 # Solutions: `tutorials/solutions/06_estimator_solutions.py`.
 #
-# 1. **Patch test.** For an affine displacement u = Gx + c (G not symmetric) PEERS
-#    reproduces σ and η exactly. Build such a scene on the pentagon (u_D = u on Γ_D, the
-#    traction σn on the Neumann side, f = 0) and check that every term of η_{σ,T} and the
-#    Neumann term vanish, while η_{u,T} does not. Why can η_{u,T} not vanish?
+# 1. **Patch test.** For an affine displacement $u = Gx + c$ ($G$ not symmetric) PEERS
+#    reproduces $\sigma$ and $\eta$ exactly. Build such a scene on the pentagon
+#    ($u_D = u$ on $\Gamma_D$, the traction $\sigma n$ on the Neumann side, $f = 0$) and
+#    check that every term of $\eta_{\sigma,T}$ and the Neumann term vanish, while
+#    $\eta_{u,T}$ does not. Why can $\eta_{u,T}$ not vanish?
 # 2. **Table 4.2.** On Example 3.46 with Coulomb friction, levels 1-4 (uniform), compute
-#    η_as^max = max_T η_{as,T} and q_as, the share of triangles with η_{as,T} ≥ 0.1 η_as^max,
-#    with as(σ_h) in L² and in H(div). Where is the maximum attained?
+#    $\eta_{as}^{\max} = \max_T \eta_{as,T}$ and $q_{as}$, the share of triangles with
+#    $\eta_{as,T} \ge 0.1\,\eta_{as}^{\max}$, with $\operatorname{as}(\sigma_h)$ in $L^2$
+#    and in $H(\operatorname{div})$. Where is the maximum attained?
 # 3. **Sum or square root of the sum of squares?** Theorem 4.8 bounds the error by
-#    Σ_T η_{tot,T} (`Estimate.total_sum`, the η_tot of Table 4.4), not by
-#    (Σ_T η²_{tot,T})^{1/2} (`Estimate.total`). Compute the ratio of the two under uniform
-#    refinement for the smooth clamped square of Tutorial 2 and for Example 3.46 without
-#    friction, and compare it with √(number of triangles). What does this mean for an
-#    effectivity index computed with Σ_T η_{tot,T}?
+#    $\sum_T \eta_{tot,T}$ (`Estimate.total_sum`, the $\eta_{tot}$ of Table 4.4), not by
+#    $(\sum_T \eta_{tot,T}^2)^{1/2}$ (`Estimate.total`). Compute the ratio of the two
+#    under uniform refinement for the smooth clamped square of Tutorial 2 and for
+#    Example 3.46 without friction, and compare it with $\sqrt{\text{number of triangles}}$.
+#    What does this mean for an effectivity index computed with $\sum_T \eta_{tot,T}$?

@@ -1,24 +1,26 @@
 # %% [markdown]
 # # Tutorial 7: Adaptive refinement
 #
-# **Problem.** Solutions of contact problems are not smooth: σ is singular at corners
-# where boundary conditions change, and at the ends of the contact zone. Uniform
-# refinement then converges slowly. The indicators η_{tot,T} of (4.50) (Tutorial 6) say
-# *where* the error is made; refining there should restore the convergence rate that
-# PEERS has for smooth solutions, e ~ N^{-1/2} in the number N of unknowns.
+# **Problem.** Solutions of contact problems are not smooth: $\sigma$ is singular at
+# corners where boundary conditions change, and at the ends of the contact zone. Uniform
+# refinement then converges slowly. The indicators $\eta_{tot,T}$ of (4.50) (Tutorial 6)
+# say *where* the error is made; refining there should restore the convergence rate that
+# PEERS has for smooth solutions, $e \sim N^{-1/2}$ in the number $N$ of unknowns.
 #
 # **Discretisation.** PEERS (3.61) on netgen meshes refined by bisection with conforming
-# closure; the coarse boundary meshes h̃ (Γ_N, Γ_C) and ĥ (ν) follow the refinement, nested,
-# with h̃ ≈ 2h locally. Each step solves the discrete problem (3.62) with the solver the
-# scene asks for (`solver.method`; Tutorials 3 and 4 show that they all agree).
+# closure; the coarse boundary meshes $\tilde h$ ($\Gamma_N$, $\Gamma_C$) and $\hat h$
+# ($\nu$) follow the refinement, nested, with $\tilde h \approx 2h$ locally. Each step
+# solves the discrete problem (3.62) with the solver the scene asks for
+# (`solver.method`; Tutorials 3 and 4 show that they all agree).
 #
 # **What you will learn.**
 # 1. The loop SOLVE → ESTIMATE → MARK → REFINE (`ngdual.afem.adapt`) and its history.
 # 2. Three marking strategies (`ngdual.marking`): the maximum strategy and the
 #    fixed-fraction strategy of Section 4.2, and Dörfler's bulk criterion.
 # 3. On an L-shaped domain with a re-entrant corner (exact solution known): uniform
-#    refinement converges like N^{−α/2}, α ≈ 0.54, adaptive refinement like N^{−1/2};
-#    rates with `ngdual.rates.fitted_rate` (the order in h_N = N^{−1/2}: e ~ N^{−rate/2}).
+#    refinement converges like $N^{-\alpha/2}$, $\alpha \approx 0.54$, adaptive refinement
+#    like $N^{-1/2}$; rates with `ngdual.rates.fitted_rate` (the order in
+#    $h_N = N^{-1/2}$: $e \sim N^{-\mathrm{rate}/2}$).
 # 4. Example 3.46 with Coulomb friction: where the indicators refine (Figs. 4.1-4.13),
 #    and the total error (3.124) against extrapolated norms (Table 4.4).
 #
@@ -34,8 +36,8 @@
 # %% [markdown]
 # ## Parameters
 #
-# A run is (marking, θ, number of SOLVE steps). Uniform refinement is `max` with θ = 0
-# (every element has η_T ≥ 0 · max η).
+# A run is (marking, $\theta$, number of SOLVE steps). Uniform refinement is `max` with
+# $\theta = 0$ (every element has $\eta_T \ge 0 \cdot \max\eta$).
 
 # %%
 import math
@@ -73,15 +75,16 @@ print(f"quick mode: {QUICK}; output in {OUT}")
 # %% [markdown]
 # ## 1. Marking is a pure function of the indicators
 #
-# Given η_T ≥ 0 and θ ∈ [0, 1]:
+# Given $\eta_T \ge 0$ and $\theta \in [0, 1]$:
 #
-# * **max** (Section 4.2, first algorithm): refine T if η_T ≥ θ max η;
-# * **fraction** (Section 4.2, second algorithm): refine the ⌈θN_T⌉ elements with the
-#   largest η_T;
-# * **Dörfler**: refine a smallest set M with Σ_M η_T² ≥ θ Σ η_T², the *bulk* of the error.
+# * **max** (Section 4.2, first algorithm): refine $T$ if $\eta_T \ge \theta\max_{T'}\eta_{T'}$;
+# * **fraction** (Section 4.2, second algorithm): refine the $\lceil\theta N_T\rceil$
+#   elements with the largest $\eta_T$;
+# * **Dörfler**: refine a smallest set $\mathcal{M}$ with
+#   $\sum_{T\in\mathcal{M}} \eta_T^2 \ge \theta\sum_T \eta_T^2$, the *bulk* of the error.
 #
-# Only Dörfler controls how much of η² is refined; it is the strategy for which optimal
-# convergence rates are proven. On the indicators of Example 3.46 (level 2):
+# Only Dörfler controls how much of $\eta^2$ is refined; it is the strategy for which
+# optimal convergence rates are proven. On the indicators of Example 3.46 (level 2):
 
 # %%
 thesis = nd.load_scene("thesis-3.46-coulomb")
@@ -145,18 +148,25 @@ plot_meshes([(level2, marked_sets[s], f"{s}, theta = {examples[s]}: {marked_sets
 #         MARK      mark(eta_T, theta, marking)
 #         REFINE    mesh = refine(mesh, marked); coarse = coarse.follow(scene, mesh)
 #
-# and returns one record per step: DOFs, η and its terms, the norms of Tables 3.2/3.3,
-# timings, and with `reference` norms the total error (3.124). An `on_step` callback sees
-# the solution, the estimate and the marks of every step (here: to store meshes and to
-# compute exact errors).
+# and returns one record per step: DOFs, $\eta$ and its terms, the norms of Tables
+# 3.2/3.3, timings, and with `reference` norms the total error (3.124). An `on_step`
+# callback sees the solution, the estimate and the marks of every step (here: to store
+# meshes and to compute exact errors).
 #
 # ## 3. The L-shaped domain: a re-entrant corner
 #
-# The L-shape (−1,1)² without the quarter (0,1)×(−1,0), traction free on the two sides
-# at the re-entrant corner, u = u_exact on the others. Near a corner of interior angle
-# 2ω = 3π/2 with free sides, the symmetric (mode I) solution of Williams is
-# u ~ r^α g(θ), σ ~ r^{α−1}, with α ∈ (0, 1) the root of sin(2ωα) + α sin(2ω) = 0.
-# σ ∈ H^{α−ε}: uniform refinement gives e ~ h^α ~ N^{−α/2}.
+# The L-shape $(-1,1)^2$ without the quarter $(0,1)\times(-1,0)$, traction free on the two
+# sides at the re-entrant corner, $u = u_{\mathrm{exact}}$ on the others. Near a corner
+# of interior angle $2\omega = 3\pi/2$ with free sides, the symmetric (mode I) solution of
+# Williams is $u \sim r^\alpha g(\theta)$, $\sigma \sim r^{\alpha-1}$, with
+# $\alpha \in (0, 1)$ the root of
+#
+# $$
+# \sin(2\omega\alpha) + \alpha\sin(2\omega) = 0 .
+# $$
+#
+# $\sigma \in H^{\alpha-\varepsilon}$: uniform refinement gives
+# $e \sim h^\alpha \sim N^{-\alpha/2}$.
 
 # %%
 # The exact solution is in `ngdual.verification.corner` (read its source: Williams'
@@ -208,10 +218,10 @@ for name, kept in l_runs.items():
           f"eta {l_rates[name]['eta']:.3f}")
 
 # %% [markdown]
-# Uniform refinement converges at about the corner exponent α ≈ 0.54, all adaptive
-# strategies at about the optimal rate 1 (the rates from three steps are rough). The
-# estimator follows the error: it overestimates it by a factor that stays between about
-# 2 and 5.
+# Uniform refinement converges at about the corner exponent $\alpha \approx 0.54$, all
+# adaptive strategies at about the optimal rate 1 (the rates from three steps are rough).
+# The estimator follows the error: it overestimates it by a factor that stays between
+# about 2 and 5.
 
 # %%
 fig, ax = plt.subplots(figsize=(7, 5))
@@ -250,12 +260,17 @@ plot_meshes([(tri, marked, f"Dörfler step {k}: {tri.triangles.shape[0]} triangl
 # %% [markdown]
 # ## 4. Example 3.46 with Coulomb friction
 #
-# The thesis runs the maximum strategy θ = 0.5 from level 1 (Table 4.1, Figs. 4.1-4.8)
-# and the fraction strategy θ = 0.2 from level 2 (Tables 4.3-4.4, Figs. 4.9-4.13). The
-# exact solution is unknown; as in Section 3.4 the norms of the exact solution are
-# extrapolated from uniform levels (Aitken's Δ²), and e_tot of (3.124) compares norms:
-# e_i(q) = |‖q_h‖² − n_q²|^{1/2}. This is a rough error measure: it is blind to errors
-# that do not change the norms.
+# The thesis runs the maximum strategy $\theta = 0.5$ from level 1 (Table 4.1,
+# Figs. 4.1-4.8) and the fraction strategy $\theta = 0.2$ from level 2 (Tables 4.3-4.4,
+# Figs. 4.9-4.13). The exact solution is unknown; as in Section 3.4 the norms of the exact
+# solution are extrapolated from uniform levels (Aitken's $\Delta^2$), and $e_{tot}$ of
+# (3.124) compares norms:
+#
+# $$
+# e_i(q) = \bigl|\,\|q_h\|^2 - n_q^2\,\bigr|^{1/2} .
+# $$
+#
+# This is a rough error measure: it is blind to errors that do not change the norms.
 
 # %%
 reference = reference_norms(thesis, REFERENCE_LEVELS)
@@ -269,11 +284,12 @@ for name, kept in thesis_runs.items():
               f"{r['estimator']:10.3e} {r['e_tot']:10.3e} {r['effectivity']:9.3f} {r['marked']:6d}")
 
 # %% [markdown]
-# e_tot jumps up and down from step to step: a difference of norms can be small by
+# $e_{tot}$ jumps up and down from step to step: a difference of norms can be small by
 # accident, and the extrapolated norms are themselves uncertain. Its "effectivity index"
-# (Table 4.4) inherits that noise, unlike η/e on the L-shape with its exact error.
+# (Table 4.4) inherits that noise, unlike $\eta/e$ on the L-shape with its exact error.
 #
-# Which terms of (4.50) drive the refinement? The share of each in η² on the last step:
+# Which terms of (4.50) drive the refinement? The share of each in $\eta^2$ on the last
+# step:
 
 # %%
 for name, kept in thesis_runs.items():
@@ -306,22 +322,23 @@ ax.legend(fontsize=7, ncol=2)
 save_figure(fig, OUT / "thesis_convergence.png")
 
 # %% [markdown]
-# The refinement concentrates where the thesis found it: at the corners (σ singular,
-# the large `asymmetry` indicators of Table 4.2), along Γ_N where t₀ switches off, and on
-# Γ_C (the `friction` and contact terms). The maximum strategy refines only a handful of
-# elements per step (the indicators differ by orders of magnitude, so few reach half the
-# maximum): slow progress per solve, as the thesis noted for Table 4.1. The fraction and
-# Dörfler strategies refine more per step, the fraction strategy also elements with
-# small indicators (Figs. 4.9-4.13: "the algorithm also refines triangles inside the
-# domain").
+# The refinement concentrates where the thesis found it: at the corners ($\sigma$
+# singular, the large `asymmetry` indicators of Table 4.2), along $\Gamma_N$ where $t_0$
+# switches off, and on $\Gamma_C$ (the `friction` and contact terms). The maximum strategy
+# refines only a handful of elements per step (the indicators differ by orders of
+# magnitude, so few reach half the maximum): slow progress per solve, as the thesis noted
+# for Table 4.1. The fraction and Dörfler strategies refine more per step, the fraction
+# strategy also elements with small indicators (Figs. 4.9-4.13: "the algorithm also
+# refines triangles inside the domain").
 #
-# η decreases, but it will not tend to zero, whatever the strategy. The reason is in the
-# two lower corners. λ_n ∈ C_h̃ vanishes at the ends of Γ_C (3.61), so there the discrete
-# solution has u_n = g = 0.01, while u = 0 on the clamped sides Γ_D: the boundary data
-# *jump* at the corners. Near a displacement jump σ ~ 1/r, which is not square
-# integrable, and the asymmetry indicator of the corner element stays the same however
-# small the element (the constant η_as^max of Table 4.2). The estimator reports a real
-# defect of the data; with g = 0 at the ends it disappears (Exercise 3).
+# $\eta$ decreases, but it will not tend to zero, whatever the strategy. The reason is in
+# the two lower corners. $\lambda_n \in C_{\tilde h}$ vanishes at the ends of $\Gamma_C$
+# (3.61), so there the discrete solution has $u_n = g = 0.01$, while $u = 0$ on the
+# clamped sides $\Gamma_D$: the boundary data *jump* at the corners. Near a displacement
+# jump $\sigma \sim 1/r$, which is not square integrable, and the asymmetry indicator of
+# the corner element stays the same however small the element (the constant
+# $\eta_{as}^{\max}$ of Table 4.2). The estimator reports a real defect of the data; with
+# $g = 0$ at the ends it disappears (Exercise 3).
 
 # %%
 results = {
@@ -344,14 +361,15 @@ print(f"wrote {save_results('07_adaptivity', results)}")
 # ## Exercises
 # Solutions: `tutorials/solutions/07_adaptivity_solutions.py`.
 #
-# 1. **The Dörfler parameter.** Run Dörfler marking on the L-shape with θ ∈ {0.2, 0.5,
-#    0.8}. Compare the rates, the number of SOLVE steps needed to reach N ≈ 5000 and the
-#    error there. What happens as θ → 1?
+# 1. **The Dörfler parameter.** Run Dörfler marking on the L-shape with
+#    $\theta \in \{0.2, 0.5, 0.8\}$. Compare the rates, the number of SOLVE steps needed
+#    to reach $N \approx 5000$ and the error there. What happens as $\theta \to 1$?
 # 2. **Which terms refine Example 3.46?** Run the fraction strategy with the indicator
-#    restricted to η_{σ,T} (4.15) (mark with `Estimate.eta_sigma` in a loop of your own,
-#    using `ngdual.afem.refine` and `BoundaryMeshes.follow`) and compare the meshes with
-#    those of η_{tot,T}. Which terms put the refinement on Γ_N and Γ_C?
+#    restricted to $\eta_{\sigma,T}$ (4.15) (mark with `Estimate.eta_sigma` in a loop of
+#    your own, using `ngdual.afem.refine` and `BoundaryMeshes.follow`) and compare the
+#    meshes with those of $\eta_{tot,T}$. Which terms put the refinement on $\Gamma_N$ and
+#    $\Gamma_C$?
 # 3. **The corners of Example 3.46.** Refine `thesis-3.46-frictionless` uniformly and
-#    with Dörfler marking (θ = 0.5), once with the gap g = 0.01 and once with g = 0
-#    (`nd.load_scene(..., ["contact.gap='0'"])`). Compare η, its rate (`fitted_rate`)
-#    and the largest asymmetry indicator. Explain the difference.
+#    with Dörfler marking ($\theta = 0.5$), once with the gap $g = 0.01$ and once with
+#    $g = 0$ (`nd.load_scene(..., ["contact.gap='0'"])`). Compare $\eta$, its rate
+#    (`fitted_rate`) and the largest asymmetry indicator. Explain the difference.

@@ -3,13 +3,13 @@
 #
 # **Problem.** A new geometry, set up without writing any finite element code: an
 # elastic stamp (a hexagon) clamped at its two short vertical sides, loaded from
-# above, resting on a *curved* rigid foundation with gap g(x) = 0.001 + 0.05 x² — the
+# above, resting on a *curved* rigid foundation with gap $g(x) = 0.001 + 0.05\,x^2$: the
 # frictionless Signorini problem (3.68) on a domain that is not a rectangle.
 #
 # **Discretisation.** Whatever the scene calls for: netgen meshes the polygon, PEERS
-# (3.61) discretises (σ, u, η), the multipliers live on the coarse boundary meshes,
-# and Algorithm 3.38 solves the contact problem (frictionless, so no ν and no outer
-# friction loop).
+# (3.61) discretises $(\sigma, u, \eta)$, the multipliers live on the coarse boundary
+# meshes, and Algorithm 3.38 solves the contact problem (frictionless, so no $\nu$ and no
+# outer friction loop).
 #
 # **What you will learn.**
 # 1. The TOML scene format: geometry, boundary roles, material, loads, contact, solver.
@@ -21,7 +21,7 @@
 # **References.** M. Andres, *Dual-dual formulations for frictional contact problems in
 # mechanics*, PhD thesis, Leibniz Universität Hannover, 2011:
 # eqs. (3.1), (3.61), (3.68), Algorithm 3.38; the scene
-# schema in `ngdual/scene.py`; the shipped scenes (`ngdual scenes`).
+# schema in `ngdual/scene/tables.py`; the shipped scenes (`ngdual scenes`).
 
 # %% [markdown]
 # ## Parameters
@@ -53,13 +53,14 @@ print(f"quick mode: {QUICK}; levels {LEVELS}; output in {OUT}")
 # %% [markdown]
 # ## 1. Writing the scene
 #
-# A scene is a TOML file. The polygon is listed **counter-clockwise**; side i runs from
-# point i to point i+1 and gets label i. Every label must get exactly one role:
-# `dirichlet` (u = u_D, here 0), `neumann` (traction t₀) or `contact`. Loads, the gap
-# and friction bounds are formulas in `x` and `y`. The thesis assumes that Γ_N and Γ_C
-# do not touch (its multipliers vanish at the ends of Γ_C, `contact.ends = "thesis"`),
-# which is why the clamped sides separate the loaded top from the base here. With the
-# default `contact.ends = "consistent"` they may touch: the multipliers are free there.
+# A scene is a TOML file. The polygon is listed **counter-clockwise**; side $i$ runs from
+# point $i$ to point $i+1$ and gets label $i$. Every label must get exactly one role:
+# `dirichlet` ($u = u_D$, here 0), `neumann` (traction $t_0$) or `contact`. Loads, the
+# gap and friction bounds are formulas in `x` and `y`. The thesis assumes that $\Gamma_N$
+# and $\Gamma_C$ do not touch (its multipliers vanish at the ends of $\Gamma_C$,
+# `contact.ends = "thesis"`), which is why the clamped sides separate the loaded top from
+# the base here. With the default `contact.ends = "consistent"` they may touch: the
+# multipliers are free there.
 
 # %%
 SCENE = """
@@ -143,8 +144,8 @@ print(f"exit status {bad_status}; output folder exists: {(OUT / 'never-written')
 # %% [markdown]
 # ## 3. Solving and refining
 #
-# `nd.solve(scene, level)` meshes (level k = k − 1 uniform refinements of the netgen
-# mesh), assembles only what the scene needs and runs the matching algorithm — here
+# `nd.solve(scene, level)` meshes (level $k$ = $k - 1$ uniform refinements of the netgen
+# mesh), assembles only what the scene needs and runs the matching algorithm, here
 # Algorithm 3.38. The record of `post.result_record` is what `ngdual solve` writes to
 # `result.json`.
 
@@ -168,7 +169,7 @@ for row in levels:
 # %% [markdown]
 # Pictures of the finest level: the von Mises stress (matplotlib, saved as PNG, the
 # colour scale clipped at the 97th percentile because of the corners, see below; in a
-# notebook also NGSolve's interactive webgui) and the traces on Γ_C.
+# notebook also NGSolve's interactive webgui) and the traces on $\Gamma_C$.
 
 # %%
 mesh = solution.problem.fes.mesh
@@ -185,12 +186,13 @@ draw(nd.post.von_mises(sigma_h, scene.material.nu), mesh, "von_mises")
 # Two things stand out, and both are mathematics rather than bugs:
 #
 # * The stress concentrates at the corners where a clamped side meets the base. Mixed
-#   boundary conditions meeting at a corner make σ singular there (like r^(α−1) with
-#   α < 1, r the distance to the corner), so these peaks grow under uniform refinement.
-#   Adaptive refinement (Chapter 4) is the remedy.
-# * Near the ends of Γ_C, σ_n^h takes both signs. The multipliers vanish at ∂Γ_C (the
-#   space C_h̃ of (3.61)), so the sign condition σ_n ≤ 0 is imposed only weakly, tested
-#   with coarse hat functions ((3.62)₆) whose weight goes to zero at the ends of Γ_C.
+#   boundary conditions meeting at a corner make $\sigma$ singular there (like
+#   $r^{\alpha-1}$ with $\alpha < 1$, $r$ the distance to the corner), so these peaks grow
+#   under uniform refinement. Adaptive refinement (Chapter 4) is the remedy.
+# * Near the ends of $\Gamma_C$, $\sigma_n^h$ takes both signs. The multipliers vanish at
+#   $\partial\Gamma_C$ (the space $C_{\tilde h}$ of (3.61)), so the sign condition
+#   $\sigma_n \le 0$ is imposed only weakly, tested with coarse hat functions
+#   ($(3.62)_6$) whose weight goes to zero at the ends of $\Gamma_C$.
 
 # %% [markdown]
 # The same from the command line (the scene file is an ordinary path):
@@ -217,11 +219,12 @@ print(f"wrote {save_results('08_your_own_scene', results)}")
 # ## Exercises
 # Solutions: `tutorials/solutions/08_your_own_scene_solutions.py`.
 #
-# 1. **First contact.** Make the foundation flat (g = 0.002) and find the load factor s
-#    (traction s · t₀) at which the stamp first touches it. Hint: before contact the
+# 1. **First contact.** Make the foundation flat ($g = 0.002$) and find the load factor
+#    $s$ (traction $s\,t_0$) at which the stamp first touches it. Hint: before contact the
 #    problem is linear, so one solve without a contact boundary suffices.
 # 2. **An arch.** Write a scene for an arch (a half annulus, approximated by a polygon)
 #    whose two feet rest on the foundation. Which sides must be Dirichlet so that
 #    validation accepts it? Trigger, read and fix two validation errors on the way.
-# 3. **Refinement.** Solve on levels 1-4 and estimate the convergence order of ‖σ‖_X
-#    and of the number of nodes in contact (relative to the number of Γ_C nodes).
+# 3. **Refinement.** Solve on levels 1-4 and estimate the convergence order of
+#    $\|\sigma\|_X$ and of the number of nodes in contact (relative to the number of
+#    $\Gamma_C$ nodes).

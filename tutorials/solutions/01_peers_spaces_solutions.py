@@ -21,15 +21,17 @@ LEVELS = [1, 2] if QUICK else [1, 2, 3, 4]
 OUT = output_dir("01_peers_spaces_solutions")
 
 # %% [markdown]
-# ## Exercise 1: the inf-sup constant in the L² norm
+# ## Exercise 1: the inf-sup constant in the $L^2$ norm
 #
-# Brezzi's theory needs b to be *continuous* and inf-sup stable in the same pair of
-# norms, both uniformly in h. We compute the smallest and the largest singular value
-# of B in both norms. The smallest barely changes (it is decided by smooth modes, for
-# which ‖div τ‖ ~ ‖τ‖). The largest is bounded in H(div) but grows like 1/h in L²:
-# a rough τ with ‖τ‖ = 1 has ‖div τ‖ ~ 1/h. In the L² norm b is not uniformly
-# continuous, so no h-independent error estimate can come out of it; in ‖·‖_X both
-# constants are h-independent, which is what Lemma 3.28 and Theorem 3.34 use.
+# Brezzi's theory needs $b$ to be *continuous* and inf-sup stable in the same pair of
+# norms, both uniformly in $h$. We compute the smallest and the largest singular value
+# of $B$ in both norms. The smallest barely changes (it is decided by smooth modes, for
+# which $\|\operatorname{div}\tau\| \sim \|\tau\|$). The largest is bounded in
+# $H(\operatorname{div})$ but grows like $1/h$ in $L^2$: a rough $\tau$ with
+# $\|\tau\| = 1$ has $\|\operatorname{div}\tau\| \sim 1/h$. In the $L^2$ norm $b$ is not
+# uniformly continuous, so no $h$-independent error estimate can come out of it; in
+# $\|\cdot\|_X$ both constants are $h$-independent, which is what Lemma 3.28 and
+# Theorem 3.34 use.
 
 # %%
 clamped = nd.load_scene("thesis-3.46-frictionless",
@@ -106,9 +108,12 @@ save_figure(fig, OUT / "singular_values.png")
 # %% [markdown]
 # ## Exercise 2: counting with Euler's formula
 #
-# Level k of Example 3.46 has n = 2^(k−1), an 8n × 2n grid of squares, so
-# V = (8n + 1)(2n + 1), T = 2 · 16n² and, by Euler, E = V + T − 1. Hence
-# dim X_h = 2(E + T), dim M_h = 2T = 64n², dim S_h = V.
+# Level $k$ of Example 3.46 has $n = 2^{k-1}$, an $8n \times 2n$ grid of squares, so
+# $V = (8n + 1)(2n + 1)$, $T = 2 \cdot 16n^2$ and, by Euler, $E = V + T - 1$. Hence
+#
+# $$
+# \dim X_h = 2(E + T), \qquad \dim M_h = 2T = 64n^2, \qquad \dim S_h = V .
+# $$
 
 # %%
 TABLE_3_1 = {1: (180, 64, 27), 2: (680, 256, 85), 3: (2640, 1024, 297),

@@ -19,12 +19,13 @@ NUS = [0.3, 0.49, 0.499, 0.4999]
 OUT = output_dir("02_locking_solutions")
 
 # %% [markdown]
-# ## Exercise 1: P2 on the same meshes
+# ## Exercise 1: $P_2$ on the same meshes
 #
-# We reuse the manufactured divergence-free solution of the tutorial. P2 is much better
-# than P1, but on general triangulations it is still not robust in λ: the error ratio
-# between ν = 0.4999 and ν = 0.3 exceeds one noticeably (locking-free conforming
-# Lagrange elements need degree ≥ 4 with special meshes, Scott-Vogelius).
+# We reuse the manufactured divergence-free solution of the tutorial. $P_2$ is much
+# better than $P_1$, but on general triangulations it is still not robust in $\lambda$:
+# the error ratio between $\nu = 0.4999$ and $\nu = 0.3$ exceeds one noticeably
+# (locking-free conforming Lagrange elements need degree $\ge 4$ with special meshes,
+# Scott-Vogelius).
 
 # %%
 P = {"p": "(T**2*(1 - T)**2)", "dp": "(2*T - 6*T**2 + 4*T**3)",
@@ -86,16 +87,23 @@ ax.legend()
 save_figure(fig, OUT / "primal_locking.png")
 
 # %% [markdown]
-# ## Exercise 2: how many divergence-free P1 fields are there?
+# ## Exercise 2: how many divergence-free $P_1$ fields are there?
 #
-# On a triangle with vertices a_k and barycentric gradients ∇φ_k, a P1 field
-# v = Σ v_k φ_k has the constant divergence Σ_k ∇φ_k · v_k. Stacking these rows for all
-# T triangles over the 2V_int unknowns (v = 0 on ∂Ω) gives a T × 2V_int matrix D; its
-# kernel is the space the P1 solution is pushed into as λ → ∞. By Euler's formula
-# T = 2V − V_∂ − 2 on a triangulation of a polygon with V_∂ boundary vertices, so
-# 2V_int − T = −V_∂ + 2 < 0: there are more constraints than unknowns, and unless the
-# mesh is special (criss-cross) the only divergence-free P1 field is v = 0. The
-# λ-limit of the P1 solution is u_h = 0, whatever f: that is locking.
+# On a triangle with vertices $a_k$ and barycentric gradients $\nabla\varphi_k$, a $P_1$
+# field $v = \sum_k v_k\varphi_k$ has the constant divergence
+# $\sum_k \nabla\varphi_k \cdot v_k$. Stacking these rows for all $T$ triangles over the
+# $2V_{\mathrm{int}}$ unknowns ($v = 0$ on $\partial\Omega$) gives a
+# $T \times 2V_{\mathrm{int}}$ matrix $D$; its kernel is the space the $P_1$ solution is
+# pushed into as $\lambda \to \infty$. By Euler's formula $T = 2V - V_\partial - 2$ on a
+# triangulation of a polygon with $V_\partial$ boundary vertices, so
+#
+# $$
+# 2V_{\mathrm{int}} - T = -V_\partial + 2 < 0 :
+# $$
+#
+# there are more constraints than unknowns, and unless the mesh is special (criss-cross)
+# the only divergence-free $P_1$ field is $v = 0$. The $\lambda$-limit of the $P_1$
+# solution is $u_h = 0$, whatever $f$: that is locking.
 
 # %%
 def divergence_matrix(mesh) -> tuple[np.ndarray, int]:

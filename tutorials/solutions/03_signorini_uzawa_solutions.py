@@ -4,6 +4,7 @@
 # Each exercise is one section; all run in seconds with `NGDUAL_QUICK=1`.
 
 # %%
+import matplotlib.pyplot as plt
 import numpy as np
 import scipy.sparse.linalg as spla
 
@@ -15,7 +16,7 @@ from ngdual.solvers.projections import NonnegativeProjection, metric_matrix
 from ngdual.solvers.reference import solve_qp
 from ngdual.solvers.settings import Model, UzawaSettings
 from ngdual.solvers.uzawa import uzawa
-from ngdual.studies.tutorials import output_dir, quick_mode, save_results
+from ngdual.studies.tutorials import output_dir, quick_mode, save_figure, save_results
 
 QUICK = quick_mode()
 LEVELS = [1, 2] if QUICK else [1, 2, 3, 4]
@@ -27,12 +28,13 @@ problems = {level: assemble(scene, build_mesh(scene.geometry, level)) for level 
 # %% [markdown]
 # ## Exercise 1: the optimal step length
 #
-# With the H^{1/2} metric ρ_opt stays near 1-1.5 on every level: the metric already
-# carries the right scaling. With the Euclidean metric the best ρ is similar, but the
-# iteration count at ρ_opt grows with the level, as the tutorial showed for ρ = 1.
+# With the $H^{1/2}$ metric $\rho_{\mathrm{opt}}$ stays near 1-1.5 on every level: the
+# metric already carries the right scaling. With the Euclidean metric the best $\rho$ is
+# similar, but the iteration count at $\rho_{\mathrm{opt}}$ grows with the level, as the
+# tutorial showed for $\rho = 1$.
 
 # %%
-optimal = {}
+optimal, sweeps = {}, {}
 for metric in ("h12", "euclidean"):
     for level, problem in problems.items():
         counts = {}
@@ -41,19 +43,35 @@ for metric in ("h12", "euclidean"):
                 scene, rho=float(rho), eps=1e-8, metric=metric, max_iter=500))
             counts[float(rho)] = solution.iterations["outer"] if solution.converged else np.inf
         best = min(counts, key=counts.get)
+        sweeps[(metric, level)] = counts
         optimal[f"{metric}-{level}"] = {"rho": best, "iterations": int(counts[best])}
         print(f"{metric:9s} level {level}: rho_opt = {best:.2f} with {counts[best]} iterations")
 
+# %%
+fig, ax = plt.subplots(figsize=(7, 4.5))
+for (metric, level), counts in sweeps.items():
+    ax.plot(list(counts), list(counts.values()), "o-" if metric == "h12" else "s--",
+            label=f"{metric}, level {level}")
+ax.set_yscale("log")
+ax.set_xlabel(r"step length $\rho$")
+ax.set_ylabel("Uzawa iterations to $\\varepsilon = 10^{-8}$")
+ax.set_title("Exercise 1: iterations against $\\rho$ (missing point: no convergence)")
+ax.grid(True, which="both", alpha=0.3)
+ax.legend(fontsize=8)
+save_figure(fig, OUT / "optimal_rho.png")
+
 # %% [markdown]
-# ## Exercise 2: the mass-matrix (L²) metric
+# ## Exercise 2: the mass-matrix ($L^2$) metric
 #
-# The L² norm on Γ_C is weaker than the H^{1/2} norm by a factor that grows like
-# h̃^{-1/2} on rough functions: not equivalent uniformly in h. Scaling the mass matrix by
-# 1/h̃ gives it the units of the other metrics; then, like the Euclidean metric, it
-# needs more and more iterations as the mesh is refined, while h12 does not.
+# The $L^2$ norm on $\Gamma_C$ is weaker than the $H^{1/2}$ norm by a factor that grows
+# like $\tilde h^{-1/2}$ on rough functions: not equivalent uniformly in $h$. Scaling the
+# mass matrix by $1/\tilde h$ gives it the units of the other metrics; then, like the
+# Euclidean metric, it needs more and more iterations as the mesh is refined, while
+# `h12` does not.
 #
-# Algorithm 3.38 itself fits in a few lines: factorise [[A, B], [Bᵀ, 0]] once, then
-# alternate the solve (step 3) and the projection in the metric W (step 4).
+# Algorithm 3.38 itself fits in a few lines: factorise
+# $\begin{pmatrix} A & B \\ B^\top & 0 \end{pmatrix}$ once, then alternate the solve
+# (step 3) and the projection in the metric $W$ (step 4).
 
 
 # %%
@@ -92,13 +110,26 @@ for level, problem in problems.items():
     print(f"level {level}: mass metric {its} iterations (converged {converged}); h12 {h12} "
           f"with ngdual's uzawa, {check} by hand")
 
+# %%
+fig, ax = plt.subplots(figsize=(6.5, 4.2))
+ax.plot(LEVELS, mass_iterations, "s--", label=r"mass metric $W = (E^*/2)\,M/\tilde h$")
+ax.plot(LEVELS, [h12 for _, h12 in hand_vs_ngdual], "o-", label=r"$H^{1/2}$ metric (h12)")
+ax.set_xticks(LEVELS)
+ax.set_xlabel("mesh level (h halves per level)")
+ax.set_ylabel(r"Uzawa iterations, $\rho = 1$")
+ax.set_title("Exercise 2: only the $H^{1/2}$ metric keeps the count fixed")
+ax.grid(True, alpha=0.3)
+ax.legend()
+save_figure(fig, OUT / "metrics_under_refinement.png")
+
 # %% [markdown]
 # ## Exercise 3: other gaps
 #
 # The Uzawa iteration and the independent QP find the same contact nodes. With
-# g = |x₁| the body can touch only around x₁ = 0. On coarse meshes it does not touch at
-# all: λ_n is tested with the coarse hats, so the *discrete* gap at the node x₁ = 0 is a
-# hat-weighted mean of |x₁|, about h̃/3, larger than the deflection until h̃ is small.
+# $g = |x_1|$ the body can touch only around $x_1 = 0$. On coarse meshes it does not
+# touch at all: $\lambda_n$ is tested with the coarse hats, so the *discrete* gap at the
+# node $x_1 = 0$ is a hat-weighted mean of $|x_1|$, about $\tilde h/3$, larger than the
+# deflection until $\tilde h$ is small.
 
 # %%
 gaps = {}

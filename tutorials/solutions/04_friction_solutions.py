@@ -40,18 +40,19 @@ def attempt(**options):
 # %% [markdown]
 # ## Exercise 1: step lengths
 #
-# With ν outside (Algorithm 3.41) the number of *outer* steps depends on ρ₂ only, like
-# the contraction factor 1 − cρ₂ of a projected gradient method: halving ρ₂ about doubles
-# it. Each outer step runs a whole inner Uzawa loop, whose length depends on ρ₁. With the
-# loops exchanged (Remark 3.43) the outer count depends on ρ₁ and the cheap ν loop runs
-# inside; counted in inner iterations (= solves with the condensed Γ_C response) the
-# exchanged order is usually cheaper here.
+# With $\nu$ outside (Algorithm 3.41) the number of *outer* steps depends on $\rho_2$
+# only, like the contraction factor $1 - c\rho_2$ of a projected gradient method: halving
+# $\rho_2$ about doubles it. Each outer step runs a whole inner Uzawa loop, whose length
+# depends on $\rho_1$. With the loops exchanged (Remark 3.43) the outer count depends on
+# $\rho_1$ and the cheap $\nu$ loop runs inside; counted in inner iterations (= solves
+# with the condensed $\Gamma_C$ response) the exchanged order is usually cheaper here.
 #
-# ρ₂ is measured relative to the computed bound 2/λ_max(H) of the *unconstrained* ν
-# iteration (Theorem 3.42 gives a cruder bound of the same kind). Beyond it the
-# iteration may still converge: on slip edges |ν| = 1 is enforced by the projection,
-# which is a contraction whatever the step, so only stick edges can be excited. Where
-# there is a stick zone, a step far beyond the bound stalls, and `nested_uzawa` says so.
+# $\rho_2$ is measured relative to the computed bound $2/\lambda_{\max}(H)$ of the
+# *unconstrained* $\nu$ iteration (Theorem 3.42 gives a cruder bound of the same kind).
+# Beyond it the iteration may still converge: on slip edges $|\nu| = 1$ is enforced by
+# the projection, which is a contraction whatever the step, so only stick edges can be
+# excited. Where there is a stick zone, a step far beyond the bound stalls, and
+# `nested_uzawa` says so.
 
 # %%
 sweep = {}
@@ -80,10 +81,11 @@ save_figure(fig, OUT / "step_lengths.png")
 # %% [markdown]
 # ## Exercise 2: the friction coefficient
 #
-# With μ_f = 0 the friction bound vanishes, ν plays no role and the nested algorithm
-# solves the frictionless problem: σ agrees with Algorithm 3.38 to the solver tolerance.
-# Growing μ_f adds friction forces, so F_abs grows, and the tangential stress can be
-# carried without slip on a growing part of the contact zone: the stick zone grows.
+# With $\mu_f = 0$ the friction bound vanishes, $\nu$ plays no role and the nested
+# algorithm solves the frictionless problem: $\sigma$ agrees with Algorithm 3.38 to the
+# solver tolerance. Growing $\mu_f$ adds friction forces, so $F_{\mathrm{abs}}$ grows,
+# and the tangential stress can be carried without slip on a growing part of the contact
+# zone: the stick zone grows.
 
 # %%
 frictionless = nd.load_scene("thesis-3.46-frictionless")

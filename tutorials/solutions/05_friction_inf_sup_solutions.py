@@ -21,14 +21,16 @@ KERNEL_LEVEL = 2
 OUT = output_dir("05_friction_inf_sup_solutions")
 
 # %% [markdown]
-# ## Exercise 1: ĥ = h̃ when (3.73) holds
+# ## Exercise 1: $\hat h = \tilde h$ when (3.73) holds
 #
-# With g = |x₁| the body touches only around x₁ = 0, far from the ends of Γ_C: 𝓕 = 0
-# near ∂Γ_C, the hats next to the ends of A_C pin the checkerboard mode, and the
-# inf-sup condition (3.74) holds with ĥ = h̃ (Lemma 3.31). Both choices converge, and λ_n,
-# λ_t agree up to the discretisation difference of ν (Figs. 3.26-3.27). ν itself is a
-# different function on the two ĥ meshes; it is printed on A_C = supp 𝓕 only (elsewhere
-# 𝓕 is zero up to round-off and ν does not enter (3.62)).
+# With $g = |x_1|$ the body touches only around $x_1 = 0$, far from the ends of
+# $\Gamma_C$: $\mathcal{F} = 0$ near $\partial\Gamma_C$, the hats next to the ends of
+# $A_C$ pin the checkerboard mode, and the inf-sup condition (3.74) holds with
+# $\hat h = \tilde h$ (Lemma 3.31). Both choices converge, and $\lambda_n$, $\lambda_t$
+# agree up to the discretisation difference of $\nu$ (Figs. 3.26-3.27). $\nu$ itself is a
+# different function on the two $\hat h$ meshes; it is printed on
+# $A_C = \operatorname{supp}\mathcal{F}$ only (elsewhere $\mathcal{F}$ is zero up to
+# round-off and $\nu$ does not enter (3.62)).
 
 # %%
 gap_abs = {}
@@ -64,11 +66,19 @@ save_figure(fig, OUT / "gap_abs_lambda_t.png")
 # %% [markdown]
 # ## Exercise 2: a variable friction bound
 #
-# With ĥ = h̃ there are N_A = N_C + 1 values of ν and only N_C hats, whatever 𝓕: Q_𝓕ᵀ
-# maps ℝ^{N_A} to ℝ^{N_C} and has a kernel for *every* 𝓕 > 0 on Γ_C. What 𝓕 changes is its
-# shape: (Q_𝓕ᵀκ)_i = Σ_j κ_j ∫_{e_j} 𝓕 μ_i = 0 gives κ_{j+1} = −κ_j w_j/w_{j+1} with the
-# 𝓕-weights w_j of the two halves of the hat, so the signs still alternate but the
-# magnitudes follow 𝓕: a *weighted* checkerboard. Only 𝓕 = 0 near the ends (3.73) helps.
+# With $\hat h = \tilde h$ there are $N_A = N_C + 1$ values of $\nu$ and only $N_C$ hats,
+# whatever $\mathcal{F}$: $Q_{\mathcal{F}}^\top$ maps $\mathbb{R}^{N_A}$ to
+# $\mathbb{R}^{N_C}$ and has a kernel for *every* $\mathcal{F} > 0$ on $\Gamma_C$. What
+# $\mathcal{F}$ changes is its shape:
+#
+# $$
+# (Q_{\mathcal{F}}^\top\kappa)_i = \sum_j \kappa_j \int_{e_j} \mathcal{F}\mu_i\,ds = 0
+# \quad\Longrightarrow\quad \kappa_{j+1} = -\kappa_j\,\frac{w_j}{w_{j+1}}
+# $$
+#
+# with the $\mathcal{F}$-weights $w_j$ of the two halves of the hat, so the signs still
+# alternate but the magnitudes follow $\mathcal{F}$: a *weighted* checkerboard. Only
+# $\mathcal{F} = 0$ near the ends (3.73) helps.
 
 # %%
 def kernel_of(problem, F) -> np.ndarray:

@@ -6,13 +6,14 @@
 # %%
 import math
 
+import matplotlib.pyplot as plt
 import ngsolve as ngs
 import numpy as np
 
 from ngdual.estimator import SIGMA_TERMS, U_TERMS, estimate
 from ngdual.scene import Geometry, Loads, Material, Scene, load_scene, validate
 from ngdual.solvers import solve_scene
-from ngdual.studies.tutorials import output_dir, quick_mode, save_results
+from ngdual.studies.tutorials import output_dir, quick_mode, save_figure, save_results
 
 QUICK = quick_mode()
 LEVELS = [1, 2, 3] if QUICK else [1, 2, 3, 4]
@@ -21,13 +22,15 @@ OUT = output_dir("06_estimator_solutions")
 # %% [markdown]
 # ## Exercise 1: the patch test
 #
-# For u = Gx + c the stress σ = C ε(u) is constant and the rotation η = (G₁₂ − G₂₁)/2 is
-# constant: both lie in the PEERS spaces, and the discrete solution reproduces them.
-# Then w_h = C⁻¹σ_h + η_h = G exactly, and every residual of (4.15) vanishes: f + div σ_h
-# = 0, as(σ_h) = 0, curl G = 0, no jumps, w_h t = ∂_t u_D on Γ_D, σn = t₀ on Γ_N.
-# η_{u,T} cannot vanish: u_h is piecewise *constant* and cannot represent an affine u.
-# h_T‖w_h‖_T measures exactly this O(h) error of u_h, and the trace terms compare u_h
-# on the boundary elements with u_D and φ.
+# For $u = Gx + c$ the stress $\sigma = \mathbb{C}\,\varepsilon(u)$ is constant and the
+# rotation $\eta = (G_{12} - G_{21})/2$ is constant: both lie in the PEERS spaces, and the
+# discrete solution reproduces them. Then $w_h = \mathbb{C}^{-1}\sigma_h + \eta_h = G$
+# exactly, and every residual of (4.15) vanishes: $f + \operatorname{div}\sigma_h = 0$,
+# $\operatorname{as}(\sigma_h) = 0$, $\operatorname{curl} G = 0$, no jumps,
+# $w_h t = \partial_t u_D$ on $\Gamma_D$, $\sigma n = t_0$ on $\Gamma_N$.
+# $\eta_{u,T}$ cannot vanish: $u_h$ is piecewise *constant* and cannot represent an
+# affine $u$. $h_T\|w_h\|_T$ measures exactly this $O(h)$ error of $u_h$, and the trace
+# terms compare $u_h$ on the boundary elements with $u_D$ and $\varphi$.
 
 # %%
 E, NU = 100.0, 0.3
@@ -57,11 +60,13 @@ print({k: f"{v:.1e}" for k, v in patch.items()})
 # %% [markdown]
 # ## Exercise 2: Table 4.2
 #
-# η_{as,T} = ‖as(σ_h)‖_T (L²) or ‖as(σ_h)‖_{H(div,T)}. The maximum sits in the lower
-# corners, where Γ_D meets Γ_C: σ is singular there and PEERS approximates its symmetry
-# poorly. In L² the maximum stays about constant, in H(div) it grows: the ∇a part is
-# not weighted with h. The share q_as of triangles near the maximum shrinks with h: the
-# large indicators concentrate in the corners.
+# $\eta_{as,T} = \|\operatorname{as}(\sigma_h)\|_T$ ($L^2$) or
+# $\|\operatorname{as}(\sigma_h)\|_{H(\operatorname{div},T)}$. The maximum sits in the
+# lower corners, where $\Gamma_D$ meets $\Gamma_C$: $\sigma$ is singular there and PEERS
+# approximates its symmetry poorly. In $L^2$ the maximum stays about constant, in
+# $H(\operatorname{div})$ it grows: the $\nabla a$ part is not weighted with $h$. The
+# share $q_{as}$ of triangles near the maximum shrinks with $h$: the large indicators
+# concentrate in the corners.
 
 # %%
 thesis = load_scene("thesis-3.46-coulomb")
@@ -83,18 +88,38 @@ for level in LEVELS:
           f"{np.round(row['l2']['argmax_xy'], 2)};  H(div) max {row['hdiv']['max']:9.3e} "
           f"q_as {row['hdiv']['q_as']:.3f} at {np.round(row['hdiv']['argmax_xy'], 2)}")
 
+# %%
+fig, ax = plt.subplots(figsize=(6.5, 4.2))
+for norm, label, style in (("l2", r"$L^2$ (ngdual's default)", "o-"),
+                           ("hdiv", r"$H(\mathrm{div})$ as printed in (4.15)", "s--")):
+    ax.semilogy(LEVELS, [row[norm]["max"] for row in table_4_2], style, label=label)
+ax.set_xticks(LEVELS)
+ax.set_xlabel("mesh level (uniform refinement)")
+ax.set_ylabel(r"$\eta_{as}^{\max} = \max_T \eta_{as,T}$")
+ax.set_title("Exercise 2 (Table 4.2): the largest asymmetry indicator,\n"
+             "attained in a lower corner where $\\Gamma_D$ meets $\\Gamma_C$")
+ax.grid(True, which="both", alpha=0.3)
+ax.legend()
+save_figure(fig, OUT / "table_4_2.png")
+
 # %% [markdown]
-# ## Exercise 3: Σ η_T against (Σ η_T²)^{1/2}
+# ## Exercise 3: $\sum_T \eta_T$ against $(\sum_T \eta_T^2)^{1/2}$
 #
-# By Cauchy-Schwarz Σ_T η_T ≤ √N_T (Σ_T η_T²)^{1/2}, with near equality when the
-# indicators are about equal. For the smooth square (u = Curl ψ, ψ = x²(1−x)²y²(1−y)²,
-# clamped, the problem of Tutorial 2) they are, and under uniform refinement the ratio
-# grows like √N_T, by 2 per level: an effectivity index built on Σ_T η_T doubles per
-# level even though η/e is constant. Theorem 4.8 is a reliability statement; the ℓ² sum
-# (Σ η_T²)^{1/2} is what is comparable with the error. In Example 3.46 a few corner
-# elements carry most of η (σ is singular there, and η itself stops decreasing), so the
-# ratio grows more slowly, far below √N_T: the indicators are not equidistributed, which
-# is what adaptive refinement is for (Tutorial 7).
+# By Cauchy-Schwarz
+#
+# $$
+# \sum_T \eta_T \le \sqrt{N_T}\,\Bigl(\sum_T \eta_T^2\Bigr)^{1/2},
+# $$
+#
+# with near equality when the indicators are about equal. For the smooth square
+# ($u = \operatorname{Curl}\psi$, $\psi = x^2(1-x)^2y^2(1-y)^2$, clamped, the problem of
+# Tutorial 2) they are, and under uniform refinement the ratio grows like $\sqrt{N_T}$, by
+# 2 per level: an effectivity index built on $\sum_T \eta_T$ doubles per level even though
+# $\eta/e$ is constant. Theorem 4.8 is a reliability statement; the $\ell^2$ sum
+# $(\sum_T \eta_T^2)^{1/2}$ is what is comparable with the error. In Example 3.46 a few
+# corner elements carry most of $\eta$ ($\sigma$ is singular there, and $\eta$ itself stops
+# decreasing), so the ratio grows more slowly, far below $\sqrt{N_T}$: the indicators are
+# not equidistributed, which is what adaptive refinement is for (Tutorial 7).
 
 # %%
 P = {"p": "(T**2*(1 - T)**2)", "dp": "(2*T - 6*T**2 + 4*T**3)",
@@ -129,6 +154,22 @@ for level in LEVELS:
           f"(square, sqrt(N_T) = {math.sqrt(square_row['elements']):6.2f}), "
           f"{thesis_row['ratio']:7.2f} (Example 3.46, sqrt(N_T) = "
           f"{math.sqrt(thesis_row['elements']):6.2f}, eta = {thesis_row['eta']:.1f})")
+
+# %%
+fig, ax = plt.subplots(figsize=(6.5, 4.2))
+for name, label, style in (("square", "smooth clamped square (Tutorial 2)", "o-"),
+                           ("thesis", "Example 3.46, frictionless", "s-")):
+    rows = ratios[name]
+    ax.loglog([row["elements"] for row in rows], [row["ratio"] for row in rows], style,
+              label=label)
+elements = sorted({row["elements"] for rows in ratios.values() for row in rows})
+ax.loglog(elements, np.sqrt(elements), "k:", label=r"Cauchy-Schwarz bound $\sqrt{N_T}$")
+ax.set_xlabel(r"number of triangles $N_T$")
+ax.set_ylabel(r"$\sum_T \eta_{tot,T} \,/\, (\sum_T \eta_{tot,T}^2)^{1/2}$")
+ax.set_title("Exercise 3: sum against square root of the sum of squares")
+ax.grid(True, which="both", alpha=0.3)
+ax.legend(fontsize=8)
+save_figure(fig, OUT / "sum_ratios.png")
 
 # %%
 save_results("06_estimator_solutions",

@@ -5,6 +5,7 @@
 
 # %%
 
+import matplotlib.pyplot as plt
 import ngsolve as ngs
 import numpy as np
 
@@ -13,11 +14,11 @@ from ngdual.boundary import BoundaryMeshes
 from ngdual.estimator import estimate
 from ngdual.forms import assemble
 from ngdual.marking import mark
-from ngdual.mesh import build_mesh
+from ngdual.mesh import build_mesh, mesh_arrays
 from ngdual.rates import fitted_rate
 from ngdual.scene import load_scene
 from ngdual.solvers import solve_problem, solve_scene
-from ngdual.studies.tutorials import output_dir, quick_mode, save_results
+from ngdual.studies.tutorials import output_dir, quick_mode, save_figure, save_results
 from ngdual.verification import corner
 
 QUICK = quick_mode()
@@ -56,12 +57,13 @@ def adapt_until(scene, marking, theta, max_dofs, level=1, indicator="eta", error
 # %% [markdown]
 # ## Exercise 1: the Dörfler parameter
 #
-# Every θ restores a rate close to the optimal 1 on the L-shape: the bulk criterion
-# refines around the corner whatever θ. Small θ refines few elements per step, so more
-# SOLVE steps are needed to reach the same N (each costing a solve), with a slightly
-# better error per unknown. Large θ refines more and more elements away from the corner;
-# θ = 1 marks every element with η_T > 0, i.e. uniform refinement, and the rate falls
-# back to α ≈ 0.54. θ ≈ 0.5 is the usual compromise.
+# Every $\theta$ restores a rate close to the optimal 1 on the L-shape: the bulk
+# criterion refines around the corner whatever $\theta$. Small $\theta$ refines few
+# elements per step, so more SOLVE steps are needed to reach the same $N$ (each costing a
+# solve), with a slightly better error per unknown. Large $\theta$ refines more and more
+# elements away from the corner; $\theta = 1$ marks every element with $\eta_T > 0$, i.e.
+# uniform refinement, and the rate falls back to $\alpha \approx 0.54$. $\theta \approx 0.5$
+# is the usual compromise.
 
 # %%
 l_shape = corner.l_shape_scene()          # Williams' corner solution (ngdual.verification.corner)
@@ -72,25 +74,40 @@ def exact_error(solution) -> float:
     return corner.exact_error(solution, exact)
 
 
-dorfler = {}
+dorfler, curves = {}, {}
 for theta in THETAS:
     rows, _ = adapt_until(l_shape, "dorfler", theta, TARGET_DOFS, error=exact_error)
     ndofs, errors = [r["ndof"] for r in rows], [r["error"] for r in rows]
+    curves[theta] = (ndofs, errors)
     dorfler[str(theta)] = {"steps": len(rows), "ndof": ndofs[-1], "error": errors[-1],
                            "rate": fitted_rate(ndofs[-3:], errors[-3:])}
     row = dorfler[str(theta)]
     print(f"theta = {theta}: {row['steps']:2d} SOLVE steps to N = {row['ndof']:5d}, error "
           f"{row['error']:.3e}, rate (last 3 steps) {row['rate']:.3f}")
 
+# %%
+fig, ax = plt.subplots(figsize=(6.5, 4.5))
+for theta, (ndofs, errors) in curves.items():
+    ax.loglog(ndofs, errors, "o-", ms=3, label=rf"Dörfler, $\theta = {theta}$")
+first_n, first_e = curves[THETAS[0]][0][0], curves[THETAS[0]][1][0]
+reference = np.array([first_n, TARGET_DOFS])
+ax.loglog(reference, first_e * (reference / first_n) ** -0.5, "k:", label=r"$N^{-1/2}$ (optimal)")
+ax.set_xlabel("degrees of freedom N")
+ax.set_ylabel("exact error e (Williams' corner solution)")
+ax.set_title(r"Exercise 1: Dörfler marking on the L-shape for three $\theta$")
+ax.grid(True, which="both", alpha=0.3)
+ax.legend()
+save_figure(fig, OUT / "dorfler_theta.png")
+
 # %% [markdown]
 # ## Exercise 2: which terms refine Example 3.46?
 #
-# Marking with η_{σ,T} alone leaves out η_{u,T} (tiny here: strains, not stresses) and,
-# more importantly, the friction term on Γ_C and the Neumann term on Γ_N. Without them
-# the refinement goes to the corners (asymmetry) and much less along Γ_N and Γ_C: the
-# Neumann term pulls the refinement to where t₀ switches off, the friction term to the
-# contact boundary. Counted below: the fine edges on Γ_N (top) and Γ_C (bottom) of the
-# final meshes.
+# Marking with $\eta_{\sigma,T}$ alone leaves out $\eta_{u,T}$ (tiny here: strains, not
+# stresses) and, more importantly, the friction term on $\Gamma_C$ and the Neumann term on
+# $\Gamma_N$. Without them the refinement goes to the corners (asymmetry) and much less
+# along $\Gamma_N$ and $\Gamma_C$: the Neumann term pulls the refinement to where $t_0$
+# switches off, the friction term to the contact boundary. Counted below: the fine edges
+# on $\Gamma_N$ (top) and $\Gamma_C$ (bottom) of the final meshes.
 
 
 # %%
@@ -99,10 +116,11 @@ def edges_on(mesh: ngs.Mesh, label: str) -> int:
 
 
 thesis = load_scene("thesis-3.46-coulomb")
-by_indicator = {}
+by_indicator, meshes = {}, {}
 for indicator in ("eta", "eta_sigma"):
     rows, mesh = adapt_until(thesis, "fraction", 0.2, 10**9, level=2, indicator=indicator,
                              max_steps=THESIS_STEPS)
+    meshes[indicator] = mesh
     by_indicator[indicator] = {"elements": mesh.ne, "top_edges": edges_on(mesh, "top"),
                                "bottom_edges": edges_on(mesh, "bottom"),
                                "eta": [r["eta"] for r in rows]}
@@ -111,28 +129,48 @@ for indicator in ("eta", "eta_sigma"):
           f"edges on Gamma_N, {row['bottom_edges']} on Gamma_C; eta_tot "
           f"{row['eta'][0]:.3e} -> {row['eta'][-1]:.3e}")
 
+# %%
+fig, axes = plt.subplots(2, 1, figsize=(9, 5.5), sharex=True)
+for ax, (indicator, label) in zip(axes, (("eta", r"$\eta_{tot,T}$ (4.50)"),
+                                         ("eta_sigma", r"$\eta_{\sigma,T}$ (4.15) only"))):
+    points, triangles = mesh_arrays(meshes[indicator])
+    ax.triplot(points[:, 0], points[:, 1], triangles, color="0.3", lw=0.3)
+    row = by_indicator[indicator]
+    ax.set_title(f"marked with {label}: {row['elements']} triangles, {row['top_edges']} "
+                 f"edges on $\\Gamma_N$ (top), {row['bottom_edges']} on $\\Gamma_C$ (bottom)",
+                 fontsize=9)
+    ax.set_aspect("equal")
+    ax.set_ylabel("$x_2$")
+axes[-1].set_xlabel("$x_1$")
+fig.suptitle(f"Exercise 2: Example 3.46 (Coulomb), fraction marking, {THESIS_STEPS} steps")
+fig.tight_layout()
+save_figure(fig, OUT / "meshes_by_indicator.png")
+
 # %% [markdown]
 # ## Exercise 3: the corners of Example 3.46
 #
-# With g = 0.01 the multiplier λ_n ∈ C_h̃ vanishes at the ends of Γ_C, so u_n = g there,
-# while u = 0 on Γ_D: the displacement jumps at the lower corners and σ ~ 1/r is not
-# square integrable. Under uniform refinement the asymmetry indicator of the corner
-# element stays at the same value, and η stalls (rate near 0). With g = 0 the data are
-# compatible: the largest asymmetry indicator shrinks with h and η decreases fast.
-# Dörfler marking first chases the largest η_{tot,T}, which for g = 0 sit at the ends of
-# Γ_N (the Neumann terms), and reaches the lower corners only after a few steps: the
-# quick run is still pre-asymptotic. Over 9 steps (without `NGDUAL_QUICK`) η decreases
-# at a rate of about 1.4 for g = 0, while for g = 0.01 it stalls near 420, its largest
-# asymmetry indicator frozen at about 160.
+# With $g = 0.01$ the multiplier $\lambda_n \in C_{\tilde h}$ vanishes at the ends of
+# $\Gamma_C$, so $u_n = g$ there, while $u = 0$ on $\Gamma_D$: the displacement jumps at
+# the lower corners and $\sigma \sim 1/r$ is not square integrable. Under uniform
+# refinement the asymmetry indicator of the corner element stays at the same value, and
+# $\eta$ stalls (rate near 0). With $g = 0$ the data are compatible: the largest asymmetry
+# indicator shrinks with $h$ and $\eta$ decreases fast. Dörfler marking first chases the
+# largest $\eta_{tot,T}$, which for $g = 0$ sit at the ends of $\Gamma_N$ (the Neumann
+# terms), and reaches the lower corners only after a few steps: the quick run is still
+# pre-asymptotic. Over 9 steps (without `NGDUAL_QUICK`) $\eta$ decreases at a rate of
+# about 1.4 for $g = 0$, while for $g = 0.01$ it stalls near 420, its largest asymmetry
+# indicator frozen at about 160.
 
 # %%
 corners = {}
 for gap in ("0.01", "0"):
     scene = load_scene("thesis-3.46-frictionless", [f"contact.gap='{gap}'"])
-    uniform = [estimate(solve_scene(scene, level)) for level in UNIFORM_LEVELS]
+    solutions = [solve_scene(scene, level) for level in UNIFORM_LEVELS]
+    uniform = [estimate(solution) for solution in solutions]
+    uniform_ndofs = [int(sum(s.problem.spaces.dofs().values())) for s in solutions]
     history = adapt(scene, "dorfler", 0.5, CORNER_STEPS, level=1)
     ndofs, etas = [r["dofs"]["total"] for r in history], [r["estimator"] for r in history]
-    corners[gap] = {"uniform_eta": [e.total for e in uniform],
+    corners[gap] = {"uniform_ndofs": uniform_ndofs, "uniform_eta": [e.total for e in uniform],
                     "uniform_as_max": [float(np.sqrt(e.terms["asymmetry"].max()))
                                        for e in uniform],
                     "dorfler_ndofs": ndofs, "dorfler_etas": etas,
@@ -141,6 +179,22 @@ for gap in ("0.01", "0"):
     print(f"g = {gap:4s} uniform levels {UNIFORM_LEVELS}: eta {np.round(row['uniform_eta'], 1)}, "
           f"max eta_as,T {np.round(row['uniform_as_max'], 1)}")
     print(f"         Dörfler: eta {np.round(etas, 1)}, rate {row['dorfler_rate']:.2f}")
+
+# %%
+# %%
+fig, ax = plt.subplots(figsize=(6.5, 4.5))
+for gap, colour in (("0.01", "tab:red"), ("0", "tab:blue")):
+    row = corners[gap]
+    ax.loglog(row["uniform_ndofs"], row["uniform_eta"], "s--", color=colour,
+              label=f"g = {gap}, uniform")
+    ax.loglog(row["dorfler_ndofs"], row["dorfler_etas"], "o-", color=colour, ms=3,
+              label=rf"g = {gap}, Dörfler $\theta = 0.5$")
+ax.set_xlabel("degrees of freedom N")
+ax.set_ylabel(r"estimator $\eta = (\sum_T \eta_{tot,T}^2)^{1/2}$")
+ax.set_title("Exercise 3: incompatible data (g = 0.01) stall the estimator")
+ax.grid(True, which="both", alpha=0.3)
+ax.legend(fontsize=8)
+save_figure(fig, OUT / "corners_eta.png")
 
 # %%
 save_results("07_adaptivity_solutions",

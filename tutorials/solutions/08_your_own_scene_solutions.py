@@ -4,12 +4,21 @@
 # Each exercise is one section; all run in seconds with `NGDUAL_QUICK=1`.
 
 # %%
+import matplotlib.pyplot as plt
 import numpy as np
 
+import ngdual as nd
 from ngdual import post
 from ngdual.scene import SceneError, load_scene
 from ngdual.solvers import solve_scene
-from ngdual.studies.tutorials import output_dir, quick_mode, save_results
+from ngdual.studies.tutorials import (
+    output_dir,
+    plot_geometry,
+    plot_von_mises,
+    quick_mode,
+    save_figure,
+    save_results,
+)
 
 QUICK = quick_mode()
 LEVELS = [1, 2, 3] if QUICK else [1, 2, 3, 4]
@@ -40,13 +49,19 @@ stamp_file.write_text(STAMP)
 # %% [markdown]
 # ## Exercise 1: the load at first contact
 #
-# Before contact the discrete problem is linear in the load factor s and in the gap g,
-# and so is λ_n (the discrete remaining gap): λ_n(g, s) = Λ(g) − s U as long as no
-# node touches. Two solves with a foundation far away (g = 1, never reached) give
-# Λ(1) (no load) and U = Λ(1) − λ_n(1, 1). For the flat foundation g₀ the node i
-# closes when g₀ Λ(1)_i = s U_i, so the first contact happens at
-# s* = min over U_i > 0 of g₀ Λ(1)_i / U_i. (Λ(1) is not 1 near the ends of Γ_C:
-# the coarse space vanishes there.) Check: 0.95 s* leaves a gap, 1.05 s* touches.
+# Before contact the discrete problem is linear in the load factor $s$ and in the gap
+# $g$, and so is $\lambda_n$ (the discrete remaining gap):
+# $\lambda_n(g, s) = \Lambda(g) - s\,U$ as long as no node touches. Two solves with a
+# foundation far away ($g = 1$, never reached) give $\Lambda(1)$ (no load) and
+# $U = \Lambda(1) - \lambda_n(1, 1)$. For the flat foundation $g_0$ the node $i$ closes
+# when $g_0\,\Lambda(1)_i = s\,U_i$, so the first contact happens at
+#
+# $$
+# s^* = \min_{i :\, U_i > 0} \frac{g_0\,\Lambda(1)_i}{U_i} .
+# $$
+#
+# ($\Lambda(1)$ is not 1 near the ends of $\Gamma_C$: the coarse space vanishes there.)
+# Check: $0.95\,s^*$ leaves a gap, $1.05\,s^*$ touches.
 
 # %%
 G0, LEVEL = 0.002, 2
@@ -62,19 +77,36 @@ loaded = solve_scene(stamp(1.0, "1"), LEVEL).part("lam_n")
 U = unloaded - loaded
 closing = U > 0
 s_star = float(np.min(G0 * unloaded[closing] / U[closing]))
-touching = {factor: post.contact_summary(solve_scene(stamp(factor * s_star, str(G0)), LEVEL))
-            ["nodes_in_contact"] for factor in (0.95, 1.05)}
+near_contact = {factor: solve_scene(stamp(factor * s_star, str(G0)), LEVEL)
+                for factor in (0.95, 1.05)}
+touching = {factor: post.contact_summary(solution)["nodes_in_contact"]
+            for factor, solution in near_contact.items()}
 print(f"first contact at s* = {s_star:.4f}; nodes in contact at 0.95 s*: {touching[0.95]}, "
       f"at 1.05 s*: {touching[1.05]}")
+
+# %%
+fig, ax = plt.subplots(figsize=(7, 4))
+for factor, solution in near_contact.items():
+    traces = nd.contact_traces(solution)
+    order = np.argsort(traces.node_xy[:, 0])
+    ax.plot(traces.node_xy[order, 0], traces.lam_n[order], "o-", ms=3,
+            label=f"load {factor} s* ({touching[factor]} nodes in contact)")
+ax.axhline(0.0, color="k", lw=0.8)
+ax.set_xlabel(r"$x_1$ on $\Gamma_C$ (the base)")
+ax.set_ylabel(r"remaining gap $\lambda_n = g - u_n$")
+ax.set_title(f"Exercise 1: first contact of the stamp at s* = {s_star:.3f} (g = {G0})")
+ax.grid(True, alpha=0.3)
+ax.legend()
+save_figure(fig, OUT / "first_contact.png")
 
 # %% [markdown]
 # ## Exercise 2: an arch on two feet
 #
 # A half annulus (radii 1 and 1.5) as a polygon with 8 segments per arc. Its feet (the
 # two short bottom sides) rest on the foundation. If all the curved sides were loaded
-# (Neumann), Γ_N would touch Γ_C at the feet, which the thesis' multipliers (zero at the
-# ends of Γ_C, `contact.ends = "thesis"`) do not allow; so the lowest segment of each arc
-# is clamped (an abutment). First two mistakes, then the fixed scene.
+# (Neumann), $\Gamma_N$ would touch $\Gamma_C$ at the feet, which the thesis' multipliers
+# (zero at the ends of $\Gamma_C$, `contact.ends = "thesis"`) do not allow; so the lowest
+# segment of each arc is clamped (an abutment). First two mistakes, then the fixed scene.
 
 # %%
 N = 8
@@ -130,15 +162,22 @@ arch_solution = solve_scene(arch, 2)
 # λ_n is the remaining gap at the coarse nodes: a node touches where it is (numerically) 0
 arch_gap = arch_solution.part("lam_n")
 arch_contact = int(np.sum(arch_gap <= 1e-6 * 0.0005))
+arch_mesh = arch_solution.problem.fes.mesh
+save_figure(plot_geometry(arch, mesh=arch_mesh,
+                          title="Exercise 2: the arch, its boundary parts and mesh (level 2)"),
+            OUT / "arch_geometry.png")
+save_figure(plot_von_mises(arch_mesh, nd.fields(arch_solution).sigma, arch.material.nu,
+                           "Exercise 2: von Mises stress in the arch on its two feet"),
+            OUT / "arch_von_mises.png")
 print(f"fixed arch: converged {arch_solution.converged}, remaining gap at the foot nodes "
       f"{np.array2string(arch_gap, precision=6)}: {arch_contact} of {len(arch_gap)} touch")
 
 # %% [markdown]
 # ## Exercise 3: convergence under refinement
 #
-# ‖σ‖_X converges; the differences between consecutive levels shrink roughly like h
-# (first order, Theorem 3.35 for smooth solutions — the kinks at the corners and the
-# contact zone limit the rate). The share of Γ_C nodes in contact settles as the
+# $\|\sigma\|_X$ converges; the differences between consecutive levels shrink roughly like
+# $h$ (first order, Theorem 3.35 for smooth solutions; the kinks at the corners and the
+# contact zone limit the rate). The share of $\Gamma_C$ nodes in contact settles as the
 # contact zone is resolved.
 
 # %%
