@@ -403,8 +403,8 @@ keys = st.sampled_from([f"{s}.{k}" for s, ks in KNOWN.items() for k in ks]
 
 
 def _data_of(name: str) -> dict:
-    from ngdual.scene import _read_toml
-    return _read_toml(name)[1]
+    from ngdual.scene import read_toml
+    return read_toml(name)[1]
 
 
 @settings(max_examples=EXAMPLES, deadline=None, **PROPERTY)

@@ -232,8 +232,8 @@ def scene_keys() -> list[SceneKey]:
     keys = [SceneKey("name", "str", "the file name", (), MEANINGS.get("name", "")),
             SceneKey("description", "str", "none", (), MEANINGS.get("description", ""))]
     keys += [SceneKey(f"boundary.{role}", "list of str", "[]", (),
-                      MEANINGS.get(f"boundary.{role}", "")) for role in scene._ROLES]
-    for section, cls in scene._SECTIONS.items():
+                      MEANINGS.get(f"boundary.{role}", "")) for role in scene.ROLES]
+    for section, cls in scene.SECTIONS.items():
         for f in dataclasses.fields(cls):
             key = f"{section}.{f.name}"
             constant = CHOICES.get(key)
@@ -242,7 +242,7 @@ def scene_keys() -> list[SceneKey]:
                                      f"of {key}) is gone; update CHOICES in {__file__}")
             choices = tuple(getattr(scene, constant)) if constant else ()
             kind = str(f.type).replace(" | None", ", optional")
-            if key in scene._FORMULAS:
+            if key in scene.FORMULAS:
                 kind = "formula" if kind.startswith("str") else "list of 2 formulas"
             keys.append(SceneKey(key, kind, _default(f), choices, MEANINGS.get(key, "")))
     missing = [k.key for k in keys if not k.meaning]

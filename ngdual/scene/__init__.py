@@ -1,0 +1,90 @@
+"""Scene description: geometry, material, loads, contact, friction, solver settings.
+
+A scene is a TOML file (or the equivalent :class:`Scene` object). Every user
+error is detected here, by :func:`validate`, and reported as one
+:class:`SceneError` whose message names the offending field, e.g.
+``material.nu: Poisson's ratio must lie in (-1, 0.5), got 0.5``; several problems
+in one scene are reported together, one line each. Types, ranges, formulas
+(:mod:`ngdual.expr`: bounded, finite and integrable where they act) and the geometry
+(no repeated points, zero-length or crossing sides) are all checked before anything
+is meshed.
+
+The schema (all tables optional except ``geometry``, whose ``kind`` must be given, and
+``boundary``: a scene states its domain, it never defaults to the thesis rectangle)::
+
+    name = "thesis-3.46-frictionless"
+    [geometry]   kind = "thesis-3.46" | "polygon", level, points, labels, maxh, arcs
+    [boundary]   dirichlet = [labels], neumann = [labels], contact = [labels]
+    [material]   E, nu                                   (plane strain)
+    [loads]      body_force = [fx, fy], traction = [tx, ty], displacement = [ux, uy]
+    [contact]    gap | foundation = {point, normal}, htilde_factor (h~/h),
+                 hhat_factor (h^/h~: 1 or 2), ends = "consistent" | "thesis"
+    [friction]   law = "none" | "tresca" | "coulomb", mu, bound (Tresca F),
+                 normal_stress = "hat-projection" | "fine-edges" (the |sigma_n| of F)
+    [solver]     method, metric, rho, eps, max_iter, rho1, rho2, eps1, eps2, loop_order,
+                 friction_metric
+    [units]      length = "m" | "mm" | ..., stress = "Pa" | "MPa" | ...  (labels of plots)
+
+Loads, gap and bound are formulas in ``x`` and ``y`` (see :mod:`ngdual.expr`).
+
+The package: :mod:`.tables` (the tables, their defaults, SceneError), :mod:`.load` (TOML,
+shipped scenes, overrides), :mod:`.values` (single values), :mod:`.domain` (the polygon,
+boundary parts, foundation and contact sides; the contact data of a scene) and
+:mod:`.validate` (the whole scene).
+"""
+
+from .domain import (
+    contact_junctions,
+    contact_samples,
+    foundation_line,
+    gap_at,
+    role_of,
+    validate_geometry,
+)
+from .load import (
+    apply_overrides,
+    load_scene,
+    read_toml,
+    scene_from_dict,
+    shipped_scenes,
+)
+from .tables import (
+    CONTACT_ENDS,
+    FRICTION_LAWS,
+    FRICTION_METRICS,
+    GEOMETRY_KINDS,
+    LENGTH_UNITS,
+    LOOP_ORDERS,
+    METRICS,
+    NORMAL_STRESSES,
+    ROLES,
+    SECTIONS,
+    SOLVER_METHODS,
+    STRESS_UNITS,
+    Contact,
+    Friction,
+    Geometry,
+    Loads,
+    Material,
+    Scene,
+    SceneError,
+    SceneTypeError,
+    Solver,
+    Units,
+)
+from .validate import (
+    check_level,
+    ensure_valid,
+    validate,
+)
+from .values import (
+    FORMULAS,
+)
+
+__all__ = ["CONTACT_ENDS", "Contact", "FORMULAS", "FRICTION_LAWS", "FRICTION_METRICS",
+           "Friction", "GEOMETRY_KINDS", "Geometry", "LENGTH_UNITS", "LOOP_ORDERS", "Loads",
+           "METRICS", "Material", "NORMAL_STRESSES", "ROLES", "SECTIONS", "SOLVER_METHODS",
+           "STRESS_UNITS", "Scene", "SceneError", "SceneTypeError", "Solver", "Units",
+           "apply_overrides", "check_level", "contact_junctions", "contact_samples",
+           "ensure_valid", "foundation_line", "gap_at", "load_scene", "read_toml", "role_of",
+           "scene_from_dict", "shipped_scenes", "validate", "validate_geometry"]

@@ -1,0 +1,110 @@
+"""Checks of single values: types, finite and positive numbers, formulas, and how a value is shown
+in an error message."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+from ..expr import Expression, ExpressionError
+from .tables import ROLES, SECTIONS, Problems, Scene, SceneError
+
+
+def show(value, width: int = 60) -> str:
+    """``repr(value)`` for a message, shortened (user input can be arbitrarily long)."""
+    try:
+        text = repr(value)
+    except ValueError:  # an integer beyond Python's digit limit for str()
+        text = f"<an integer of {value.bit_length()} bits>"
+    return text if len(text) <= width else text[:width - 3] + "..."
+
+
+def _is_number(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def finite(value) -> bool:
+    """A number (not a bool) that is finite in double precision (huge integers are not)."""
+    try:
+        return _is_number(value) and math.isfinite(value)
+    except OverflowError:
+        return False
+
+
+def positive(value, field_name: str, integer: bool = False) -> None:
+    kind = int if integer else (int, float)
+    if not isinstance(value, kind) or not finite(value) or value <= 0:
+        raise SceneError(field_name, f"must be a positive {'integer' if integer else 'number'}, "
+                                     f"got {show(value)}")
+
+
+def expression(text, field_name: str) -> Expression:
+    try:
+        return Expression(text)
+    except (ExpressionError, TypeError) as err:
+        raise SceneError(field_name, str(err)) from None
+
+
+def pair(values, field_name: str) -> list[Expression]:
+    if not isinstance(values, (list, tuple)) or len(values) != 2:
+        raise SceneError(field_name, f"must be a pair [x-component, y-component], got "
+                                     f"{show(values)}")
+    problems = Problems()
+    out = []
+    for i, v in enumerate(values):
+        with problems.check():
+            out.append(expression(v, f"{field_name}[{i}]"))
+    problems.raise_any()
+    return out
+
+
+# What each setting must be; the formulas (loads, contact.gap, friction.bound) are checked
+# by parsing them, the tables of geometry (points, labels, arcs, side_maxh) entry by entry.
+_TYPES = {"str": (str,), "int": (int,), "float": (int, float), "list": (list, tuple),
+          "dict": (dict,)}
+
+
+_TYPE_NAMES = {"str": "a string", "int": "an integer", "float": "a number",
+               "list": "a list", "dict": "a table"}
+
+
+FORMULAS = {"contact.gap", "friction.bound", "loads.body_force", "loads.traction",
+             "loads.displacement"}
+
+
+def field_type_problems(section: str, obj) -> list[tuple[str, str]]:
+    """``(field, message)`` for every setting of one section whose type is wrong."""
+    found = []
+    for f in dataclasses.fields(obj):
+        key, value = f"{section}.{f.name}", getattr(obj, f.name)
+        kinds = [k.strip() for k in str(f.type).split("|")]
+        if key in FORMULAS or (value is None and "None" in kinds):
+            continue
+        if isinstance(value, bool) or not isinstance(value, _TYPES[kinds[0]]):
+            found.append((key, f"must be {_TYPE_NAMES[kinds[0]]}, got {show(value)}"))
+    return found
+
+
+def type_problems(scene: Scene) -> list[tuple[str, str]]:
+    """``(field, message)`` for every setting of ``scene`` whose type is wrong."""
+    found = []
+    if not isinstance(scene.name, str):
+        found.append(("name", f"must be a string, got {show(scene.name)}"))
+    for section, cls in SECTIONS.items():
+        obj = getattr(scene, section)
+        if not isinstance(obj, cls):
+            found.append((section, f"must be a {cls.__module__}.{cls.__name__}, got "
+                                   f"{type(obj).__name__}"))
+            continue
+        found += field_type_problems(section, obj)
+    if not isinstance(scene.boundary, dict):
+        found.append(("boundary", f"must be a table role -> labels, got {show(scene.boundary)}"))
+        return found
+    for role, labels in scene.boundary.items():
+        if role not in ROLES:
+            found.append((f"boundary.{role}", f"unknown role; use one of {', '.join(ROLES)}"))
+        elif not isinstance(labels, (list, tuple)) or not all(isinstance(lab, str)
+                                                              for lab in labels):
+            found.append((f"boundary.{role}", f"must be a list of side labels, got "
+                                              f"{show(labels)}"))
+    return found
