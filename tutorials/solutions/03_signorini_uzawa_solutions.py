@@ -52,7 +52,6 @@ fig, ax = plt.subplots(figsize=(7, 4.5))
 for (metric, level), counts in sweeps.items():
     ax.plot(list(counts), list(counts.values()), "o-" if metric == "h12" else "s--",
             label=f"{metric}, level {level}")
-ax.set_yscale("log")
 ax.set_xlabel(r"step length $\rho$")
 ax.set_ylabel("Uzawa iterations to $\\varepsilon = 10^{-8}$")
 ax.set_title("Exercise 1: iterations against $\\rho$ (missing point: no convergence)")
