@@ -256,7 +256,7 @@ def open_page(browser, server: str, path: str, screenshot: str | None = None) ->
         browser.execute_script("window.scrollTo(0, 0);")
         browser.save_screenshot(str(SCREENSHOTS / f"{screenshot}.png"))
         if browser.execute_script("""const img = document.querySelector('.cell_output img');
-                                     if (img) { img.scrollIntoView(); } return !!img;"""):
+            if (img) { img.scrollIntoView({block: 'center'}); } return !!img;"""):
             browser.save_screenshot(str(SCREENSHOTS / f"{screenshot}-first-figure.png"))
     return {"math": math, "images": images, "resources": browser.execute_script(RESOURCES),
             "console": [e for e in browser.get_log("browser") if e["level"] == "SEVERE"],
