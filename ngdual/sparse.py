@@ -1,7 +1,8 @@
-"""NGSolve's assembled sparse matrices as SciPy matrices: the one conversion ngdual uses."""
+"""Sparse matrices between NGSolve and SciPy: the one conversion each way that ngdual uses."""
 
 from __future__ import annotations
 
+import ngsolve as ngs
 import numpy as np
 import scipy.sparse as sp
 
@@ -25,3 +26,11 @@ def to_scipy(matrix, copy: bool = True) -> sp.csr_matrix:
     return sp.csr_matrix((np.array(values, copy=copy), np.array(columns, copy=copy),
                           np.array(row_starts, dtype=np.int64)),
                          shape=(matrix.height, matrix.width))
+
+
+def to_ngsolve(matrix: sp.spmatrix) -> ngs.la.SparseMatrixd:
+    """A SciPy sparse matrix as an NGSolve one (for NGSolve's direct solvers)."""
+    coo = matrix.tocoo()
+    return ngs.la.SparseMatrixd.CreateFromCOO(
+        coo.row.astype(np.int64).tolist(), coo.col.astype(np.int64).tolist(),
+        coo.data.tolist(), matrix.shape[0], matrix.shape[1])

@@ -41,7 +41,7 @@ import scipy.sparse as sp
 
 from .. import peers
 from ..forms import DiscreteProblem, boundary_regex
-from .linear import to_scipy
+from ..sparse import to_scipy
 from .settings import Model
 
 

@@ -10,29 +10,14 @@ from __future__ import annotations
 
 import time
 
-import ngsolve as ngs
 import numpy as np
 import scipy.sparse as sp
 from threadpoolctl import threadpool_limits
 
 from ..forms import DiscreteProblem
+from ..sparse import to_ngsolve
 from ..tolerances import BLAS_THREADS
 from .result import Solution
-
-
-def to_scipy(matrix) -> sp.csr_matrix:
-    """An assembled NGSolve sparse matrix as a SciPy CSR matrix (from its COO triplets)."""
-    rows, cols, vals = matrix.COO()
-    return sp.csr_matrix((np.asarray(vals), (np.asarray(rows), np.asarray(cols))),
-                         shape=(matrix.height, matrix.width))
-
-
-def to_ngsolve(matrix: sp.spmatrix) -> ngs.la.SparseMatrixd:
-    """A SciPy sparse matrix as an NGSolve one (for NGSolve's direct solvers)."""
-    coo = matrix.tocoo()
-    return ngs.la.SparseMatrixd.CreateFromCOO(
-        coo.row.astype(np.int64).tolist(), coo.col.astype(np.int64).tolist(),
-        coo.data.tolist(), matrix.shape[0], matrix.shape[1])
 
 
 class Factorization:
