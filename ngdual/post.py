@@ -323,7 +323,8 @@ def friction_diagnostics(solution: Solution, slip_tol: float = 1e-6) -> Friction
     from .friction import build_friction_forms
 
     pb = solution.problem
-    forms = build_friction_forms(pb)
+    # the solver's own forms; a solution assembled elsewhere builds them once here
+    forms = solution.friction_forms or build_friction_forms(pb)
     sigma = solution.x[pb.sigma]
     t_n = pb.block(pb.sigma, pb.lam_n).T @ sigma
     t_t = pb.block(pb.sigma, pb.index("lam_t")).T @ sigma

@@ -58,8 +58,8 @@ def field_arrays(solution) -> dict[str, np.ndarray]:
         from ...friction import build_friction_forms
 
         diag = post.friction_diagnostics(solution)
-        bound = build_friction_forms(pb).q_matrix(solution.friction_bound).T @ np.ones(
-            len(solution.nu))
+        forms = solution.friction_forms or build_friction_forms(pb)
+        bound = forms.q_matrix(solution.friction_bound).T @ np.ones(len(solution.nu))
         out["bound_ratio"] = np.where(bound > 0, np.abs(diag.t_t) / np.where(bound > 0, bound,
                                                                             1.0), 0.0)
         codes = {"separation": 0, "free": 0, "stick": 1, "slip": 2}
