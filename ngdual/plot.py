@@ -49,15 +49,24 @@ def _stress(units) -> str | None:
     return getattr(units, "stress", None)
 
 
-def clipped_scale(values: np.ndarray, clip: float | None) -> tuple[float, float, str, str]:
+def clipped_scale(values: np.ndarray, clip: float | None,
+                  vmax: float | None = None) -> tuple[float, float, str, str]:
     """``(vmin, vmax, extend, note)`` of a colour scale ending at the ``clip`` percentile.
 
     A field that changes sign is clipped symmetrically in |value|. ``note`` states the
     clipping and the largest value beyond it (empty without clipping, or when nothing
-    lies beyond the percentile).
+    lies beyond the percentile). ``vmax`` ends the scale at a given value instead (one
+    scale for several pictures), stated the same way where values lie beyond it.
+
+    >>> clipped_scale(np.array([0.0, 1.0, 4.0]), None, vmax=2.0)[1:3]
+    (2.0, 'max')
     """
     values = np.asarray(values, float)
     low, high = float(values.min()), float(values.max())
+    if vmax is not None:
+        if vmax >= high:
+            return low, vmax, "neither", ""
+        return low, vmax, "max", f"colour scale ends at {vmax:.3g} (max {high:.3g})"
     if clip is None or not 0 < clip < 100:
         return low, high, "neither", ""
     if low < 0 < high:
@@ -148,16 +157,17 @@ def plot_contact_traces(traces, title: str = "", units=None,
 
 def plot_element_field(points: np.ndarray, triangles: np.ndarray, values: np.ndarray,
                        title: str, label: str, clip: float | None = None,
-                       units=None) -> Figure:
+                       units=None, vmax: float | None = None) -> Figure:
     """A piecewise constant field on the triangulation, with a colour bar labelled ``label``.
 
     ``clip``: end the colour scale at this percentile (e.g. 99 for a von Mises stress
-    with corner singularities); the colour bar states the clipping.
+    with corner singularities); ``vmax``: end it at this value (to compare pictures);
+    the colour bar states the clipping.
     """
     aspect = float(np.ptp(points[:, 1])) / max(float(np.ptp(points[:, 0])), 1e-300)
     fig, ax = plt.subplots(figsize=(11, min(9 * aspect, 12.0) + 2.0), constrained_layout=True)
     tri = mtri.Triangulation(points[:, 0], points[:, 1], triangles)
-    vmin, vmax, extend, note = clipped_scale(values, clip)
+    vmin, vmax, extend, note = clipped_scale(values, clip, vmax)
     art = ax.tripcolor(tri, facecolors=values, cmap="viridis", vmin=vmin, vmax=vmax,
                        edgecolors="none")
     _colorbar(fig, art, ax, label, extend, note, _is_wide(points))

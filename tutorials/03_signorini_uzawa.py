@@ -64,7 +64,6 @@ from ngdual.studies.tutorials import (
     draw,
     output_dir,
     plot_geometry,
-    plot_traces,
     plot_von_mises,
     quick_mode,
     save_figure,
@@ -287,8 +286,8 @@ print("contact residuals of the Uzawa solution:",
 # reaches $-g$ (gap closed, $\lambda_n = 0$) exactly where $\sigma_n < 0$.
 
 # %%
-save_figure(plot_traces(nd.contact_traces(tight),
-                        f"Example 3.46 without friction: traces on Γ_C, level {LEVEL}"),
+save_figure(nd.plot_contact_traces(nd.contact_traces(tight),
+                                    f"Example 3.46 without friction: traces on Γ_C, level {LEVEL}"),
             OUT / "contact_traces.png")
 
 # %% [markdown]

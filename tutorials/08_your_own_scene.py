@@ -38,7 +38,6 @@ from ngdual.studies.tutorials import (
     draw,
     output_dir,
     plot_geometry,
-    plot_traces,
     plot_von_mises,
     quick_mode,
     save_figure,
@@ -177,8 +176,8 @@ sigma_h = nd.fields(solution).sigma
 save_figure(plot_von_mises(mesh, sigma_h, scene.material.nu,
                            f"von Mises stress, {scene.name}, level {LEVELS[-1]}"),
             OUT / "von_mises.png")
-save_figure(plot_traces(nd.contact_traces(solution),
-                        f"Traces on Γ_C, {scene.name}, level {LEVELS[-1]}"),
+save_figure(nd.plot_contact_traces(nd.contact_traces(solution),
+                                    f"Traces on Γ_C, {scene.name}, level {LEVELS[-1]}"),
             OUT / "contact_traces.png")
 draw(nd.post.von_mises(sigma_h, scene.material.nu), mesh, "von_mises")
 

@@ -23,9 +23,10 @@ Pictures
 :func:`plot_geometry` draws the domain of a scene with its boundary parts Γ_D, Γ_N,
 Γ_C and the mesh (the first picture of every tutorial); :func:`plot_von_mises` the von
 Mises stress per element on a percentile-clipped colour scale (stated on the colour
-bar), because corner singularities would otherwise take the whole scale;
-:func:`plot_traces` the traces on Γ_C. They return matplotlib figures and need only
-matplotlib; :func:`save_figure` saves a figure and shows it in a notebook.
+bar), because corner singularities would otherwise take the whole scale (through
+:func:`ngdual.plot.plot_element_field`; the traces on Γ_C are ``nd.plot_contact_traces``).
+They return matplotlib figures; :func:`save_figure` saves a figure and shows it in a
+notebook.
 """
 
 from __future__ import annotations
@@ -85,17 +86,15 @@ def output_dir(tutorial: str) -> Path:
 
 
 def save_figure(fig, path: str | Path) -> None:
-    """Save a matplotlib figure as PNG and close it; in a notebook also show the file.
+    """Save a matplotlib figure as PNG (:func:`ngdual.plot.save_figure`: atomically, then
+    closed); in a notebook also show the file.
 
     The PNG is shown rather than the figure object, so the picture appears whatever
     matplotlib backend is active (a headless run uses Agg).
     """
-    import matplotlib.pyplot as plt
+    from ..plot import save_figure as write
 
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120, bbox_inches="tight")
-    plt.close(fig)
+    write(fig, path, dpi=120)
     show_file(path)
 
 
@@ -176,78 +175,20 @@ def plot_geometry(scene, mesh=None, level: int | None = None, title: str | None 
 
 def plot_von_mises(mesh, sigma, nu: float, title: str, clip: float | None = 97.0,
                    label: str = "von Mises stress", vmax: float | None = None):
-    """The plane-strain von Mises stress of ``sigma`` per element (value at the centroid).
+    """The plane-strain von Mises stress of ``sigma`` per element (value at the centroid):
+    :func:`ngdual.plot.plot_element_field` of :func:`ngdual.post.von_mises`.
 
     ``clip``: the colour scale ends at this percentile of the element values (corner
     singularities would otherwise take the whole scale); the colour bar says so and
     gives the true maximum. ``None`` shows the full range. ``vmax`` ends the scale at a
     given value instead (to compare pictures). Returns the figure.
     """
-    import matplotlib.pyplot as plt
-    import numpy as np
-
+    from ..plot import plot_element_field
     from ..post import element_values, von_mises
 
     points, triangles, values = element_values(mesh, von_mises(sigma, nu))
-    top = float(values.max())
-    by_percentile = vmax is None and clip is not None
-    if vmax is None:
-        vmax = float(np.percentile(values, clip)) if clip is not None else top
-    width, height = np.ptp(points, axis=0)
-    fig, ax = plt.subplots(figsize=(9, max(3.0, 7 * height / width + 1.0)))
-    art = ax.tripcolor(points[:, 0], points[:, 1], triangles, facecolors=values,
-                       cmap="viridis", vmin=0.0, vmax=vmax, edgecolors="none")
-    clipped = top > vmax
-    where = f"the {clip:g}th\npercentile" if by_percentile else f"{vmax:.3g}"
-    note = f"\n(scale clipped at {where};\nmaximum {top:.3g})" if clipped else ""
-    fig.colorbar(art, ax=ax, extend="max" if clipped else "neither", label=label + note,
-                 fraction=0.046, pad=0.02)
-    ax.set_aspect("equal")
-    ax.set_xlabel("$x_1$")
-    ax.set_ylabel("$x_2$")
-    ax.set_title(title)
-    fig.tight_layout()
-    return fig
+    return plot_element_field(points, triangles, values, title, label, clip=clip, vmax=vmax)
 
-
-def plot_traces(traces, title: str):
-    """σ_n, σ_t (per fine edge) and λ_n − g, λ_t (nodal) along Γ_C; returns the figure.
-
-    ``traces``: :func:`ngdual.post.contact_traces` (``nd.contact_traces``).
-    """
-    import matplotlib.pyplot as plt
-    import numpy as np
-
-    fig, axes = plt.subplots(2, 2, figsize=(11, 6), sharex=True)
-    edge, node = np.argsort(traces.edge_xy[:, 0]), np.argsort(traces.node_xy[:, 0])
-    x_edge, x_node = traces.edge_xy[edge, 0], traces.node_xy[node, 0]
-    opening = (traces.lam_n - traces.gap)[node]
-    panels = [(axes[0, 0], x_edge, traces.sigma_n[edge], r"normal stress $\sigma_n^h$",
-               "steps-mid"),
-              (axes[0, 1], x_edge, traces.sigma_t[edge], r"tangential stress $\sigma_t^h$",
-               "steps-mid"),
-              (axes[1, 0], x_node, opening, r"$\lambda_n - g = -u_n$", "default"),
-              (axes[1, 1], x_node, traces.lam_t[node], r"$\lambda_t = -u_t$", "default")]
-    for ax, xs, ys, label, style in panels:
-        ax.plot(xs, ys, drawstyle=style, lw=1.2)
-        ax.set_ylabel(label)
-        ax.grid(alpha=0.3)
-    for ax, values in ((axes[0, 0], traces.sigma_n), (axes[0, 1], traces.sigma_t)):
-        limit = 1.4 * float(np.percentile(np.abs(values), 90))   # the ends of Γ_C are singular
-        if 0 < limit < np.max(np.abs(values)):
-            ax.set_ylim(-limit, limit)
-            ax.set_title(f"range clipped: |max| = {np.max(np.abs(values)):.3g} at the ends",
-                         fontsize=8)
-    contact = traces.coarse_xy[traces.coarse_in_contact, 0]
-    if contact.size:
-        axes[1, 0].plot(contact, np.interp(contact, x_node, opening), "rv", ms=4,
-                        label=r"$\tilde h$-node in contact")
-        axes[1, 0].legend(loc="best")
-    for ax in axes[1]:
-        ax.set_xlabel(r"$x_1$ on $\Gamma_C$")
-    fig.suptitle(title)
-    fig.tight_layout()
-    return fig
 
 def save_results(tutorial: str, results: dict) -> Path:
     """Write the numbers a tutorial computed to ``output_dir(tutorial)/results.json``.
