@@ -65,12 +65,13 @@ def solve_scene(scene: Scene, level: int | None = None,
         raise SceneTypeError("allow_large", f"must be True or False, got {allow_large!r}")
     budget.check(scene.geometry, level, "level", allow_large, method=scene.solver.method)
     status = status or (lambda phase: None)
-    status(f"meshing level {scene.geometry.level if level is None else level}")
+    level = scene.geometry.level if level is None else level
+    status(f"meshing level {level}")
     mesh = build_mesh(scene.geometry, level)
     check_formulas(scene, mesh)
     status(f"assembling on {mesh.ne} triangles")
     problem = assemble(scene, mesh)
-    problem.level = scene.geometry.level if level is None else level
+    problem.level = level
     check_unknowns(problem)
     status(f"factorising and solving, {problem.fes.ndof} unknowns")
     solution = solve_problem(problem, solver_settings(scene), progress)
