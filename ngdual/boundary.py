@@ -330,7 +330,7 @@ class CoarseMesh:
         first, last = self.free[c]
         return n[(0 if first else 1):(len(n) if last else len(n) - 1)]
 
-    def _ends(self, c: int) -> np.ndarray:
+    def end_positions(self, c: int) -> np.ndarray:
         """Positions of the fixed end nodes of chain c (none for a closed chain)."""
         n = self.nodes[c]
         if self.chains[c].closed:
@@ -339,7 +339,7 @@ class CoarseMesh:
 
     def end_points(self) -> np.ndarray:
         """Coordinates of the fixed end nodes, in the order of ``ends=True``."""
-        pts = [self.chains[c].points[self._ends(c)] for c in range(len(self.chains))]
+        pts = [self.chains[c].points[self.end_positions(c)] for c in range(len(self.chains))]
         return np.vstack(pts) if pts else np.zeros((0, 2))
 
     def end_normals(self) -> np.ndarray:
@@ -350,7 +350,7 @@ class CoarseMesh:
         out = []
         for c, chain in enumerate(self.chains):
             normals = edge_normals(chain)
-            for pos in self._ends(c):
+            for pos in self.end_positions(c):
                 out.append(normals[min(int(pos), chain.n_edges - 1)])
         return np.array(out).reshape(-1, 2)
 
@@ -408,7 +408,7 @@ class CoarseMesh:
         offset = 0
         for c, chain in enumerate(self.chains):
             s, nodes = chain.arclength, self.nodes[c]
-            carriers = self._ends(c) if ends else self.dof_positions(c)
+            carriers = self.end_positions(c) if ends else self.dof_positions(c)
             dof_of_pos = {int(p): offset + k for k, p in enumerate(carriers)}
             offset += len(carriers)
             for e in range(len(nodes) - 1):
@@ -439,7 +439,7 @@ class CoarseMesh:
         offset, edge = 0, 0
         for c, chain in enumerate(self.chains):
             s, nodes = chain.arclength, self.nodes[c]
-            carriers = self._ends(c) if ends else self.dof_positions(c)
+            carriers = self.end_positions(c) if ends else self.dof_positions(c)
             dof_of_pos = {int(p): offset + k for k, p in enumerate(carriers)}
             offset += len(carriers)
             for k in range(chain.n_edges):

@@ -9,7 +9,8 @@ estimator read Gamma_C from it instead of deriving it again:
 * the h~ mesh of lambda_n, lambda_t and the h^ mesh of nu (:mod:`ngdual.boundary`), the
   h~ and h^ edge of every fine edge and the mean of every h~ hat on every fine edge;
 * the gap g (a formula, or from a foundation line, :class:`ngdual.scene.Contact`) as an
-  NGSolve coefficient and at points;
+  NGSolve coefficient, at points, and its P1 interpolant g_h on the h~ mesh (the gap of
+  ``contact.discrete_gap = "nodal"``);
 * the prescribed end values of lambda_n = g - u_n and lambda_t = -u_t where Gamma_C meets
   Gamma_D (``contact.ends = "consistent"``): g - u_D.n and -u_D.t; zero for ``"thesis"``.
 """
@@ -38,6 +39,16 @@ def trace_space(mesh: ngs.Mesh, labels: list[str]) -> ngs.FESpace:
         return ngs.Compress(ngs.Discontinuous(h1, BND=True))
     finally:
         ngs.ngsglobals.msg_level = level
+
+
+def _vertex_normals(chain) -> np.ndarray:
+    """Outward unit normals at the vertices of ``chain`` (``path_points`` order): the mean
+    of the two edge normals inside the chain, the end edge's at an end of an open chain."""
+    n = edge_normals(chain)
+    mean = np.vstack([n[:1], n[:-1] + n[1:], n[-1:]])
+    if chain.closed:
+        mean[0] = mean[-1] = n[0] + n[-1]
+    return mean / np.linalg.norm(mean, axis=1)[:, None]
 
 
 def gap_coefficient(scene: Scene) -> ngs.CoefficientFunction:
@@ -139,19 +150,41 @@ class ContactBoundary:
     def vertex_normals(self) -> np.ndarray:
         """Outward normals at the fine vertices of every chain (``path_points`` order): the
         mean of the two edge normals inside a chain, the end edge's at a chain end."""
-        out = []
-        for chain in self.coarse.chains:
-            n = edge_normals(chain)
-            mean = np.vstack([n[:1], n[:-1] + n[1:], n[-1:]])
-            if chain.closed:
-                mean[0] = mean[-1] = n[0] + n[-1]
-            out.append(mean / np.linalg.norm(mean, axis=1)[:, None])
-        return np.vstack(out)
+        return np.vstack([_vertex_normals(chain) for chain in self.coarse.chains])
 
     def gap_at_vertices(self) -> np.ndarray:
         """g at the fine vertices of every chain (``path_points`` order)."""
         pts = np.vstack([ch.path_points for ch in self.coarse.chains])
         return gap_at(self.scene.contact, pts, self.vertex_normals())
+
+    def gap_at_nodes(self) -> tuple[np.ndarray, np.ndarray]:
+        """g at the h~ nodes: (at the dofs, in dof order; at the fixed ends, in the order
+        of ``coarse.end_points()``), with the vertex normals of :meth:`vertex_normals`.
+
+        These are the nodal values of g_h = I_h~ g, the gap of ``contact.discrete_gap =
+        "nodal"`` (:meth:`gap_interpolant`).
+        """
+        dofs, ends = [], []
+        for c, chain in enumerate(self.coarse.chains):
+            points, normals = chain.path_points, _vertex_normals(chain)
+            for out, positions in ((dofs, self.coarse.dof_positions(c)),
+                                   (ends, self.coarse.end_positions(c))):
+                out.append(gap_at(self.scene.contact, points[positions], normals[positions]))
+        return np.concatenate(dofs), np.concatenate(ends)
+
+    def gap_interpolant(self, prolongation: sp.csr_matrix, end_hats: sp.csr_matrix
+                        ) -> np.ndarray:
+        """Fine trace coefficients of g_h = I_h~ g, the P1 interpolant of g on the h~ mesh.
+
+        ``prolongation`` and ``end_hats`` are :meth:`prolongation` without and with
+        ``ends=True``. With g_h for g in g(tau) of (3.32), lambda_n - g_h = -u_n lies in the
+        multiplier space: the discrete problem sees u_n only through its h~ nodal values,
+        the contact condition lambda_n >= 0 is u_n <= g at the h~ nodes, and without load
+        lambda_n = g_h, sigma = 0 solves (3.62) for any g >= 0 (g itself would prescribe
+        u_n = g - lambda_n on the fine edges wherever g is not P1 on h~).
+        """
+        at_dofs, at_ends = self.gap_at_nodes()
+        return prolongation @ at_dofs + end_hats @ at_ends
 
     def end_values(self, u_d: tuple[str, str]) -> tuple[np.ndarray, np.ndarray]:
         """(lambda_n, lambda_t) at the fixed ends (``coarse.end_points()``).

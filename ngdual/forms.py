@@ -235,7 +235,8 @@ def _forms(scene: Scene, fes: ngs.FESpace, names: list[str]):
                       intrules=TRACE_RULES)
         d += (trial["lam_t"] * (t * trac_tau) + test["lam_t"] * (t * trac_sig)) * ds_c  # d_Ct
         d += (trial["lam_n"] * (n * trac_tau) + test["lam_n"] * (n * trac_sig)) * ds_c  # d_Cn
-        rhs += gap_coefficient(scene) * (n * trac_tau) * ds_c                 # g(tau)
+        if scene.contact.discrete_gap == "thesis":
+            rhs += gap_coefficient(scene) * (n * trac_tau) * ds_c             # g(tau)
     return a, d, rhs
 
 
@@ -268,7 +269,8 @@ def assemble(scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes | None = None
     if d is not None:
         D = to_scipy(d.mat)
         K = volume + P.T @ D @ P
-        F -= P.T @ (D @ lift)  # a has no entries in the multipliers' columns, where lift lives
+        # a has no entries in the multipliers' columns, where lift and the gap live
+        F -= P.T @ (D @ (lift - _discrete_gap(scene, spaces, fes, names)))
     else:
         K = volume.copy()
     K.eliminate_zeros()
@@ -283,6 +285,24 @@ def _leading_block(K_fine: sp.csr_matrix, n: int, size: int) -> sp.csr_matrix:
         raise ValueError("the volume form couples unknowns after the PEERS triple")
     indptr = np.concatenate([K_fine.indptr[:n + 1], np.full(size - n, K_fine.nnz)])
     return sp.csr_matrix((K_fine.data, K_fine.indices, indptr), shape=(size, size))
+
+
+def _discrete_gap(scene: Scene, spaces: Spaces, fes: ngs.FESpace, names: list[str]
+                  ) -> np.ndarray:
+    """g_h = I_h~ g in the lambda_n block of the fine unknowns (``contact.discrete_gap =
+    "nodal"``; zero for ``"thesis"``, whose g(tau) is the integral of g in :func:`_forms`).
+
+    g(tau) = d_Cn(g_h, tau): the gap enters like a known part of lambda_n, so that
+    lambda_n - g_h = -u_n lies in the multiplier space
+    (:meth:`ngdual.contact.ContactBoundary.gap_interpolant`).
+    """
+    gap = np.zeros(fes.ndof)
+    if spaces.gamma_c is None or scene.contact.discrete_gap == "thesis":
+        return gap
+    rng = fes.Range(names.index("lam_n"))
+    gap[rng.start:rng.stop] = spaces.gamma_c.gap_interpolant(spaces.prolongations["lam_n"],
+                                                             spaces.end_hats["lam_n"])
+    return gap
 
 
 def _end_lift(scene: Scene, spaces: Spaces, fes: ngs.FESpace, names: list[str]) -> np.ndarray:

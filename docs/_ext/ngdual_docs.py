@@ -153,6 +153,10 @@ MEANINGS = {
     "contact.ends": "Values of lambda_n, lambda_t at the ends of Gamma_C: `consistent` "
                     "(those the data prescribe where Gamma_C meets Gamma_D, free elsewhere) "
                     "or `thesis` (zero at every end, C_h~ of (3.61)).",
+    "contact.discrete_gap": "The gap the discrete problem sees: `nodal` (g_h, the P1 "
+                            "interpolant of g on the h~ mesh of lambda_n: no stress without "
+                            "load, whatever the shape of g) or `thesis` (g itself in g(tau) of "
+                            "(3.32), as in the thesis).",
     "friction.law": "Friction on Gamma_C: `none`, `tresca` (given bound F) or `coulomb` "
                     "(F = mu_f |sigma_n|, fixed point of Remark 3.45).",
     "friction.mu": "Coulomb friction coefficient mu_f >= 0 (> 0 for `coulomb`).",
@@ -184,15 +188,25 @@ MEANINGS = {
                     "only the labels of plots read it. Not given: no unit is shown.",
     "units.stress": "Unit of E, tractions and stresses; only the labels of plots read it. "
                     "Not given: no unit is shown.",
+    "benchmark.kind": "The analytic solution the contact pictures draw against p_h, q_h, "
+                      "for the forces the solution carries: `none`, `hertz`, `flat-punch`, "
+                      "`cattaneo-mindlin` (needs Coulomb friction) or `wedge`.",
+    "benchmark.radius": "Radius R of the cylinder (`hertz`, `cattaneo-mindlin`).",
+    "benchmark.half_width": "Half-width a of the rigid flat punch (`flat-punch`).",
+    "benchmark.slope": "Slope s of the wedge's flanks, cot of its semi-angle (`wedge`).",
+    "benchmark.center": "Point [x, y] of the foundation line where the analytic solution "
+                        "is centred.",
 }
 
 # the module constant that lists the allowed values of a key
 CHOICES = {
     "geometry.kind": "GEOMETRY_KINDS", "contact.ends": "CONTACT_ENDS",
+    "contact.discrete_gap": "DISCRETE_GAPS",
     "friction.law": "FRICTION_LAWS", "friction.normal_stress": "NORMAL_STRESSES",
     "solver.method": "SOLVER_METHODS", "solver.metric": "METRICS",
     "solver.loop_order": "LOOP_ORDERS", "solver.friction_metric": "FRICTION_METRICS",
     "units.length": "LENGTH_UNITS", "units.stress": "STRESS_UNITS",
+    "benchmark.kind": "BENCHMARK_KINDS",
 }
 
 

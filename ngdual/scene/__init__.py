@@ -24,6 +24,8 @@ The schema (all tables optional except ``geometry``, whose ``kind`` must be give
     [solver]     method, metric, rho, eps, max_iter, rho1, rho2, eps1, eps2, loop_order,
                  friction_metric
     [units]      length = "m" | "mm" | ..., stress = "Pa" | "MPa" | ...  (labels of plots)
+    [benchmark]  kind = "none" | "hertz" | "flat-punch" | "cattaneo-mindlin" | "wedge",
+                 radius, half_width, slope, center  (the analytic solution of the pictures)
 
 Loads, gap and bound are formulas in ``x`` and ``y`` (see :mod:`ngdual.expr`).
 
@@ -49,7 +51,9 @@ from .load import (
     shipped_scenes,
 )
 from .tables import (
+    BENCHMARK_KINDS,
     CONTACT_ENDS,
+    DISCRETE_GAPS,
     FRICTION_LAWS,
     FRICTION_METRICS,
     GEOMETRY_KINDS,
@@ -61,6 +65,7 @@ from .tables import (
     SECTIONS,
     SOLVER_METHODS,
     STRESS_UNITS,
+    Benchmark,
     Contact,
     Friction,
     Geometry,
@@ -81,10 +86,11 @@ from .values import (
     FORMULAS,
 )
 
-__all__ = ["CONTACT_ENDS", "Contact", "FORMULAS", "FRICTION_LAWS", "FRICTION_METRICS",
-           "Friction", "GEOMETRY_KINDS", "Geometry", "LENGTH_UNITS", "LOOP_ORDERS", "Loads",
+__all__ = ["CONTACT_ENDS", "Contact", "DISCRETE_GAPS", "FORMULAS", "FRICTION_LAWS",
+           "FRICTION_METRICS", "Friction", "GEOMETRY_KINDS", "Geometry", "LENGTH_UNITS", "LOOP_ORDERS", "Loads",
            "METRICS", "Material", "NORMAL_STRESSES", "ROLES", "SECTIONS", "SOLVER_METHODS",
            "STRESS_UNITS", "Scene", "SceneError", "SceneTypeError", "Solver", "Units",
            "apply_overrides", "check_level", "contact_junctions", "contact_samples",
            "ensure_valid", "foundation_line", "gap_at", "load_scene", "read_toml", "role_of",
-           "scene_from_dict", "shipped_scenes", "validate", "validate_geometry"]
+           "scene_from_dict", "shipped_scenes", "validate", "validate_geometry",
+           "BENCHMARK_KINDS", "Benchmark"]

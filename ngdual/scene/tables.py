@@ -158,6 +158,7 @@ class Loads:
 
 
 CONTACT_ENDS = ("consistent", "thesis")
+DISCRETE_GAPS = ("nodal", "thesis")
 
 
 @dataclass
@@ -179,6 +180,16 @@ class Contact:
     ends (with g(+-4) = 0.01 and u_D = 0 in Example 3.46 it is not: the solution is
     forced to u_n = g at the clamped corners, so that the thesis scenes, which set it,
     reproduce the thesis tables, tension included).
+
+    ``discrete_gap`` says which gap the discrete problem (3.62) sees. ``"nodal"``
+    (default): g_h = I_h~ g, the P1 interpolant of g on the h~ mesh of lambda_n, so that
+    lambda_n - g_h = -u_n stays in the multiplier space and the contact condition
+    lambda_n >= 0 reads u_n <= g at the h~ nodes; with no load the stress is zero,
+    whatever the shape of g. ``"thesis"``: g itself in g(tau) = int g tau_n ds of
+    (3.32), as in the thesis; the part of g that P1(h~) cannot represent then acts on the
+    fine edges like a prescribed displacement (stress without load on a curved gap). Both
+    give the same discrete problem where g is affine on every h~ edge (the gaps 0.01, 0
+    and |x_1| of Example 3.46).
     """
 
     gap: str | None = None
@@ -186,6 +197,7 @@ class Contact:
     hhat_factor: int = 2
     ends: str = "consistent"
     foundation: dict | None = None
+    discrete_gap: str = "nodal"
 
     @property
     def gap_formula(self) -> str:
@@ -260,6 +272,37 @@ class Units:
     stress: str | None = None
 
 
+BENCHMARK_KINDS = ("none", "hertz", "flat-punch", "cattaneo-mindlin", "wedge")
+
+
+@dataclass
+class Benchmark:
+    """The analytic solution a scene is compared with (its pictures draw it against p_h, q_h).
+
+    ``kind`` names a half-plane solution of :mod:`ngdual.verification.analytic`; the loads
+    P and Q are the normal and tangential forces the solution carries on Gamma_C, E and nu
+    come from ``[material]``, mu_f from ``[friction]``. Each kind reads its own
+    parameters, lengths in the scene's units:
+
+    * ``"hertz"``: a cylinder of ``radius`` R on a rigid plane;
+    * ``"cattaneo-mindlin"``: the same with Coulomb friction and a tangential load
+      below sliding (needs ``friction.law = "coulomb"``);
+    * ``"flat-punch"``: a rigid flat punch of ``half_width`` a;
+    * ``"wedge"``: a blunt wedge whose flanks have ``slope`` s.
+
+    ``center`` is the point of the foundation line where the solution is centred (the
+    foot of the cylinder's axis, the middle of the punch, the apex); the profile runs
+    along the foundation (along x_1 without one). ``"none"`` (default): no analytic
+    solution.
+    """
+
+    kind: str = "none"
+    radius: float | None = None
+    half_width: float | None = None
+    slope: float | None = None
+    center: list = field(default_factory=lambda: [0.0, 0.0])
+
+
 @dataclass
 class Scene:
     """Everything needed to set up and solve one problem."""
@@ -273,6 +316,7 @@ class Scene:
     friction: Friction = field(default_factory=Friction)
     solver: Solver = field(default_factory=Solver)
     units: Units = field(default_factory=Units)
+    benchmark: Benchmark = field(default_factory=Benchmark)
 
     @property
     def has_contact(self) -> bool:
@@ -292,7 +336,8 @@ class Scene:
 
 
 SECTIONS = {"geometry": Geometry, "material": Material, "loads": Loads,
-             "contact": Contact, "friction": Friction, "solver": Solver, "units": Units}
+             "contact": Contact, "friction": Friction, "solver": Solver, "units": Units,
+             "benchmark": Benchmark}
 
 
 ROLES = ("dirichlet", "neumann", "contact")

@@ -14,7 +14,9 @@ from .domain import (
     validate_geometry,
 )
 from .tables import (
+    BENCHMARK_KINDS,
     CONTACT_ENDS,
+    DISCRETE_GAPS,
     FRICTION_LAWS,
     FRICTION_METRICS,
     LENGTH_UNITS,
@@ -98,6 +100,8 @@ def validate(scene: Scene) -> None:
         _validate_solver(scene.solver, problems)
     if isinstance(scene.units, Units):  # a bad type of one unit is reported above
         _validate_units(scene.units, problems)
+    if ok["benchmark"] and ok["friction"]:
+        problems.run(_validate_benchmark, scene)
     if ok["solver"] and ok["friction"] and scene.solver.method in SOLVER_METHODS:
         reported = {f for f, _ in problems.found}
         for f, m in _settings_without_effect(scene):
@@ -132,6 +136,9 @@ def _validate_contact_settings(con: Contact) -> None:
     if con.ends not in CONTACT_ENDS:
         problems.add("contact.ends", f"unknown choice {show(con.ends)}; use one of "
                                      + ", ".join(CONTACT_ENDS))
+    if con.discrete_gap not in DISCRETE_GAPS:
+        problems.add("contact.discrete_gap", f"unknown choice {show(con.discrete_gap)}; use "
+                                             "one of " + ", ".join(DISCRETE_GAPS))
     with problems.check():
         positive(con.htilde_factor, "contact.htilde_factor", integer=True)
     if con.hhat_factor not in (1, 2):
@@ -187,6 +194,44 @@ def _validate_units(units: Units, problems: Problems) -> None:
                                          + ", ".join(allowed) + " (or leave it out: no unit)")
 
 
+# The parameters each analytic solution reads (besides [material] and, for
+# Cattaneo-Mindlin, friction.mu).
+BENCHMARK_READS = {"none": ("kind",), "hertz": ("kind", "radius", "center"),
+                   "cattaneo-mindlin": ("kind", "radius", "center"),
+                   "flat-punch": ("kind", "half_width", "center"),
+                   "wedge": ("kind", "slope", "center")}
+
+
+def _validate_benchmark(scene: Scene) -> None:
+    """The ``[benchmark]`` table: a known kind, the parameters it reads and no others."""
+    bench = scene.benchmark
+    if bench.kind not in BENCHMARK_KINDS:
+        raise SceneError("benchmark.kind", f"unknown analytic solution {show(bench.kind)}; use "
+                                           "one of " + ", ".join(BENCHMARK_KINDS))
+    problems = Problems()
+    reads = BENCHMARK_READS[bench.kind]
+    for key in ("radius", "half_width", "slope"):
+        if key in reads and getattr(bench, key) is None:
+            problems.add(f"benchmark.{key}", f"missing: {bench.kind!r} needs it (a positive "
+                                             "number)")
+        elif key in reads:
+            problems.run(positive, getattr(bench, key), f"benchmark.{key}")
+    if "center" in reads and not (isinstance(bench.center, (list, tuple))
+                                  and len(bench.center) == 2
+                                  and all(finite(v) for v in bench.center)):
+        problems.add("benchmark.center", f"must be a point [x, y], got {show(bench.center)}")
+    for key in sorted(_given(scene, "benchmark") - set(reads)):
+        problems.add(f"benchmark.{key}", f"does nothing with benchmark.kind = {bench.kind!r}, "
+                     "which reads " + (", ".join(reads[1:]) or "nothing") + "; remove it")
+    if bench.kind != "none" and not scene.has_contact:
+        problems.add("benchmark.kind", f"{bench.kind!r} is a contact solution: the scene needs "
+                                       "a contact boundary (boundary.contact is empty)")
+    if bench.kind == "cattaneo-mindlin" and scene.friction.law != "coulomb":
+        problems.add("benchmark.kind", "'cattaneo-mindlin' needs Coulomb friction "
+                                       f"(friction.law = \"coulomb\"), got {scene.friction.law!r}")
+    problems.raise_any()
+
+
 # The settings each choice reads. "uzawa" reads those of Algorithm 3.38 or of Algorithm 3.41
 # (Remark 3.45), whichever the friction law calls for: one set of Uzawa parameters serves
 # the scenes of every law (e.g. the tuned steps of ``ngdual bench``).
@@ -203,8 +248,9 @@ def _given(scene: Scene, section: str) -> set[str]:
     """The keys of ``section`` the user set: in the scene's document (TOML, overrides), or,
     for a scene built in Python, those that differ from the default."""
     obj, given = getattr(scene, section), scene.__dict__.get("_given", frozenset())
+    default = type(obj)()
     return {f.name for f in dataclasses.fields(obj)
-            if f"{section}.{f.name}" in given or getattr(obj, f.name) != f.default}
+            if f"{section}.{f.name}" in given or getattr(obj, f.name) != getattr(default, f.name)}
 
 
 def _settings_without_effect(scene: Scene) -> list[tuple[str, str]]:
