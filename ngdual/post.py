@@ -9,16 +9,17 @@ closed) and lambda_t = -u_t on Gamma_C.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 
 import ngsolve as ngs
 import numpy as np
 
+from .friction import hat_projection
 from .io import versions
 from .quantities import fields, norms
+from .solvers.checks import ForceBalance, contact_forces
+from .solvers.checks import in_contact as _in_contact
 from .solvers.result import Solution
-
-CONTACT_TOL = 1e-8
 
 
 def von_mises(sigma, nu: float) -> ngs.CoefficientFunction:
@@ -34,7 +35,18 @@ class ContactTraces:
 
     Edge quantities (sigma_n, sigma_t: constant per fine edge for RT_0) are given
     at edge midpoints ``edge_xy``; nodal ones at the fine vertices ``node_xy``.
-    ``coarse_*`` refer to the h~ contact mesh dofs.
+    ``coarse_*``, ``pressure`` and ``shear`` refer to the h~ nodes with a dof.
+
+    ``pressure`` p_h and ``shear`` q_h are what the discrete contact conditions of (3.62)
+    control: the moments d_C(mu_i, sigma) = int sigma_{n,t} mu_i ds over the h~ hats mu_i,
+    divided by int mu_i ds (:func:`ngdual.friction.hat_projection`), with p_h = -sigma_n
+    positive in compression and q_h along t = (n_2, -n_1) of (3.24). The fine-edge
+    sigma_n, sigma_t also carry modes orthogonal to every hat, which nothing in (3.62)
+    controls. (3.62) makes p_h >= 0 at every node with a dof; ``end_pressure`` and
+    ``end_shear`` are the same projections onto the hats of the fixed ends of Gamma_C
+    (``end_xy``, where lambda is prescribed), which no contact condition constrains.
+    ``coarse_status``: "separation", "contact" (without friction), "stick" or "slip"
+    (:func:`friction_diagnostics`); ``friction``: the scene has a friction law.
     """
 
     edge_xy: np.ndarray
@@ -50,18 +62,18 @@ class ContactTraces:
     coarse_lam_n: np.ndarray
     coarse_lam_t: np.ndarray
     coarse_in_contact: np.ndarray
-
-
-def _in_contact(lam_n: np.ndarray, lam_t: np.ndarray) -> np.ndarray:
-    """lambda_n = 0 relative to the displacement scale on Gamma_C (not max lambda_n alone,
-    which is round-off itself when every node touches)."""
-    scale = max(float(np.max(np.abs(lam_n), initial=0.0)),
-                float(np.max(np.abs(lam_t), initial=0.0)), 1e-300)
-    return lam_n <= CONTACT_TOL * scale
+    pressure: np.ndarray
+    shear: np.ndarray
+    end_xy: np.ndarray
+    end_pressure: np.ndarray
+    end_shear: np.ndarray
+    coarse_status: np.ndarray
+    friction: bool
 
 
 def contact_traces(solution: Solution) -> ContactTraces:
-    """sigma_n, sigma_t, lambda_n - g, lambda_t along Gamma_C."""
+    """sigma_n, sigma_t, lambda_n - g, lambda_t, p_h and q_h along Gamma_C (see
+    :class:`ContactTraces`)."""
     pb = solution.problem
     mesh, contact = pb.fes.mesh, pb.spaces.contact
     f = fields(solution)
@@ -94,11 +106,24 @@ def contact_traces(solution: Solution) -> ContactTraces:
         s_t.append(np.array([normal[1], -normal[0]]) @ traction)
     node_xy = np.vstack([chain.path_points for chain in contact.chains])
     coarse_xy = contact.node_points()
-    return ContactTraces(gamma_c.midpoints, gamma_c.lengths, np.array(s_n), np.array(s_t),
+    s_n, s_t = np.array(s_n), np.array(s_t)
+    projected = []
+    for hats in (pb.spaces.prolongations["lam_n"], pb.spaces.end_hats["lam_n"]):
+        means = gamma_c.hat_means(hats)
+        projected += [-hat_projection(means, gamma_c.lengths, s_n) if means.shape[1]
+                      else np.zeros(0),
+                      hat_projection(means, gamma_c.lengths, s_t) if means.shape[1]
+                      else np.zeros(0)]
+    if solution.nu is not None:
+        status = friction_diagnostics(solution).node_status
+    else:
+        status = np.where(in_contact, "contact", "separation")
+    return ContactTraces(gamma_c.midpoints, gamma_c.lengths, s_n, s_t,
                          np.array(active, dtype=bool), node_xy,
                          gamma_c.vertex_values(fine_n), gamma_c.vertex_values(fine_t),
                          pb.spaces.gamma_c.gap_at_vertices(), coarse_xy, lam_n_c, lam_t_c,
-                         in_contact)
+                         in_contact, projected[0], projected[1], contact.end_points(),
+                         projected[2], projected[3], status, solution.nu is not None)
 
 
 def contact_summary(solution: Solution) -> dict:
@@ -108,6 +133,8 @@ def contact_summary(solution: Solution) -> dict:
     h~ edges with a node in contact. Stick / slip as in :func:`friction_diagnostics`
     (all contact nodes count as slip without friction); with friction also the
     largest hat-weighted ratio |sigma_t| / |sigma_n| over the contact nodes.
+    ``resultant``, ``multiplier_force``, ``force_mismatch`` and ``tension`` are those of
+    :func:`force_balance` (the last two relative to its force scale).
     """
     if solution.problem.spaces.contact is None:
         return {"nodes_in_contact": 0, "stick_nodes": 0, "slip_nodes": 0, "F_abs": 0.0}
@@ -115,7 +142,7 @@ def contact_summary(solution: Solution) -> dict:
     f_abs = np.sum(tr.edge_length * (np.abs(tr.sigma_n) + np.abs(tr.sigma_t)) * tr.edge_active)
     summary = {"nodes_in_contact": int(tr.coarse_in_contact.sum()), "stick_nodes": 0,
                "slip_nodes": int(tr.coarse_in_contact.sum()), "F_abs": float(f_abs)}
-    balance = force_balance(solution, tr)
+    balance = force_balance(solution)
     summary.update(resultant=[float(v) for v in balance.resultant],
                    multiplier_force=[float(v) for v in balance.multiplier_force],
                    force_mismatch=balance.mismatch, tension=balance.tension)
@@ -130,47 +157,18 @@ def contact_summary(solution: Solution) -> dict:
     return summary
 
 
-@dataclass
-class ForceBalance:
-    """The resultant of sigma n on Gamma_C against the force the multipliers carry.
-
-    ``resultant`` = int_{Gamma_C} sigma n ds (exact: sigma n is constant on every fine
-    edge for RT_0, the Curl bubbles have no normal trace). ``multiplier_force`` =
-    sum_i int_{Gamma_C} sigma n mu_i ds over the h~ hats mu_i with a dof: the contact
-    force the discrete contact conditions see (the hat moments d_C(mu_i, sigma) of
-    (3.62)). Where every end of Gamma_C is free the hats sum to one and the two agree on
-    every mesh; at a fixed end they differ by the force in the end h~ edge, which is a
-    discretisation error only if the end values are the right ones. ``tension`` =
-    int (sigma_n)_+ ds / int |sigma_n| ds.
-    """
-
-    resultant: np.ndarray
-    multiplier_force: np.ndarray
-    tension: float
-
-    @property
-    def mismatch(self) -> float:
-        """|resultant - multiplier_force| / |multiplier_force|."""
-        scale = np.linalg.norm(self.multiplier_force) or 1.0
-        return float(np.linalg.norm(self.resultant - self.multiplier_force) / scale)
-
-
-def force_balance(solution: Solution, traces: ContactTraces | None = None) -> ForceBalance:
-    """:class:`ForceBalance` of a contact solution (``traces``: its :func:`contact_traces`)."""
-    pb = solution.problem
-    tr = traces if traces is not None else contact_traces(solution)
-    gamma_c = pb.spaces.gamma_c
-    weight = np.asarray(gamma_c.hat_means(pb.spaces.prolongations["lam_n"]).sum(axis=1))
-    force = tr.edge_length[:, None] * (tr.sigma_n[:, None] * gamma_c.normals
-                                       + tr.sigma_t[:, None] * gamma_c.tangents)
-    tension = np.sum(tr.edge_length * np.maximum(tr.sigma_n, 0.0))
-    total = np.sum(tr.edge_length * np.abs(tr.sigma_n)) or 1.0
-    return ForceBalance(force.sum(axis=0), (weight.reshape(-1, 1) * force).sum(axis=0),
-                        float(tension / total))
+def force_balance(solution: Solution) -> ForceBalance:
+    """The forces on Gamma_C of a contact solution: the resultant of sigma n against the
+    multiplier force, their mismatch and the tension in the h~ hat moments, relative to
+    a force scale that does not vanish when nothing touches
+    (:class:`ngdual.solvers.checks.ForceBalance`)."""
+    return contact_forces(solution)
 
 
 def result_record(solution: Solution) -> dict:
-    """The result record of SPEC section 6 (plain JSON-serialisable data)."""
+    """The result record of SPEC section 6 (plain JSON-serialisable data); ``warnings``
+    lists the failed physics checks (code, message, value, tolerance;
+    :mod:`ngdual.solvers.checks`)."""
     pb = solution.problem
     t = solution.timings
     # SPEC's four phases: the Gamma_C condensation counts as part of the contact solve
@@ -188,6 +186,7 @@ def result_record(solution: Solution) -> dict:
         "contact": contact_summary(solution),
         "iterations": {k: int(v) for k, v in solution.iterations.items()},
         "residuals": {k: float(v) for k, v in solution.residuals.items()},
+        "warnings": [asdict(w) for w in solution.warnings],
         "timings_s": timings,
         "parameters": pb.scene.to_dict(),
         "versions": versions(),

@@ -6,6 +6,7 @@
 * Axis labels carry the units the scene's ``[units]`` table declares, and without it name
   the quantity only (never "[stress units]").
 * A field with a corner singularity gets a clipped colour scale and the colour bar says
+  so; a trace on Gamma_C never clips p_h, only spikes of the fine-edge stress, and says
   so; meshes of adaptive runs shade the marked triangles and count them in the legend.
 """
 
@@ -32,17 +33,21 @@ MM_MPA = Units(length="mm", stress="MPa")
 
 
 def traces() -> ContactTraces:
-    """Traces on the bottom side y = 0: in contact on [1, 3], a corner spike at x = 0."""
+    """Traces on the bottom side y = 0: in contact on [1, 3], a corner spike at x = 0, fixed
+    ends at x = 0 and x = 4."""
     nodes = np.linspace(0, 4, 33)
     mids = 0.5 * (nodes[1:] + nodes[:-1])
     sigma_n = np.where(np.abs(mids - 2) < 1, -1.0, 0.0)
     sigma_n[0] = 500.0
     lam_n = np.where(np.abs(nodes - 2) <= 1, 0.0, 0.01 * np.abs(nodes - 2))
     coarse = nodes[2:-1:2]
+    in_contact = lam_n[2:-1:2] == 0
     return ContactTraces(np.column_stack([mids, 0 * mids]), np.full(32, 0.125), sigma_n,
                          0.1 * sigma_n, sigma_n < 0, np.column_stack([nodes, 0 * nodes]),
                          lam_n, 0.001 * nodes, 0 * nodes, np.column_stack([coarse, 0 * coarse]),
-                         lam_n[2:-1:2], 0 * coarse, lam_n[2:-1:2] == 0)
+                         lam_n[2:-1:2], 0 * coarse, in_contact, in_contact * 1.0,
+                         0 * coarse, np.array([[0.0, 0.0], [4.0, 0.0]]), np.zeros(2),
+                         np.zeros(2), np.where(in_contact, "contact", "separation"), False)
 
 
 def every_figure(units=None) -> dict[str, Figure]:
@@ -124,7 +129,7 @@ def test_without_declared_units_labels_name_the_quantity_and_no_made_up_unit():
             assert "[mm]" not in text and "[MPa]" not in text, (name, text)
         plot.plt.close(fig)
     fig = plot.plot_contact_traces(traces())
-    assert r"$\sigma_n^h$" in labels(fig)
+    assert r"pressure $p_h = -\sigma_n$" in labels(fig)
     plot.plt.close(fig)
 
 
@@ -151,11 +156,14 @@ def test_a_signed_field_is_clipped_symmetrically():
     assert vmin == -vmax and vmax < 2 and extend == "both" and "-50" in note
 
 
-def test_the_stress_traces_are_clipped_at_a_corner_spike_and_say_so():
+def test_the_pressure_panel_holds_p_h_and_leaves_only_a_fine_edge_spike_off_scale():
     fig = plot.plot_contact_traces(traces())
     ax = fig.axes[0]
-    assert ax.get_ylim()[1] < 100
-    assert any("off scale" in t.get_text() and "500" in t.get_text() for t in ax.texts)
+    low, high = ax.get_ylim()
+    assert low <= 0 and high >= 1                        # every p_h (0 and 1) on scale
+    assert low > -500                                    # the corner spike of -sigma_n is not
+    notes = " ".join(t.get_text() for t in ax.texts)
+    assert "fine-edge values: 1 value off scale (up to -500)" in notes
     plot.plt.close(fig)
 
 

@@ -53,9 +53,11 @@ def cmd_solve(args) -> int:
 
 def solution_figures(solution, out) -> list:
     """von_mises.png (colour scale clipped: the corners are singular) and, with contact,
-    contact_traces.png, labelled in the scene's units."""
+    contact_traces.png (p_h, q_h against the analytic solution of the scene's
+    ``[benchmark]``, if it names one), labelled in the scene's units."""
     from .. import plot, post
     from ..quantities import fields
+    from ..verification.benchmark import benchmark_traces
 
     scene, level = solution.problem.scene, solution.problem.level
     pts, tris, vm = post.element_values(solution.problem.fes.mesh,
@@ -68,7 +70,7 @@ def solution_figures(solution, out) -> list:
     if solution.problem.spaces.contact is not None:
         fig = plot.plot_contact_traces(post.contact_traces(solution),
                                        f"Gamma_C traces, {scene.name}, level {level}",
-                                       units=scene.units)
+                                       units=scene.units, exact=benchmark_traces(solution))
         written += plot.save_figure(fig, out / "contact_traces.png")
     return written
 
