@@ -1,13 +1,15 @@
 """The textbook contact problems (beyond the thesis): one picture per shipped scene.
 
-``hertz-cylinder``, ``flat-punch``, ``cattaneo-mindlin`` and ``wedge`` on the field level:
+The shipped scenes whose ``[benchmark]`` table names an analytic solution (``hertz-cylinder``,
+``flat-punch``, ``cattaneo-mindlin`` and ``wedge``), on the field level:
 left, the von Mises stress around the contact zone, its colour scale clipped at the 99th
 percentile of the window shown (stated in the colour bar: the punch edges and the wedge apex
 are stress singularities, the clipped elements are drawn in the top colour); right, the
 contact pressure p_h -- the projection of -sigma_n^h onto the h~ hats, what the discrete
 contact conditions see (:func:`ngdual.verification.analytic.traction_profile`; the
 fine-edge values of sigma_n^h, light, oscillate about it) -- against the analytic
-half-plane solution for the computed total force (Hertz, Sadowsky's flat punch,
+half-plane solution the table names, for the computed total force
+(:func:`ngdual.verification.benchmark.exact_solution`: Hertz, Sadowsky's flat punch,
 Cattaneo-Mindlin, whose tangential traction is shown too, with the computed stick zone
 shaded; the blunt wedge, p = (E* s / pi) arccosh(a / |x|)).
 """
@@ -15,36 +17,15 @@ shaded; the blunt wedge, p = (E* s / pi) arccosh(a / |x|)).
 import numpy as np
 
 from ngdual import plot
-from ngdual.scene import load_scene
+from ngdual.scene import load_scene, shipped_scenes
 from ngdual.studies.figures import script_main, solve
-from ngdual.verification import analytic
+from ngdual.verification.benchmark import center_coordinate, exact_solution
 
 THESIS = "Beyond the thesis: contact scenes"
 STUDIES = ()
-SCENES = ("hertz-cylinder", "flat-punch", "cattaneo-mindlin", "wedge")
+SCENES = tuple(name for name in shipped_scenes() if load_scene(name).benchmark.kind != "none")
 CLIP = plot.CORNER_CLIP  # percentile of the von Mises stress where the colour scale ends
 WINDOW = 3.0       # the window shown: WINDOW contact half-widths around the contact zone
-
-
-def exact_solution(scene, P: float, Q: float):
-    """The half-plane solution of the scene for the computed forces P (normal), Q (tangential)."""
-    E, nu = scene.material.E, scene.material.nu
-    if scene.geometry.arcs:
-        (center,) = scene.geometry.arcs.values()
-        radius = float(np.hypot(*(np.asarray(scene.geometry.points[0]) - center)))
-        if scene.friction.law == "coulomb":
-            return analytic.cattaneo_mindlin(P, Q, radius, E, nu, scene.friction.mu)
-        return analytic.hertz(P, radius, E, nu)
-    if scene.name == "flat-punch":
-        k = scene.geometry.labels.index(scene.labels("contact")[0])
-        a = 0.5 * abs(scene.geometry.points[k + 1][0] - scene.geometry.points[k][0])
-        return analytic.flat_punch(P, a)
-    if scene.name == "wedge":
-        pts = np.asarray(scene.geometry.points)
-        k = scene.geometry.labels.index(scene.labels("contact")[0])
-        dx, dy = pts[(k + 1) % len(pts)] - pts[k]
-        return analytic.wedge(P, abs(dy / dx), E, nu)
-    return None
 
 
 def forces(arrays: dict) -> tuple[float, float]:
@@ -124,20 +105,32 @@ def run(ctx):
         ax_c.plot(arrays["hat_x"][hat], arrays["hat_pressure"][hat], "C0.-", lw=1.4, ms=3,
                   label=r"$p_h$ ($\tilde h$ hat projection)")
         fine = np.linspace(box[0], box[1], 2001)
+        x0 = center_coordinate(scene)
         if exact is not None:
-            ax_c.plot(fine, exact.pressure(fine), "k--", lw=1, label="half-plane solution")
-        if scene.friction.law == "coulomb":
+            ax_c.plot(fine, exact.pressure(fine - x0), "k--", lw=1, label="half-plane solution")
+        if hasattr(exact, "shear"):
             ax_c.plot(arrays["hat_x"][hat], arrays["hat_shear"][hat], "C1.-", lw=1.4, ms=3,
                       label=r"$q_h$ ($\tilde h$ hat projection)")
-            ax_c.plot(fine, exact.shear(fine), "k:", lw=1, label="Cattaneo-Mindlin $q$")
+            ax_c.plot(fine, exact.shear(fine - x0), "k:", lw=1, label="Cattaneo-Mindlin $q$")
             stick = arrays["hat_node_x"][arrays["node_status"] == 1]
             if len(stick):
                 ax_c.axvspan(stick.min(), stick.max(), color="0.85", label="computed stick zone")
                 row["stick_from"], row["stick_to"] = float(stick.min()), float(stick.max())
             row["exact_c"] = float(exact.c)
         ax_c.set_xlim(box[0], box[1])
-        top = max(arrays["hat_pressure"].max(), np.abs(arrays["hat_shear"]).max())
-        ax_c.set_ylim(-0.15 * top, 1.5 * top)  # the flat punch's exact p is unbounded
+        # every p_h, q_h on scale; spikes of the fine-edge stress and the unbounded exact
+        # pressure of the flat punch off scale, said in the panel
+        inside = (x >= box[0]) & (x <= box[1])
+        secondary = [(p_h[inside], "fine-edge values")]
+        if exact is not None:
+            secondary.append((exact.pressure(fine - x0), "half-plane solution"))
+        low, high, notes = plot.trace_range(
+            np.concatenate([arrays["hat_pressure"], arrays["hat_shear"]]), secondary,
+            plot.TRACE_CLIP)
+        ax_c.set_ylim(low, high)
+        if notes:
+            ax_c.text(0.02, 0.03, "\n".join(notes), transform=ax_c.transAxes, fontsize=7,
+                      va="bottom", ha="left", bbox={"fc": "white", "alpha": 0.8, "lw": 0})
         ax_c.set_xlabel(plot.unit_label(r"$x_1$ on $\Gamma_C$", scene.units.length))
         ax_c.set_ylabel(plot.unit_label("traction", scene.units.stress))
         ax_c.grid(alpha=0.3)

@@ -81,7 +81,7 @@ def clipped_scale(values: np.ndarray, clip: float | None,
     return low, top, "max", f"colour scale clipped at the {clip:g}th percentile (max {high:.3g})"
 
 
-def _trace_range(main: np.ndarray, secondary: list[tuple[np.ndarray, str]],
+def trace_range(main: np.ndarray, secondary: list[tuple[np.ndarray, str]],
                  clip: float | None) -> tuple[float, float, list[str]]:
     """y-range of a trace panel and the notes on what it leaves off.
 
@@ -259,7 +259,7 @@ def plot_contact_traces(traces, title: str = "", units=None, clip: float | None 
         secondary = [(fine[inside(x_edge)], "fine-edge values")]
         if exact_curve is not None:
             secondary.append((exact_curve[1][inside(exact_curve[0])], "exact solution"))
-        lo, hi, notes = _trace_range(main[inside(x_nodes)], secondary, clip)
+        lo, hi, notes = trace_range(main[inside(x_nodes)], secondary, clip)
         ax.set_ylim(lo, hi)
         if window is not None:
             ax.set_xlim(*window)

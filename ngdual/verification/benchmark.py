@@ -56,6 +56,15 @@ def plane_direction(scene: Scene) -> np.ndarray:
     return np.array([n_f[1], -n_f[0]])
 
 
+def center_coordinate(scene: Scene) -> float:
+    """``benchmark.center`` as a coordinate along the foundation, measured from the
+    foundation's point (from x_1 = 0 without one), as the x of
+    :class:`~ngdual.verification.traction.TractionProfile`."""
+    origin = np.zeros(2) if scene.contact.foundation is None else \
+        foundation_line(scene.contact)[0]
+    return float((np.asarray(scene.benchmark.center, float) - origin) @ plane_direction(scene))
+
+
 @dataclass(frozen=True)
 class BenchmarkTraces:
     """The exact traction at points along Gamma_C (``xy``), for a picture of the traces.
