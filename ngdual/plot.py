@@ -209,6 +209,12 @@ def plot_contact_traces(traces, title: str = "", units=None, clip: float | None 
     of Gamma_C and p_h, q_h vanish outside it, the top panels show the zone (and say so).
     ``units``: the scene's ``units``.
     """
+    from .post import ContactTraces
+    from .scene import SceneTypeError
+
+    if not isinstance(traces, ContactTraces):
+        raise SceneTypeError("traces", "must be the ContactTraces of nd.contact_traces("
+                                       f"solution), got {type(traces).__name__}")
     fig, axes = plt.subplots(2, 2, figsize=(11, 6.8))
     stress, length = _stress(units), _length(units)
     x_dof, x_end = traces.coarse_xy[:, 0], traces.end_xy[:, 0]

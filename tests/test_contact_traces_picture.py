@@ -156,3 +156,15 @@ def test_a_bad_benchmark_table_is_a_scene_error_naming_its_field(overrides, fiel
     with pytest.raises(SceneError) as err:
         load_scene("hertz-cylinder", overrides)
     assert field in err.value.fields, err.value
+
+
+def test_traces_of_something_else_are_refused_naming_the_argument():
+    with pytest.raises(TypeError, match="^solution: must be an ngdual Solution"):
+        nd.contact_traces(None)
+    with pytest.raises(TypeError, match="^traces: must be the ContactTraces"):
+        nd.plot_contact_traces(None)
+    with pytest.raises(SceneError, match="no contact boundary") as err:
+        nd.contact_traces(nd.solve(load_scene("thesis-3.46-frictionless", [
+            "geometry.level=1", 'boundary.dirichlet=["left", "right"]',
+            'boundary.neumann=["top", "bottom"]', 'boundary.contact=[]'])))
+    assert err.value.field == "solution"
