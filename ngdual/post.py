@@ -17,6 +17,7 @@ import numpy as np
 from .friction import hat_projection
 from .io import versions
 from .quantities import fields, norms
+from .scene import SceneError, SceneTypeError
 from .solvers.result import Solution
 
 CONTACT_TOL = 1e-8
@@ -82,8 +83,14 @@ def _in_contact(lam_n: np.ndarray, lam_t: np.ndarray) -> np.ndarray:
 def contact_traces(solution: Solution) -> ContactTraces:
     """sigma_n, sigma_t, lambda_n - g, lambda_t, p_h and q_h along Gamma_C (see
     :class:`ContactTraces`)."""
+    if not isinstance(solution, Solution):
+        raise SceneTypeError("solution", "must be an ngdual Solution (see nd.solve), got "
+                                         f"{type(solution).__name__}")
     pb = solution.problem
     mesh, contact = pb.fes.mesh, pb.spaces.contact
+    if contact is None:
+        raise SceneError("solution", f"scene {pb.scene.name!r} has no contact boundary "
+                                     "(boundary.contact is empty): no traces on Gamma_C")
     f = fields(solution)
     sigma = f.sigma
     lam_n_c, lam_t_c = solution.part("lam_n"), solution.part("lam_t")
