@@ -9,18 +9,18 @@ closed) and lambda_t = -u_t on Gamma_C.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 
 import ngsolve as ngs
 import numpy as np
 
+from .checks import ForceBalance, contact_forces
+from .checks import in_contact as _in_contact
 from .friction import hat_projection
 from .io import versions
 from .quantities import fields, norms
 from .scene import SceneError, SceneTypeError
 from .solvers.result import Solution
-
-CONTACT_TOL = 1e-8
 
 
 def von_mises(sigma, nu: float) -> ngs.CoefficientFunction:
@@ -70,14 +70,6 @@ class ContactTraces:
     end_shear: np.ndarray
     coarse_status: np.ndarray
     friction: bool
-
-
-def _in_contact(lam_n: np.ndarray, lam_t: np.ndarray) -> np.ndarray:
-    """lambda_n = 0 relative to the displacement scale on Gamma_C (not max lambda_n alone,
-    which is round-off itself when every node touches)."""
-    scale = max(float(np.max(np.abs(lam_n), initial=0.0)),
-                float(np.max(np.abs(lam_t), initial=0.0)), 1e-300)
-    return lam_n <= CONTACT_TOL * scale
 
 
 def contact_traces(solution: Solution) -> ContactTraces:
@@ -148,6 +140,8 @@ def contact_summary(solution: Solution) -> dict:
     h~ edges with a node in contact. Stick / slip as in :func:`friction_diagnostics`
     (all contact nodes count as slip without friction); with friction also the
     largest hat-weighted ratio |sigma_t| / |sigma_n| over the contact nodes.
+    ``resultant``, ``multiplier_force``, ``force_mismatch`` and ``tension`` are those of
+    :func:`force_balance` (the last two relative to its force scale).
     """
     if solution.problem.spaces.contact is None:
         return {"nodes_in_contact": 0, "stick_nodes": 0, "slip_nodes": 0, "F_abs": 0.0}
@@ -155,7 +149,7 @@ def contact_summary(solution: Solution) -> dict:
     f_abs = np.sum(tr.edge_length * (np.abs(tr.sigma_n) + np.abs(tr.sigma_t)) * tr.edge_active)
     summary = {"nodes_in_contact": int(tr.coarse_in_contact.sum()), "stick_nodes": 0,
                "slip_nodes": int(tr.coarse_in_contact.sum()), "F_abs": float(f_abs)}
-    balance = force_balance(solution, tr)
+    balance = force_balance(solution)
     summary.update(resultant=[float(v) for v in balance.resultant],
                    multiplier_force=[float(v) for v in balance.multiplier_force],
                    force_mismatch=balance.mismatch, tension=balance.tension)
@@ -170,47 +164,18 @@ def contact_summary(solution: Solution) -> dict:
     return summary
 
 
-@dataclass
-class ForceBalance:
-    """The resultant of sigma n on Gamma_C against the force the multipliers carry.
-
-    ``resultant`` = int_{Gamma_C} sigma n ds (exact: sigma n is constant on every fine
-    edge for RT_0, the Curl bubbles have no normal trace). ``multiplier_force`` =
-    sum_i int_{Gamma_C} sigma n mu_i ds over the h~ hats mu_i with a dof: the contact
-    force the discrete contact conditions see (the hat moments d_C(mu_i, sigma) of
-    (3.62)). Where every end of Gamma_C is free the hats sum to one and the two agree on
-    every mesh; at a fixed end they differ by the force in the end h~ edge, which is a
-    discretisation error only if the end values are the right ones. ``tension`` =
-    int (sigma_n)_+ ds / int |sigma_n| ds.
-    """
-
-    resultant: np.ndarray
-    multiplier_force: np.ndarray
-    tension: float
-
-    @property
-    def mismatch(self) -> float:
-        """|resultant - multiplier_force| / |multiplier_force|."""
-        scale = np.linalg.norm(self.multiplier_force) or 1.0
-        return float(np.linalg.norm(self.resultant - self.multiplier_force) / scale)
-
-
-def force_balance(solution: Solution, traces: ContactTraces | None = None) -> ForceBalance:
-    """:class:`ForceBalance` of a contact solution (``traces``: its :func:`contact_traces`)."""
-    pb = solution.problem
-    tr = traces if traces is not None else contact_traces(solution)
-    gamma_c = pb.spaces.gamma_c
-    weight = np.asarray(gamma_c.hat_means(pb.spaces.prolongations["lam_n"]).sum(axis=1))
-    force = tr.edge_length[:, None] * (tr.sigma_n[:, None] * gamma_c.normals
-                                       + tr.sigma_t[:, None] * gamma_c.tangents)
-    tension = np.sum(tr.edge_length * np.maximum(tr.sigma_n, 0.0))
-    total = np.sum(tr.edge_length * np.abs(tr.sigma_n)) or 1.0
-    return ForceBalance(force.sum(axis=0), (weight.reshape(-1, 1) * force).sum(axis=0),
-                        float(tension / total))
+def force_balance(solution: Solution) -> ForceBalance:
+    """The forces on Gamma_C of a contact solution: the resultant of sigma n against the
+    multiplier force, their mismatch and the tension in the h~ hat moments, relative to
+    a force scale that does not vanish when nothing touches
+    (:class:`ngdual.checks.ForceBalance`)."""
+    return contact_forces(solution)
 
 
 def result_record(solution: Solution) -> dict:
-    """The result record of SPEC section 6 (plain JSON-serialisable data)."""
+    """The result record of SPEC section 6 (plain JSON-serialisable data); ``warnings``
+    lists the failed physics checks (code, message, value, tolerance;
+    :mod:`ngdual.checks`)."""
     pb = solution.problem
     t = solution.timings
     # SPEC's four phases: the Gamma_C condensation counts as part of the contact solve
@@ -228,6 +193,7 @@ def result_record(solution: Solution) -> dict:
         "contact": contact_summary(solution),
         "iterations": {k: int(v) for k, v in solution.iterations.items()},
         "residuals": {k: float(v) for k, v in solution.residuals.items()},
+        "warnings": [asdict(w) for w in solution.warnings],
         "timings_s": timings,
         "parameters": pb.scene.to_dict(),
         "versions": versions(),

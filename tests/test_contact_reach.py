@@ -32,15 +32,13 @@ def solved(name: str, level: int, extra: tuple = ()):
 @pytest.mark.parametrize("name", NEW_SCENES)
 def test_force_on_gamma_c_equals_the_multiplier_force_on_every_level(name):
     """Every end of Gamma_C is free (free sides, kinks): the h~ hats sum to one on Gamma_C,
-    so the resultant and the multiplier force agree to round-off, and the tension (sigma_n
-    > 0 on fine edges, which only the hat moments forbid) shrinks under refinement."""
-    tensions = []
+    so the resultant and the multiplier force agree to round-off, and no hat moment is
+    tensile (every hat has a dof, where (3.62) makes d_Cn(mu_i, sigma) <= 0)."""
     for level in (1, 2, 3):
         balance = post.force_balance(solved(name, level))
         assert balance.mismatch < 1e-9, (level, balance)
         assert balance.multiplier_force[1] > 0  # pressed onto the foundation y = 0
-        tensions.append(balance.tension)
-    assert tensions[2] < tensions[0] or max(tensions) == 0.0, tensions
+        assert balance.tension < 1e-9, (level, balance)
 
 
 def test_clamped_contact_ends_balance_forces_unless_the_thesis_ends_are_chosen():
@@ -52,11 +50,13 @@ def test_clamped_contact_ends_balance_forces_unless_the_thesis_ends_are_chosen()
         thesis.append(post.force_balance(solved("thesis-3.46-frictionless", level)))
         consistent.append(post.force_balance(
             solved("thesis-3.46-frictionless", level, ("contact.ends='consistent'",))))
-    assert all(b.mismatch > 1.0 for b in thesis[1:]), [b.mismatch for b in thesis]
+    excess = [np.linalg.norm(b.resultant - b.multiplier_force) / np.linalg.norm(
+        b.multiplier_force) for b in thesis[1:]]
+    assert min(excess) > 1.0, excess
     assert all(b.resultant[1] < 0 for b in thesis), "net tension on Gamma_C"
     mismatch = [b.mismatch for b in consistent]
     assert mismatch[-1] < 0.025 and mismatch[-1] < mismatch[0], mismatch
-    assert consistent[-1].tension < consistent[1].tension < consistent[0].tension
+    assert max(b.tension for b in consistent[1:]) < 1e-9 < consistent[0].tension
 
 
 def test_thesis_scenes_keep_the_thesis_ends():

@@ -21,7 +21,7 @@ STAGES = [
     ("mesh", ["mesh", "budget", "io"]),
     ("spaces", ["peers", "boundary", "contact"]),
     ("forms", ["forms", "friction", "quadrature_check"]),
-    ("solvers", ["solvers"]),
+    ("solvers", ["solvers", "checks"]),
     ("quantities", ["quantities"]),
     ("estimator", ["estimator"]),
     ("marking", ["marking"]),

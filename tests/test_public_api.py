@@ -69,7 +69,7 @@ def test_the_readme_example_solves_example_3_46_with_coulomb_friction():
     assert record["dofs"]["X"] == 680                         # Table 3.1, level 2
     assert record["contact"]["nodes_in_contact"] > 0
     traces = nd.contact_traces(solution)
-    force = nd.force_balance(solution, traces).multiplier_force  # on the h~ hats, n = (0, -1)
+    force = nd.force_balance(solution).multiplier_force      # on the h~ hats, n = (0, -1)
     # the foundation pushes up; the load and gap are even in x, but the diagonals of the
     # structured mesh of Example 3.46 all lean one way (it is not mirror-symmetric), so the
     # discrete friction force is not exactly zero (0.7 % of the normal force on level 2)

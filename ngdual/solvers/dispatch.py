@@ -15,11 +15,12 @@ solve.
 from __future__ import annotations
 
 import time
+import warnings
 from collections.abc import Callable
 
 import numpy as np
 
-from .. import budget
+from .. import budget, checks
 from ..forms import DiscreteProblem, assemble
 from ..mesh import build_mesh
 from ..quadrature_check import check_formulas
@@ -27,7 +28,7 @@ from ..scene import Scene, SceneError, SceneTypeError, check_level, ensure_valid
 from .active_set import active_set_solve
 from .linear import solve_linear
 from .nested import nested_uzawa
-from .result import ConvergenceError, Solution
+from .result import ConvergenceError, PhysicsWarning, Solution
 from .settings import (
     ActiveSetSettings,
     LinearSettings,
@@ -54,6 +55,9 @@ def solve_scene(scene: Scene, level: int | None = None,
     :class:`ngdual.solvers.result.ConvergenceError`. ``progress(iteration, increment)`` is
     called after every iteration of the contact solver, ``status(phase)`` when a phase
     begins (meshing, assembling, factorising and solving), e.g. for a progress display.
+    Every failed physics check (``solution.warnings``, :mod:`ngdual.checks`) is
+    also issued as a Python warning of category
+    :class:`~ngdual.solvers.result.PhysicsWarning`, so a notebook shows it.
     """
     start = time.perf_counter()
     ensure_valid(scene)
@@ -76,6 +80,8 @@ def solve_scene(scene: Scene, level: int | None = None,
     status(f"factorising and solving, {problem.fes.ndof} unknowns")
     solution = solve_problem(problem, solver_settings(scene), progress)
     solution.timings["total"] = time.perf_counter() - start
+    for found in solution.warnings:
+        warnings.warn(found.message, PhysicsWarning, stacklevel=2)
     return solution
 
 
@@ -125,6 +131,9 @@ def solve_problem(problem: DiscreteProblem, settings: Settings | None = None,
                         f"got {type(settings).__name__}")
     solution.settings = settings
     _check_finite(solution)
+    start = time.perf_counter()
+    solution.warnings = checks.physics_checks(solution)
+    solution.timings["checks"] = time.perf_counter() - start
     return solution
 
 

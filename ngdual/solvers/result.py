@@ -10,6 +10,29 @@ from ..forms import DiscreteProblem
 from ..friction import FrictionForms
 
 
+class PhysicsWarning(UserWarning):
+    """The category of the Python warnings :func:`ngdual.solvers.solve_scene` issues, one
+    per failed physics check (:mod:`ngdual.checks`), e.g. to turn them into errors:
+    ``warnings.simplefilter("error", PhysicsWarning)``."""
+
+
+@dataclass(frozen=True)
+class CheckWarning:
+    """One failed physics check of a solution (:mod:`ngdual.checks`).
+
+    ``code`` names the check, ``message`` is one line naming the cause, its size and the
+    remedy, ``value`` is the measured size and ``tolerance`` the bound it exceeds.
+    """
+
+    code: str
+    message: str
+    value: float
+    tolerance: float
+
+    def __str__(self) -> str:
+        return self.message
+
+
 class ConvergenceError(RuntimeError):
     """An iteration that diverged or stagnated; ``history`` holds its residuals."""
 
@@ -27,7 +50,10 @@ class Solution:
     F per fine Gamma_C edge and ``friction_forms`` the fine-edge operators on Gamma_C the
     solver built (:class:`ngdual.friction.FrictionForms`: sigma_n, sigma_t per edge, Q_F of
     (3.95)), for post-processing to reuse rather than assemble again. ``settings`` are
-    those the solution was computed with (:mod:`ngdual.solvers.settings`).
+    those the solution was computed with (:mod:`ngdual.solvers.settings`). ``warnings``
+    lists the physics checks the solution fails (:class:`CheckWarning`,
+    :func:`ngdual.checks.physics_checks`; filled by
+    :func:`~ngdual.solvers.solve_problem`), empty for a solution to believe.
     """
 
     problem: DiscreteProblem
@@ -43,6 +69,7 @@ class Solution:
     nu_l2: float | None = None
     friction_forms: FrictionForms | None = None
     settings: object | None = None
+    warnings: list[CheckWarning] = field(default_factory=list)
 
     def part(self, *names: str) -> np.ndarray:
         return self.x[self.problem.index(*names)]
