@@ -124,13 +124,13 @@ def run(ctx):
         secondary = [(p_h[inside], "fine-edge values")]
         if exact is not None:
             secondary.append((exact.pressure(fine - x0), "half-plane solution"))
+        if hasattr(exact, "shear"):
+            secondary.append((exact.shear(fine - x0), "Cattaneo-Mindlin q"))
         low, high, notes = plot.trace_range(
             np.concatenate([arrays["hat_pressure"], arrays["hat_shear"]]), secondary,
             plot.TRACE_CLIP)
         ax_c.set_ylim(low, high)
-        if notes:
-            ax_c.text(0.02, 0.03, "\n".join(notes), transform=ax_c.transAxes, fontsize=7,
-                      va="bottom", ha="left", bbox={"fc": "white", "alpha": 0.8, "lw": 0})
+        plot.corner_note(ax_c, notes)
         ax_c.set_xlabel(plot.unit_label(r"$x_1$ on $\Gamma_C$", scene.units.length))
         ax_c.set_ylabel(plot.unit_label("traction", scene.units.stress))
         ax_c.grid(alpha=0.3)

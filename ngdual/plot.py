@@ -82,7 +82,7 @@ def clipped_scale(values: np.ndarray, clip: float | None,
 
 
 def trace_range(main: np.ndarray, secondary: list[tuple[np.ndarray, str]],
-                 clip: float | None) -> tuple[float, float, list[str]]:
+                 clip: float | None, note_lines: int = 0) -> tuple[float, float, list[str]]:
     """y-range of a trace panel and the notes on what it leaves off.
 
     The range holds every value of ``main`` (the quantity to read) and zero. Each
@@ -90,7 +90,8 @@ def trace_range(main: np.ndarray, secondary: list[tuple[np.ndarray, str]],
     percentile of its non-zero |values| (or the extent of ``main``, if larger): isolated
     spikes beyond that (the corner singularities of the fine-edge stress, an unbounded
     exact solution) stay off scale, and a note names the series, how many values and the
-    largest.
+    largest. The range leaves room at the bottom for the notes and ``note_lines`` more lines
+    of the caller's (:func:`corner_note`).
     """
     main = np.asarray(main, float)
     main = main[np.isfinite(main)]
@@ -108,21 +109,30 @@ def trace_range(main: np.ndarray, secondary: list[tuple[np.ndarray, str]],
         hi = max(hi, min(float(values.max()), bound))
     pad = 0.08 * (hi - lo) or 1.0
     lo, hi = lo - pad, hi + pad
-    notes = []
-    for values, label in secondary:
-        values = np.asarray(values, float)
-        off = (values < lo) | (values > hi) | np.isinf(values)
-        if off.any():
-            worst = values[off][np.argmax(np.abs(values[off]))]
-            notes.append(f"{label}: {int(off.sum())} value{'s' * (int(off.sum()) > 1)} off scale "
-                         f"(up to {worst:.3g})")
-    return lo, hi, notes
 
+    def off_scale(lo: float) -> list[str]:
+        notes = []
+        for values, label in secondary:
+            values = np.asarray(values, float)
+            off = (values < lo) | (values > hi) | np.isinf(values)
+            if off.any():
+                worst = values[off][np.argmax(np.abs(values[off]))]
+                notes.append(f"{label}: {int(off.sum())} value{'s' * (int(off.sum()) > 1)} "
+                             f"off scale (up to {worst:.3g})")
+        return notes
 
-def _note(ax, lines: list[str], y: float = 0.03, va: str = "bottom") -> None:
+    lines = len(off_scale(lo)) + note_lines
     if lines:
-        ax.text(0.02, y, "\n".join(lines), transform=ax.transAxes, fontsize=7, va=va,
-                ha="left", bbox={"fc": "white", "alpha": 0.8, "lw": 0})
+        share = 0.04 + 0.055 * lines   # of the axes height, taken by the notes
+        lo = (lo - share * hi) / (1 - share)
+    return lo, hi, off_scale(lo)
+
+
+def corner_note(ax, lines: list[str]) -> None:
+    """``lines`` in a white box in the lower left corner of ``ax`` (what is off scale)."""
+    if lines:
+        ax.text(0.02, 0.03, "\n".join(lines), transform=ax.transAxes, fontsize=7,
+                va="bottom", ha="left", bbox={"fc": "white", "alpha": 0.8, "lw": 0})
 
 
 def _coordinates(ax, units) -> None:
@@ -265,16 +275,17 @@ def plot_contact_traces(traces, title: str = "", units=None, clip: float | None 
         secondary = [(fine[inside(x_edge)], "fine-edge values")]
         if exact_curve is not None:
             secondary.append((exact_curve[1][inside(exact_curve[0])], "exact solution"))
-        lo, hi, notes = trace_range(main[inside(x_nodes)], secondary, clip)
-        ax.set_ylim(lo, hi)
+        own = []
+        if len(end_values) and end_values.min() < 0 and ax is axes[0, 0]:
+            own.append(f"tension at a fixed end of Gamma_C: p = {end_values.min():.3g} "
+                       "(no contact condition there)")
         if window is not None:
             ax.set_xlim(*window)
-            notes.insert(0, f"zoom on the contact zone: outside, |p_h| and |q_h| stay below "
-                            f"{QUIET:.0%} of their largest")
-        if len(end_values) and end_values.min() < 0 and ax is axes[0, 0]:
-            notes.insert(0, f"tension at a fixed end of Gamma_C: p = {end_values.min():.3g} "
-                            "(no contact condition there)")
-        _note(ax, notes)
+            own.append(f"zoom on the contact zone: outside, |p_h| and |q_h| stay below "
+                       f"{QUIET:.0%} of their largest")
+        lo, hi, notes = trace_range(main[inside(x_nodes)], secondary, clip, len(own))
+        ax.set_ylim(lo, hi)
+        corner_note(ax, own + notes)
         ax.set_ylabel(ylabel)
         ax.set_title(name, fontsize=10)
         ax.set_xlabel(unit_label(r"$x_1$ on $\Gamma_C$", length))
