@@ -93,7 +93,7 @@ def test_the_solve_figures_carry_the_declared_units(tmp_path, monkeypatch):
     assert von_mises["axes"][0]["xlabel"] == "$x_1$ [mm]"
     bar = von_mises["axes"][1]["label"]
     assert bar.startswith(r"von Mises stress $\sigma_0$ [MPa]") and "percentile" in bar
-    assert traces["axes"][0]["ylabel"] == r"$\sigma_n^h$ [MPa]"
+    assert traces["axes"][0]["ylabel"] == r"pressure $p_h = -\sigma_n$ [MPa]"
     assert traces["axes"][2]["xlabel"] == r"$x_1$ on $\Gamma_C$ [mm]"
 
 
