@@ -32,8 +32,9 @@ def exact_solution(scene: Scene, P: float, Q: float = 0.0):
     (per unit thickness), or None for ``kind = "none"``.
 
     >>> from ngdual.scene import load_scene
-    >>> round(exact_solution(load_scene("hertz-cylinder"), P=100.0).a, 6)
-    0.076134
+    >>> hertz = exact_solution(load_scene("hertz-cylinder"), P=100.0)
+    >>> type(hertz).__name__, hertz.R, round(hertz.a, 6)       # a = sqrt(4 P R / (pi E*))
+    ('HertzContact', 10.0, 0.076113)
     """
     bench, mat = scene.benchmark, scene.material
     if bench.kind == "hertz":
