@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
+from dataclasses import asdict
 
 import ngsolve as ngs
 import numpy as np
@@ -97,7 +98,8 @@ def adapt(scene: Scene, marking: str = "dorfler", theta: float = 0.5, steps: int
     Returns
     -------
     list of dict
-        One record per step (see :func:`step_record`).
+        One record per step (see :func:`step_record`), with the physics checks its
+        solution fails under ``warnings`` (recorded, not issued as Python warnings).
     """
     _check_adapt_arguments(scene, marking, theta, steps, level, asymmetry, reference, on_step,
                            allow_large)
@@ -187,7 +189,8 @@ def step_record(step: int, solution: Solution, indicators: Estimate,
 
     ``estimator`` is eta = (sum_T eta_{tot,T}^2)^{1/2} of (4.50); ``estimator_terms[k]`` is
     (sum_T term_k,T)^{1/2}, so ``estimator``^2 is the sum of their squares;
-    ``estimator_sum`` is sum_T eta_{tot,T} (the eta_tot of Table 4.4). (The records of
+    ``estimator_sum`` is sum_T eta_{tot,T} (the eta_tot of Table 4.4); ``warnings`` lists
+    the physics checks the step's solution fails (:mod:`ngdual.checks`). (The records of
     ngdual < 0.2 called these ``eta``, ``eta_sum``, ...; ``eta`` is the rotation's name in
     ``norms``. :func:`ngdual.studies.sweep.records.estimator` reads both.)
     """
@@ -209,6 +212,7 @@ def step_record(step: int, solution: Solution, indicators: Estimate,
         "estimator_terms": {k: float(np.sqrt(v)) for k, v in indicators.summed().items()},
         "asymmetry_norm": indicators.asymmetry,
         "norms": norms(solution),
+        "warnings": [asdict(w) for w in solution.warnings],
         "marked": 0,
         "timings_s": {"assemble": float(timings.get("assemble", pb.assemble_seconds)),
                       "solve": float(timings.get("factorize", 0.0) + timings.get("condense", 0.0)

@@ -1,10 +1,12 @@
 """The ``ngdual`` command line.
 
-``ngdual solve SCENE [--level N] [--set key=value ...] [--out DIR] [--vtk] [--no-plots]``
+``ngdual solve SCENE [--level N] [--set key=value ...] [--out DIR] [--vtk] [--no-plots]
+[--strict]``
 solves one scene, prints the result table and writes ``DIR/result.json``
 (atomically) plus figures. ``ngdual scenes`` lists the shipped scenes;
 ``ngdual dofs SCENE --levels 1 2 3`` prints DOF counts without solving;
-``ngdual adapt SCENE --marking max|fraction|dorfler --theta T --steps N --out DIR [--vtk]``
+``ngdual adapt SCENE --marking max|fraction|dorfler --theta T --steps N --out DIR [--vtk]
+[--strict]``
 runs the adaptive loop and writes ``DIR/history.json`` plus a mesh (.vol, .png with the
 marked triangles shaded) and, with ``--vtk``, a VTK file per step.
 ``ngdual tutorials [--notebooks DIR] [--solutions]`` lists the lecture tutorials or
@@ -13,10 +15,16 @@ writes them as Jupyter notebooks.
 linear solve of the same matrix (the limit ratio, :mod:`ngdual.studies.bench`).
 ``ngdual verify [--quick] [--json FILE]`` prints the errors against exact solutions with
 observed orders (:mod:`ngdual.verification.report`).
+After the result table ``solve`` prints one ``warning:`` line per failed physics check
+(tension or a force imbalance on Gamma_C, penetration, the friction bound, contact at a
+clamped end, thesis end values that contradict the data; :mod:`ngdual.checks`), also
+stored in ``result.json`` under ``warnings``; ``adapt`` prints them below each step.
 Exit status: 0 solved and converged, 1 not converged, 2 bad input (one message naming
 every field or flag at fault; nothing is written), 3 an internal error (a bug: the message
-says so; ``ngdual --debug ...`` shows the traceback). Runs whose estimated size exceeds the
-memory available are refused before meshing; ``--allow-large`` runs them anyway.
+says so; ``ngdual --debug ...`` shows the traceback), 4 a physics check failed under
+``--strict`` (``solve`` writes nothing; ``adapt`` stops at that step). Runs whose
+estimated size exceeds the memory available are refused before meshing;
+``--allow-large`` runs them anyway.
 """
 
 from __future__ import annotations
@@ -25,7 +33,7 @@ import argparse
 import sys
 
 from ..scene import SceneError
-from .output import EXIT_BAD_INPUT, EXIT_INTERNAL
+from .output import EXIT_BAD_INPUT, EXIT_INTERNAL, EXIT_NOT_CONVERGED, EXIT_WARNINGS
 from .pipeline import cmd_adapt, cmd_dofs, cmd_scenes, cmd_solve
 from .studies import cmd_bench, cmd_figures, cmd_tutorials, cmd_verify
 
@@ -33,7 +41,11 @@ from .studies import cmd_bench, cmd_figures, cmd_tutorials, cmd_verify
 def parser() -> argparse.ArgumentParser:
     from .. import __version__
 
-    p = argparse.ArgumentParser(prog="ngdual", description=__doc__.splitlines()[0])
+    p = argparse.ArgumentParser(
+        prog="ngdual", description=__doc__.splitlines()[0],
+        epilog=f"exit status: 0 solved and converged, {EXIT_NOT_CONVERGED} not converged, "
+               f"{EXIT_BAD_INPUT} bad input (nothing written), {EXIT_INTERNAL} internal error, "
+               f"{EXIT_WARNINGS} a physics check failed under --strict")
     p.add_argument("--version", action="version", version=f"ngdual {__version__}",
                    help="print the version of ngdual and exit")
     p.add_argument("--debug", action="store_true",
@@ -59,6 +71,9 @@ def parser() -> argparse.ArgumentParser:
                         "applies it) and, with contact, DIR/solution_contact.vtu (lambda as "
                         "a vector on Gamma_C)")
     s.add_argument("--no-plots", action="store_true", help="do not write PNG figures")
+    s.add_argument("--strict", action="store_true",
+                   help=f"fail with exit status {EXIT_WARNINGS}, writing nothing, when a "
+                        "physics check fails (the warning lines after the result table)")
     s.set_defaults(func=cmd_solve)
     sc = sub.add_parser("scenes", help="list the shipped scenes", parents=[common])
     sc.set_defaults(func=cmd_scenes)
@@ -93,6 +108,10 @@ def parser() -> argparse.ArgumentParser:
     ad.add_argument("--vtk", action="store_true",
                     help="also write DIR/solution_stepNN.vtu (and _contact.vtu) per step for "
                          "ParaView")
+    ad.add_argument("--strict", action="store_true",
+                    help=f"stop with exit status {EXIT_WARNINGS} at the first step whose "
+                         "solution fails a physics check, writing nothing for it "
+                         "(history.json keeps the steps before)")
     ad.set_defaults(func=cmd_adapt)
     tu = sub.add_parser("tutorials", help="list the tutorials or write them as notebooks",
                         parents=[common])

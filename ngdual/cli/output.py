@@ -6,7 +6,7 @@ import sys
 
 from ..scene import SceneError, check_level
 
-EXIT_NOT_CONVERGED, EXIT_BAD_INPUT, EXIT_INTERNAL = 1, 2, 3
+EXIT_NOT_CONVERGED, EXIT_BAD_INPUT, EXIT_INTERNAL, EXIT_WARNINGS = 1, 2, 3, 4
 HISTORY_ROWS = 8  # residuals shown when an iteration fails
 LARGE_MESH = 2e5  # triangles: say so before meshing
 
@@ -32,6 +32,29 @@ def _residual(value) -> str:
 def not_converged(err) -> int:
     print(f"ngdual: not converged: {err}{residual_history(err)}", file=sys.stderr)
     return EXIT_NOT_CONVERGED
+
+
+def warning_lines(warnings: list[dict], indent: str = "") -> str:
+    """The failed physics checks of a record (:mod:`ngdual.checks`), one line each."""
+    return "\n".join(f"{indent}warning: {w['message']}" for w in warnings)
+
+
+class StrictFailure(Exception):
+    """A physics check failed under ``--strict``: the record's ``warnings``, ``where``
+    (the solution, step k) and what was ``written`` before."""
+
+    def __init__(self, warnings: list[dict], where: str, written: str):
+        super().__init__(where)
+        self.warnings, self.where, self.written = warnings, where, written
+
+
+def strict_failure(err: StrictFailure) -> int:
+    """Say that ``--strict`` stops here (the warnings are printed already)."""
+    n = len(err.warnings)
+    print(f"ngdual: error: --strict: {err.where} fails {n} physics check{'s' * (n > 1)} "
+          f"({', '.join(w['code'] for w in err.warnings)}: the warnings above); "
+          f"{err.written}", file=sys.stderr)
+    return EXIT_WARNINGS
 
 
 def number_flag(value, flag: str, low: float, high: float, integer: bool = False):

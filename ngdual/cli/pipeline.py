@@ -3,17 +3,22 @@
 from __future__ import annotations
 
 import sys
+import warnings
 
 from ..scene import SceneError, check_level, load_scene, shipped_scenes
+from ..solvers.result import PhysicsWarning
 from .output import (
     EXIT_NOT_CONVERGED,
     LARGE_MESH,
     PhaseStatus,
+    StrictFailure,
     level_flags,
     not_converged,
     number_flag,
     progress_bar,
     result_table,
+    strict_failure,
+    warning_lines,
 )
 
 
@@ -33,8 +38,10 @@ def cmd_solve(args) -> int:
     status = PhaseStatus(sys.stderr.isatty() or size.elements > LARGE_MESH)
     iterations = progress_bar("Uzawa" if scene.solver.method == "uzawa" else "Newton")
     try:
-        solution = solve_scene(scene, level, progress=iterations, allow_large=args.allow_large,
-                               status=status)
+        with warnings.catch_warnings():  # printed after the result table instead
+            warnings.simplefilter("ignore", PhysicsWarning)
+            solution = solve_scene(scene, level, progress=iterations,
+                                   allow_large=args.allow_large, status=status)
     except ConvergenceError as err:
         status.done()
         return not_converged(err)
@@ -42,6 +49,11 @@ def cmd_solve(args) -> int:
     record = post.result_record(solution)
     status.done()
     print(result_table(record))
+    if record["warnings"]:
+        print(warning_lines(record["warnings"]))
+        if args.strict:
+            return strict_failure(StrictFailure(record["warnings"], "the solution",
+                                                "nothing written"))
     write_json(record, out / "result.json")
     print(f"wrote {out / 'result.json'}")
     if args.vtk:
@@ -101,7 +113,16 @@ def cmd_dofs(args) -> int:
 
 def cmd_adapt(args) -> int:
     """SOLVE -> ESTIMATE -> MARK -> REFINE; writes DIR/history.json and a mesh per step
-    (.vol, and .png with the marked triangles shaded), with --vtk a VTK file per step."""
+    (.vol, and .png with the marked triangles shaded), with --vtk a VTK file per step.
+    The failed physics checks of every step are printed below its line and kept in its
+    record; with --strict the run stops at the first step that has one, writing nothing
+    for that step (history.json then holds the steps before it, if any)."""
+    with warnings.catch_warnings():  # the reference solves' checks are not the run's
+        warnings.simplefilter("ignore", PhysicsWarning)
+        return _adapt(args)
+
+
+def _adapt(args) -> int:
 
     from .. import budget, plot, post
     from ..afem import adapt, reference_norms
@@ -135,6 +156,17 @@ def cmd_adapt(args) -> int:
             return not_converged(err)
 
     def on_step(record, solution, estimate, marked):
+        effectivity = record.get("effectivity")
+        line = (f"step {record['step']:3d}  dofs {record['dofs']['total']:8d}  "
+                f"estimator {record['estimator']:.4e}"
+                + (f"  e_tot {record['e_tot']:.4e}  eta/e_tot {effectivity:.3f}"
+                   if effectivity else "") + f"  marked {record['marked']}")
+        if args.strict and record["warnings"]:
+            print(line + "\n" + warning_lines(record["warnings"], "    "))
+            step = record["step"]
+            raise StrictFailure(record["warnings"], f"step {step}",
+                                f"history.json holds the {step} steps before it" if step
+                                else "nothing written")
         mesh = solution.problem.fes.mesh
         stem = out / f"mesh_step{record['step']:02d}"
         stem.parent.mkdir(parents=True, exist_ok=True)
@@ -148,17 +180,17 @@ def cmd_adapt(args) -> int:
             post.write_vtk(solution, str(out / f"solution_step{record['step']:02d}"))
         run["history"].append(record)
         write_json(run, out / "history.json")
-        effectivity = record.get("effectivity")
-        print(f"step {record['step']:3d}  dofs {record['dofs']['total']:8d}  "
-              f"estimator {record['estimator']:.4e}" + (f"  e_tot {record['e_tot']:.4e}  eta/e_tot "
-                                           f"{effectivity:.3f}" if effectivity else "")
-              + f"  marked {record['marked']}")
+        print(line)
+        if record["warnings"]:
+            print(warning_lines(record["warnings"], "    "))
 
     try:
         adapt(scene, args.marking, args.theta, args.steps, level, args.asymmetry,
               run.get("reference_norms"), on_step, allow_large=args.allow_large)
     except ConvergenceError as err:
         return not_converged(err)
+    except StrictFailure as err:
+        return strict_failure(err)
     write_json(run, out / "history.json")
     print(f"wrote {out / 'history.json'} and {len(run['history'])} meshes (.vol, .png"
           + (", solution_stepNN.vtu)" if args.vtk else ")"))

@@ -13,7 +13,9 @@ three are final. ``"error"`` (any other exception, with its traceback) is kept
 for inspection but counts as unfinished, so the next run tries again.
 
 Record keys: the a posteriori estimator (4.50) is ``estimator`` (``eta`` is the rotation,
-as in the norms). Records written before this release named it ``eta`` (adaptive steps)
+as in the norms); ``warnings`` (in a solve record and in every adaptive or manufactured
+step) lists the physics checks the solution fails (:mod:`ngdual.checks`). Records written
+before this release named the estimator ``eta`` (adaptive steps)
 or ``estimator.eta`` (solves); :func:`estimator` reads both, for one release.
 """
 
@@ -30,7 +32,7 @@ from ...io import write_json, write_npz
 
 FINISHED = ("ok", "not-converged", "failed")
 # part of every task id: raise it when what a task writes changes, so old records are not reused
-RECORD_FORMAT = 2
+RECORD_FORMAT = 3
 
 
 @dataclass(frozen=True)

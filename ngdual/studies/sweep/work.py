@@ -15,6 +15,7 @@ import platform
 import socket
 import time
 import traceback
+import warnings
 from collections.abc import Callable
 
 import numpy as np
@@ -39,6 +40,8 @@ def solve_task(scene: str, level: int, overrides: list[str] = (), fields: bool =
                samples: bool = False) -> tuple[dict, dict]:
     """Solve one scene on one level: the result record of ``ngdual solve`` (and field arrays).
 
+    The record keeps the failed physics checks under ``warnings``, as ``result.json`` does.
+
     The record also holds the a posteriori estimator (4.50) of the solution
     (``estimator``: ``total`` = (sum_T eta_T^2)^(1/2), ``sum`` = sum_T eta_T and its
     ``seconds``, not part of ``timings_s``; read it with
@@ -49,8 +52,11 @@ def solve_task(scene: str, level: int, overrides: list[str] = (), fields: bool =
     from ...estimator import estimate
     from ...post import result_record
     from ...solvers import solve_scene
+    from ...solvers.result import PhysicsWarning
 
-    solution = solve_scene(load_scene_with(scene, overrides), level)
+    with warnings.catch_warnings():  # recorded under "warnings", not printed by a worker
+        warnings.simplefilter("ignore", PhysicsWarning)
+        solution = solve_scene(load_scene_with(scene, overrides), level)
     record = result_record(solution)
     record["status"] = _status_of(solution)
     record["ndof"] = int(sum(record["dofs"].values()))
@@ -181,7 +187,7 @@ def manufactured_task(case: str, level: int, marking: str | None = None, theta: 
     def on_step(record, solution, indicators, marked):
         history.append({"step": record["step"], "ndof": record["dofs"]["total"],
                         "elements": record["elements"], "estimator": record["estimator"],
-                        "converged": record["converged"],
+                        "converged": record["converged"], "warnings": record["warnings"],
                         "errors": volume_errors(mc, solution)})
 
     adapt(mc.scene(), marking or "max", theta if marking else 0.0,
