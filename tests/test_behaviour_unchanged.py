@@ -11,9 +11,10 @@ So each case's relative tolerance is derived from the settings its scene calls f
 * Direct solves (no friction, or a given Tresca bound: the active-set method ends exactly
   on its contact and stick sets, then one factorised solve): ``SAFETY delta``, the level
   to which the solver itself accepts its residuals, with ``delta`` its round-off level of
-  this problem (``residuals["roundoff_level"]``, :mod:`ngdual.solvers.active_set`):
-  4e-13 to 1e-11 on levels 1-4 of the shipped scenes, up to 5e-8 on cattaneo-mindlin
-  (nu = 0.4999: the compliance's condition (lambda + 2 mu) / mu is 5001).
+  this problem (``residuals["roundoff_level"]``, :mod:`ngdual.solvers.active_set`).
+  On levels 1-4 of the shipped scenes SAFETY delta is 4e-13 to 1e-11, except on
+  cattaneo-mindlin (nu = 0.4999: the compliance's condition (lambda + 2 mu) / mu is 5001),
+  1e-10 to 5e-8.
 * Iterative solves stop on a relative change: the Coulomb fixed point of the active-set
   method at ``COULOMB_FIXED_POINT_TOL`` or, where it stagnates, at its round-off
   ``SAFETY eps kappa_1(G)`` <= ``SAFETY delta``; Uzawa at ``solver.eps``; nested Uzawa at
@@ -34,11 +35,12 @@ Measured (levels 1-4 of every shipped scene, OpenBLAS 0.3.33 and 0.3.15, NGSolve
   at its round-off), 2.4e-10 = 0.5 delta on cattaneo-mindlin, level 4 (lambda_t, the
   case that failed a fixed 1e-10 on a fresh machine).
 * The relative change of a norm per unit of the change at which the iteration stopped
-  (stopping it early at 1e-3 .. 1e-10): at most 0.76 for the Coulomb fixed point
-  (thesis-3.46-coulomb-gap0, level 4; 1e-3 to 2e-2 on the others), 0.68 for Uzawa
-  (thesis-3.46-frictionless, levels 1-3, eps = 1e-6 and 1e-8), 1.2 eps1 for nested Uzawa
-  (thesis-3.46-tresca and -coulomb, levels 1-2, eps2 = 1e-6): 2 q/(1-q) L <= 2.4, and
-  ``STABILITY`` = 10 leaves a factor 4.
+  (stopping it early, at 1e-3 .. 1e-10, against the solve to 1e-12 or to round-off): at
+  most 0.76 for the Coulomb fixed point (thesis-3.46-coulomb-gap0, level 4; 2.5e-4 to 0.15
+  on the others), 0.68 per unit of eps for Uzawa against the active-set solution
+  (thesis-3.46-frictionless, levels 1-3, eps = 1e-6 and 1e-8), 0.012 per unit of
+  max(eps1, eps2) for nested Uzawa (thesis-3.46-tresca and -coulomb, levels 1-2,
+  eps2 = 1e-6): 2 q/(1-q) L <= 1.6, and ``STABILITY`` = 10 leaves a factor 6.
 
 A norm stored as zero (a structurally vanishing multiplier, no nu without friction) must
 be zero again: the active-set method sets it exactly.
