@@ -9,9 +9,10 @@ X = 680 + M = 256 + S = 81 + ... on 128 triangles) and the peak memory of a solv
 unknowns, peaks at 9 GB with the active-set solver; the Uzawa algorithms, with the
 saddle-point factorisation, need about 8.5 kB per unknown: 0.6 GB on level 5 and 2.2 GB on
 level 6 of Example 3.46 with Coulomb friction).
-:func:`check` refuses a run whose estimate exceeds the memory the machine has
-available, with the estimate in the message; ``allow_large=True`` (the CLI's
-``--allow-large``) runs it anyway.
+:func:`check` refuses a run whose estimate exceeds the memory this process may use
+(:func:`available_memory`: the smallest of the machine's available memory, the address
+space left under ``ulimit -v`` and the room left in the process's cgroup), with the
+estimate in the message; ``allow_large=True`` (the CLI's ``--allow-large``) runs it anyway.
 
 >>> from ngdual.scene import Geometry
 >>> estimate(Geometry(), level=2).elements   # Example 3.46: 32 * 4 triangles
@@ -22,7 +23,9 @@ from __future__ import annotations
 
 import math
 import os
-from dataclasses import dataclass
+import resource
+from dataclasses import dataclass, replace
+from pathlib import Path
 
 import numpy as np
 
@@ -81,14 +84,98 @@ def solve_memory(elements: float, method: str = "auto") -> float:
     return BASE_BYTES + per_unknown * UNKNOWNS_PER_ELEMENT * elements
 
 
+CGROUP = Path("/sys/fs/cgroup")  # where the cgroup file system is mounted
+
+
 def available_memory() -> float:
-    """Bytes of memory available to a new run (psutil's estimate, else the physical size)."""
+    """Bytes this process may hold at the peak of a run: the smallest of three limits.
+
+    The estimates of :func:`solve_memory` are the peak resident memory of the whole
+    process, so each limit counts what the process holds already as usable:
+
+    * the machine: the available memory (psutil's estimate) plus this process's resident
+      memory;
+    * the address space (``ulimit -v``, ``prlimit --as``, RLIMIT_AS): the limit minus the
+      address space the process has reserved without using it (thread stacks, allocator
+      arenas: 1.2-1.5 GiB with NGSolve loaded, measured), which a run keeps reserved;
+      beyond the limit an allocation fails and the sparse factorisations crash;
+    * the cgroup (a container's or a batch job's ``memory.max``, version 1
+      ``memory.limit_in_bytes``): the limit minus what the rest of the group uses.
+    """
+    return min(_memory_limits().values())
+
+
+def _memory_limits() -> dict[str, float]:
+    """Bytes usable under each limit that applies, by its name in a message."""
+    resident, reserved = _process_memory()
     try:
         import psutil
 
-        return float(psutil.virtual_memory().available)
+        machine = float(psutil.virtual_memory().available) + resident
     except ImportError:  # pragma: no cover - psutil comes with dask.distributed
-        return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
+        machine = float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
+    limits = {"this machine has available": machine}
+    soft, _ = resource.getrlimit(resource.RLIMIT_AS)
+    if soft != resource.RLIM_INFINITY:
+        limits["the address-space limit (ulimit -v) leaves"] = float(soft) - (reserved - resident)
+    group = _cgroup_memory()
+    if group is not None:
+        limit, used = group
+        limits["the cgroup's memory limit leaves"] = limit - (used - resident)
+    return limits
+
+
+def _process_memory() -> tuple[float, float]:
+    """Resident memory and address space (bytes) of this process (Linux; else zero)."""
+    try:
+        status = Path("/proc/self/status").read_text()
+    except OSError:  # pragma: no cover - not Linux
+        return 0.0, 0.0
+    values = {}
+    for line in status.splitlines():
+        key, _, rest = line.partition(":")
+        if key in ("VmRSS", "VmSize"):
+            values[key] = float(rest.split()[0]) * 1024  # kB
+    return values.get("VmRSS", 0.0), values.get("VmSize", 0.0)
+
+
+def _cgroup_memory() -> tuple[float, float] | None:
+    """``(limit, usage)`` in bytes of this process's cgroup, None without a limit.
+
+    The group's own directory is tried first, then the mount point itself (inside a
+    container the group is mounted there); version 2 (``memory.max``) before version 1.
+    """
+    try:
+        lines = Path("/proc/self/cgroup").read_text().splitlines()
+    except OSError:
+        lines = []
+    v2 = [line.split(":", 2)[2] for line in lines if line.startswith("0::")]
+    v1 = [line.split(":", 2)[2] for line in lines
+          if "memory" in line.split(":", 2)[1].split(",")]
+    candidates = [(CGROUP / path.lstrip("/"), "memory.max", "memory.current") for path in v2]
+    candidates.append((CGROUP, "memory.max", "memory.current"))
+    candidates += [(CGROUP / "memory" / path.lstrip("/"), "memory.limit_in_bytes",
+                    "memory.usage_in_bytes") for path in v1]
+    candidates.append((CGROUP / "memory", "memory.limit_in_bytes", "memory.usage_in_bytes"))
+    for folder, limit_file, usage_file in candidates:
+        try:
+            limit = (folder / limit_file).read_text().strip()
+            usage = float((folder / usage_file).read_text().strip())
+        except (OSError, ValueError):
+            continue
+        # "max" (version 2) or a page-rounded 2^63 (version 1): no limit
+        if limit == "max" or float(limit) >= 2.0**62:
+            return None
+        return float(limit), usage
+    return None
+
+
+def describe_available() -> str:
+    """The memory of :func:`available_memory` and the limit it comes from, for messages:
+    e.g. ``"the 1.2 GiB the address-space limit (ulimit -v) leaves"``."""
+    limits = _memory_limits()
+    source = min(limits, key=limits.get)
+    return f"the {_gib(limits[source])} {source}"
 
 
 def check(geo: Geometry, level: int | None = None, field_name: str = "geometry.level",
@@ -100,16 +187,31 @@ def check(geo: Geometry, level: int | None = None, field_name: str = "geometry.l
     have = available_memory()
     if need > have and not allow_large:
         where = f"level {geo.level if level is None else level}"
+        remedy = "a coarser level or maxh"
         if geo.kind == "polygon":
-            where += f" with maxh = {geo.maxh:g}"
+            where += f" with maxh = {geo.maxh:g}" + "".join(
+                f", side_maxh.{label} = {h:g}" for label, h in geo.side_maxh.items())
             first = estimate(geo, 1, method)
             if (first.mesh_memory if mesh_only else first.memory) > have:
-                field_name = "geometry.maxh"  # too fine before any refinement
+                # too fine before any refinement: blame the size that makes it so
+                field_name, remedy = _finest_size(geo)
         raise SceneError(field_name, f"{where} needs {size.describe(mesh_only)}, more than "
-                                     f"the {_gib(have)} this machine has available; choose a "
-                                     "coarser level or maxh, or pass --allow-large "
-                                     "(allow_large=True) to try anyway")
+                                     f"{describe_available()}; choose {remedy}, or pass "
+                                     "--allow-large (allow_large=True) to try anyway")
     return size
+
+
+def _finest_size(geo: Geometry) -> tuple[str, str]:
+    """The field whose mesh size makes the initial mesh of ``geo`` largest, and the remedy:
+    ``geometry.maxh``, or ``geometry.side_maxh.<label>`` where that side's graded strip
+    (:func:`estimate`) holds more triangles than the rest of the domain."""
+    without = estimate(replace(geo, side_maxh={}), 1).elements
+    strips = {label: estimate(replace(geo, side_maxh={label: h}), 1).elements - without
+              for label, h in geo.side_maxh.items()}
+    if strips and max(strips.values()) > without:
+        label = max(strips, key=strips.get)
+        return f"geometry.side_maxh.{label}", f"a larger side_maxh on {label!r}"
+    return "geometry.maxh", "a larger maxh"
 
 
 def _gib(nbytes: float) -> str:

@@ -22,6 +22,14 @@ import numpy as np
 
 MAX_ARC_PIECE = np.pi / 4  # netgen gets an arc as rational quadratic splines of <= 45 degrees
 
+# Every geometric and sign check (coincident points, the foundation line, the gap >= 0, the
+# values at the ends of Gamma_C, an arc's round-off) treats lengths below ROUND_OFF times
+# the scene's length scale as zero (:func:`round_off`). Points, distances and gaps computed
+# in double precision are off by a few eps = 2.2e-16 times the coordinates involved (the
+# hertz-cylinder rotated by 30 degrees: gaps of -1.9e-15 on a domain of size 8); 1e-10 is
+# five decades above that and far below any length a scene means.
+ROUND_OFF = 1e-10
+
 
 @dataclass(frozen=True)
 class Side:
@@ -86,14 +94,26 @@ class Side:
             pieces.append((pts[k], control, pts[k + 1]))
         return pieces
 
-    def arc_error(self) -> str | None:
-        """Why this arc is not a valid minor arc (None when it is)."""
+    def arc_error(self, tolerance: float) -> str | None:
+        """Why this arc is not a valid minor arc (None when it is).
+
+        ``tolerance`` is the scene's :func:`round_off`. The points of an arc, c + r (cos phi,
+        sin phi), carry a round-off of about eps (|c| + r); an arc whose points are not known
+        to the scene's round-off (a radius above about 2e5 times the scene's length scale)
+        is straight to double precision, and netgen fails on the largest ones.
+        """
         if not self.is_arc:
             return None
         ra, rb = np.linalg.norm(self.start - self.center), np.linalg.norm(self.end - self.center)
         if min(ra, rb) <= 0 or abs(ra - rb) > 1e-6 * max(ra, rb):
             return (f"the end points of side {self.label!r} are at distances {ra:.6g} and "
                     f"{rb:.6g} from the centre; an arc needs equal distances")
+        blur = np.finfo(float).eps * (float(np.abs(self.center).max()) + max(ra, rb))
+        if blur > tolerance:
+            return (f"side {self.label!r} has radius {max(ra, rb):.3g}: its points are known "
+                    f"only to {blur:.2g} in double precision, more than the scene's round-off "
+                    f"{tolerance:.2g}; make it a straight side (remove it from geometry.arcs) "
+                    "or give a centre closer to it")
         _, _, sweep = self._angles()
         if abs(sweep) >= np.pi * (1 - 1e-9):
             return (f"side {self.label!r} spans 180 degrees or more; split it into two sides "
@@ -120,6 +140,23 @@ def outline(boundary: list[Side], per_arc: int = 64) -> np.ndarray:
         xy = side.sample(per_arc)[0] if side.is_arc else side.start[None, :]
         pts.append(xy[:-1] if side.is_arc else xy)
     return np.vstack(pts)
+
+
+def length_scale(boundary: list[Side]) -> float:
+    """The scene's length scale: the larger of the domain's size (the longest side of its
+    bounding box) and the distance of its farthest point from the origin.
+
+    Coordinates far from the origin carry a round-off in proportion to their size, so a
+    translated copy of a domain has the length scale of where it lies.
+    """
+    poly = outline(boundary)
+    return max(float(np.ptp(poly, axis=0).max()), float(np.abs(poly).max()))
+
+
+def round_off(boundary: list[Side]) -> float:
+    """The length below which two positions of the scene are the same: :data:`ROUND_OFF`
+    times its :func:`length_scale`; every geometric and sign check compares with it."""
+    return ROUND_OFF * length_scale(boundary)
 
 
 def signed_area(poly: np.ndarray) -> float:

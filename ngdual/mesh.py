@@ -13,11 +13,11 @@ from __future__ import annotations
 import ngsolve as ngs
 import numpy as np
 from netgen.geom2d import SplineGeometry
-from netgen.meshing import Element1D, FaceDescriptor
+from netgen.meshing import Element1D, FaceDescriptor, NgException
 from netgen.meshing import Mesh as NetgenMesh
 
 from . import geometry
-from .scene import Geometry, check_level, validate_geometry
+from .scene import Geometry, SceneError, check_level, validate_geometry
 
 THESIS_LABELS = ("bottom", "right", "top", "left")
 
@@ -96,7 +96,13 @@ def polygon_mesh(points, labels, maxh: float, level: int = 1, arcs: dict | None 
                 geo.Append(["spline3", point(a), point(control), point(b)], **options)
         else:
             geo.Append(["line", point(side.start), point(side.end)], **options)
-    mesh = ngs.Mesh(geo.GenerateMesh(maxh=maxh))
+    try:
+        mesh = ngs.Mesh(geo.GenerateMesh(maxh=maxh))
+    except NgException as err:
+        # validation refuses every geometry known to fail; this names the fields if one slips
+        raise SceneError("geometry", f"netgen could not mesh the domain ({err}); check "
+                                     "geometry.points, geometry.arcs, geometry.maxh and "
+                                     "geometry.side_maxh") from None
     refine_uniformly(mesh, level - 1)
     return mesh
 
@@ -120,6 +126,30 @@ def build_mesh(geo: Geometry, level: int | None = None) -> ngs.Mesh:
     if geo.kind == "thesis-3.46":
         return thesis_mesh(level)
     return polygon_mesh(geo.points, geo.labels, geo.maxh, level, geo.arcs, geo.side_maxh)
+
+
+def moved_mesh(mesh: ngs.Mesh, matrix, shift=(0.0, 0.0)) -> ngs.Mesh:
+    """A copy of ``mesh`` with every vertex x moved to ``matrix @ x + shift``.
+
+    Vertex and element numbers and boundary labels are those of ``mesh``: a rotated (or
+    otherwise moved, the orientation kept) copy of a scene's mesh, on which the equally moved
+    scene is solved on the same triangles as the original. The copy has no curved geometry,
+    so refining it splits its boundary edges at their midpoints.
+
+    >>> quarter = np.array([[0.0, -1.0], [1.0, 0.0]])
+    >>> moved_mesh(thesis_mesh(1), quarter).ne
+    32
+    """
+    matrix = np.asarray(matrix, dtype=float)
+    if matrix.shape != (2, 2) or not np.linalg.det(matrix) > 0:
+        # a reflection would turn the boundary clockwise, the body to the right of its edges
+        raise ValueError(f"matrix must be a 2x2 matrix with positive determinant, got "
+                         f"{matrix.tolist()}")
+    copy = mesh.ngmesh.Copy()
+    copy.SetGeometry(None)  # the curves belong to the unmoved domain
+    xy = copy.Coordinates()
+    xy[:] = xy @ matrix.T + np.asarray(shift, dtype=float)
+    return ngs.Mesh(copy)
 
 
 def mesh_arrays(mesh: ngs.Mesh) -> tuple[np.ndarray, np.ndarray]:

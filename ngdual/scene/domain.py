@@ -34,6 +34,18 @@ LABEL = re.compile(r"[A-Za-z0-9_-]+")
 SHORT_SIDE = 1e-9  # relative to the diameter: shorter sides are degenerate (netgen crashes)
 
 
+def round_off(scene: Scene) -> float:
+    """The length below which distances, gaps and displacements of ``scene`` are zero in
+    every check of the domain: :func:`ngdual.geometry.round_off` of its boundary, or of
+    the point of its foundation line where that lies farther from the origin (the gap is
+    computed from it)."""
+    tolerance = geometry.round_off(scene.geometry.curves())
+    if scene.contact.foundation is not None:
+        point, _ = foundation_line(scene.contact)
+        tolerance = max(tolerance, geometry.ROUND_OFF * float(np.abs(point).max()))
+    return tolerance
+
+
 def _side_table(geo: Geometry, key: str, value: str) -> list[tuple[str, object]]:
     """The entries of ``geometry.<key>``, a table side label -> ``value``, labels checked."""
     table = getattr(geo, key)
@@ -116,8 +128,9 @@ def validate_geometry(geo: Geometry) -> None:
     for label, h in _side_table(geo, "side_maxh", "mesh size"):
         positive(h, f"geometry.side_maxh.{label}")
     curves = geo.curves()
+    tolerance = geometry.round_off(curves)
     for curve in curves:
-        problem = curve.arc_error()
+        problem = curve.arc_error(tolerance)
         if problem:
             raise SceneError(f"geometry.arcs.{curve.label}", problem)
     poly = geometry.outline(curves)
@@ -231,8 +244,7 @@ def _validate_foundation(scene: Scene) -> None:
     point, n_f = foundation_line(scene.contact)
     body = geometry.outline(scene.geometry.curves(), per_arc=401)
     depth = (body - point) @ n_f
-    size = float(np.ptp(body, axis=0).max())
-    if depth.min() < -1e-9 * size:
+    if depth.min() < -round_off(scene):
         i = int(np.argmin(depth))
         raise SceneError("contact.foundation", f"the foundation cuts the body: the point "
                                                f"({body[i, 0]:.4g}, {body[i, 1]:.4g}) lies "
@@ -277,8 +289,9 @@ def validate_contact(scene: Scene, u_d: list[Expression]) -> None:
     if not len(ends):
         return
     values = np.column_stack([e.numpy(ends[:, 0], ends[:, 1]) for e in u_d])
+    tolerance = round_off(scene)
     if con.ends == "thesis":
-        if np.abs(values).max() > 1e-12:
+        if np.abs(values).max() > tolerance:
             raise SceneError("loads.displacement", "the prescribed displacement must vanish "
                                                    "where Gamma_D meets Gamma_C (the thesis' "
                                                    "contact multipliers are zero there)")
@@ -288,13 +301,13 @@ def validate_contact(scene: Scene, u_d: list[Expression]) -> None:
         k = int(np.argmin(np.linalg.norm(xy - p, axis=1)))
         g = float(gap_at(con, xy[k:k + 1], normals[k:k + 1])[0])
         slide = abs(u @ np.array([normals[k, 1], -normals[k, 0]]))
-        if scene.friction.law != "none" and slide > 1e-12:
+        if scene.friction.law != "none" and slide > tolerance:
             # the friction functional q(nu, lambda_t) is posed on the lambda_t dofs only
             raise SceneError("loads.displacement", f"with friction the prescribed "
                                                    f"displacement must not slide along "
                                                    f"Gamma_C where Gamma_D meets it (u_D.t = "
                                                    f"{slide:.3g} at ({p[0]:.4g}, {p[1]:.4g}))")
-        if g < u @ normals[k] - 1e-12 * max(1.0, abs(g)):
+        if g < u @ normals[k] - tolerance:
             raise SceneError("contact.gap", f"where Gamma_D meets Gamma_C at ({p[0]:.4g}, "
                                             f"{p[1]:.4g}) the clamp pushes the body "
                                             f"{u @ normals[k]:.3g} into the foundation but "
@@ -338,10 +351,11 @@ def validate_gap_and_bound(scene: Scene) -> None:
     if not np.all(np.isfinite(g)):
         i = int(np.argmin(np.isfinite(g)))
         problems.add("contact.gap", f"not finite on Gamma_C at ({x[i]:.4g}, {y[i]:.4g})")
-    elif g.min() < 0:
+    elif g.min() < -round_off(scene):
         i = int(np.argmin(g))
         problems.add("contact.gap", f"negative gap {g[i]:.3g} at ({x[i]:.3g}, {y[i]:.3g}); "
-                                    "the gap must be >= 0")
+                                    f"the gap must be >= 0 (to the scene's round-off "
+                                    f"{round_off(scene):.2g})")
     if fr.law == "tresca":
         b = Expression(fr.bound).numpy(x, y)
         if b.min() < 0:
