@@ -23,10 +23,14 @@ hats sum to one along Gamma_C, every tensile moment is a sign condition of (3.62
 the solve violated, and the force balance holds exactly; at a fixed end the end hat
 carries the force the prescribed end value causes.
 
-Sizes are relative to the force scale F_ref = max(sum_i |t_i|, |Gamma_C| sigma_rms): the
-total force on the h~ hats, or, where that is smaller (always when nothing touches), the
-force Gamma_C would carry at the body's RMS stress sigma_rms = (int |sigma_h|^2 / |Omega|)^{1/2}.
-F_ref vanishes only when sigma_h does; a zero size over a zero scale counts as zero.
+Sizes are relative to the force scale F_ref = max(sum_i |t_i|, |Gamma_C| sigma_rms,
+NOISE E U): the total force on the h~ hats, or, where that is smaller (always when nothing
+touches), the force Gamma_C would carry at the body's RMS stress sigma_rms =
+(int |sigma_h|^2 / |Omega|)^{1/2}; never below the force that round-off of the data can
+cause, NOISE E U with U the displacement scale (the largest |u_h|, |lambda_n| = |g - u_n|,
+|lambda_t|: it holds the gap). Without that floor a stress-free solution compares round-off
+with round-off: hertz-cylinder without load has hat moments of 3e-11 (2e-16 E U), with its
+foundation 1e6 away 6e-4 (3e-15 E U). A zero size over a zero scale counts as zero.
 
 Tolerances
 ----------
@@ -61,6 +65,7 @@ FORCE_BALANCE_TOL = 0.05  # |int sigma n - sum_i t_i over the hats with a dof|, 
 PENETRATION_TOL = 1e-6    # -lambda_n at an h~ node, of the displacement scale
 FRICTION_TOL = 1e-6       # |t_t,i| beyond int F mu_i, of F_ref
 END_GAP_TOL = 1e-8        # |g - u_D.n| at a clamped end, of the displacement scale
+NOISE = 1e-10             # forces below NOISE E U are round-off (module docstring)
 CONTACT_TOL = 1e-8        # lambda_n = 0 (in contact) below this fraction of the lambda scale
 
 
@@ -131,7 +136,8 @@ def contact_forces(solution: Solution, forms: FrictionForms | None = None) -> Fo
     end_normal = ends.T @ (force * gamma_c.normals).sum(axis=1)
     total = float(np.sum(np.linalg.norm(moments, axis=1))
                   + np.sum(np.linalg.norm(end_moments, axis=1)))
-    scale = max(total, float(np.sum(gamma_c.lengths)) * stress_rms(solution))
+    noise = NOISE * pb.scene.material.E * displacement_scale(solution)
+    scale = max(total, float(np.sum(gamma_c.lengths)) * stress_rms(solution), noise)
     return ForceBalance(force.sum(axis=0), moments.sum(axis=0), normal, end_normal,
                         gamma_c.coarse.end_points(), scale)
 
@@ -164,13 +170,15 @@ def physics_checks(solution: Solution) -> list[CheckWarning]:
     balance = contact_forces(solution, forms)
     clamped = _clamped_ends(solution)
     inconsistent = _inconsistent_thesis_ends(solution, clamped)
-    found = [_tension(balance, inconsistent, pb.scene.contact),
-             _force_balance(balance, inconsistent, pb.scene.contact),
+    curved = _thesis_gap_is_curved(solution)
+    found = [_tension(balance, pb.spaces.contact.node_points(), inconsistent,
+                      pb.scene.contact, curved),
+             _force_balance(balance, inconsistent, pb.scene.contact, curved),
              _penetration(solution),
              _friction_bound(solution, forms, balance.scale),
              _contact_at_clamped_end(solution, clamped)]
     if inconsistent:
-        found.append(_thesis_ends_warning(inconsistent, _displacement_scale(solution)))
+        found.append(_thesis_ends_warning(inconsistent, displacement_scale(solution)))
     return [w for w in found if w is not None]
 
 
@@ -182,8 +190,9 @@ def _vector(v) -> str:
     return f"({v[0]:.4g}, {v[1]:.4g})"
 
 
-def _end_cause(inconsistent: list, contact: Contact) -> str:
-    """Why the fixed-end hats carry force, and the remedy."""
+def _end_cause(inconsistent: list, contact: Contact, curved: bool) -> str:
+    """Why the fixed-end hats carry force, and the remedy (``curved``: the thesis' discrete
+    gap acts where g is not affine on the h~ edges)."""
     if inconsistent:
         point, gap = inconsistent[0]
         return (f'contact.ends = "thesis" forces u_n = g at the clamped ends of Gamma_C '
@@ -192,50 +201,53 @@ def _end_cause(inconsistent: list, contact: Contact) -> str:
     if contact.ends == "thesis":
         return ('contact.ends = "thesis" fixes lambda = 0 at every end of Gamma_C; use '
                 'contact.ends = "consistent"')
-    if contact.discrete_gap == "thesis":
-        return ('the h~ edges at the fixed ends of Gamma_C carry it: contact.discrete_gap = '
-                '"thesis" imposes the part of g that is not affine on the h~ edges like a '
-                'displacement, or the corner is not resolved; use contact.discrete_gap = '
-                '"nodal", or refine towards those ends (ngdual adapt)')
+    if curved:
+        return ('contact.discrete_gap = "thesis" imposes the part of g that is not affine '
+                'on the h~ edges like a displacement, and the fixed-end hats carry the '
+                'force it makes; use contact.discrete_gap = "nodal"')
     return ("the h~ edges at the clamped ends of Gamma_C carry it (the corner singularity, "
             "not resolved); refine towards those ends (ngdual adapt) or let Gamma_C end at a "
             "free side")
 
 
-def _tension(balance: ForceBalance, inconsistent: list, contact: Contact
-             ) -> CheckWarning | None:
+def _tension(balance: ForceBalance, nodes: np.ndarray, inconsistent: list, contact: Contact,
+             curved: bool) -> CheckWarning | None:
+    """Tensile hat moments; ``nodes``: the h~ nodes with a dof."""
     if balance.tension <= TENSION_TOL:
         return None
     moments = np.concatenate([balance.end_moments, balance.normal_moments])
     where = int(np.argmax(moments))
-    cause = _end_cause(inconsistent, contact) if where < len(balance.end_moments) else (
-        "an interior h~ node, where (3.62) forbids it: the contact solve did not converge; "
-        "tighten solver.eps or use solver.method = \"active-set\"")
+    at_end = where < len(balance.end_moments)
+    point = balance.end_points[where] if at_end else nodes[where - len(balance.end_moments)]
+    cause = _end_cause(inconsistent, contact, curved) if at_end else (
+        "(3.62) forbids it at a node with a dof: the contact solve did not reach (3.62); "
+        'tighten solver.eps or use solver.method = "active-set"')
     return CheckWarning(
         "tension", f"tension on Gamma_C: the h~ hats carry a tensile force of "
                    f"{balance.tension * balance.scale:.4g} = {100 * balance.tension:.3g} % of "
-                   f"the force scale {balance.scale:.4g}, most at "
-                   f"{'a fixed end' if where < len(balance.end_moments) else 'a node'}; "
-                   f"{cause}", balance.tension, TENSION_TOL)
+                   f"the force scale {balance.scale:.4g}, most at the "
+                   f"{'fixed end' if at_end else 'h~ node'} {_point(point)}; {cause}",
+        balance.tension, TENSION_TOL)
 
 
-def _force_balance(balance: ForceBalance, inconsistent: list, contact: Contact
-                   ) -> CheckWarning | None:
+def _force_balance(balance: ForceBalance, inconsistent: list, contact: Contact,
+                   curved: bool) -> CheckWarning | None:
     if balance.mismatch <= FORCE_BALANCE_TOL:
         return None
     seen = float(np.linalg.norm(balance.multiplier_force))
     times = (f" ({np.linalg.norm(balance.resultant - balance.multiplier_force) / seen:.3g}x "
-             "the multiplier force)") if seen > 0 else ""
+             "the multiplier force)") if seen > FORCE_BALANCE_TOL * balance.scale else ""
     return CheckWarning(
         "force-balance",
         f"force balance on Gamma_C: the sides carry {_vector(balance.resultant)}, the "
         f"multipliers see {_vector(balance.multiplier_force)}: a mismatch of "
         f"{100 * balance.mismatch:.3g} % of the force scale {balance.scale:.4g}{times}; "
-        f"{_end_cause(inconsistent, contact)}", balance.mismatch, FORCE_BALANCE_TOL)
+        f"{_end_cause(inconsistent, contact, curved)}", balance.mismatch, FORCE_BALANCE_TOL)
 
 
-def _displacement_scale(solution: Solution) -> float:
-    """The largest |u_h| in the body and |lambda| on the h~ nodes (zero for sigma = u = 0)."""
+def displacement_scale(solution: Solution) -> float:
+    """U: the largest |u_h| in the body and |lambda_n|, |lambda_t| at the h~ nodes
+    (lambda_n = g - u_n: U holds the gap)."""
     parts = [solution.part("u1", "u2"), solution.part("lam_n"), solution.part("lam_t")]
     return max(float(np.max(np.abs(p), initial=0.0)) for p in parts)
 
@@ -243,7 +255,7 @@ def _displacement_scale(solution: Solution) -> float:
 def _penetration(solution: Solution) -> CheckWarning | None:
     lam_n = solution.part("lam_n")
     depth = float(-np.min(lam_n, initial=0.0))
-    scale = _displacement_scale(solution)
+    scale = displacement_scale(solution)
     if depth <= PENETRATION_TOL * scale:
         return None
     where = solution.problem.spaces.contact.node_points()[int(np.argmin(lam_n))]
@@ -277,6 +289,20 @@ def _friction_bound(solution: Solution, forms: FrictionForms, scale: float
                           f"at {_point(where)}: the friction solve did not reach (3.62); "
                           "tighten solver.eps1 and solver.eps2 or use "
                           'solver.method = "active-set"', size, FRICTION_TOL)
+
+
+def _thesis_gap_is_curved(solution: Solution) -> bool:
+    """``contact.discrete_gap = "thesis"`` with a g that P1(h~) does not represent: at some
+    fine vertex g differs from its h~ interpolant g_h by more than END_GAP_TOL of U."""
+    pb = solution.problem
+    if pb.scene.contact.discrete_gap != "thesis":
+        return False
+    gamma_c = pb.spaces.gamma_c
+    g = gamma_c.gap_at_vertices()
+    g_h = gamma_c.vertex_values(gamma_c.gap_interpolant(pb.spaces.prolongations["lam_n"],
+                                                         pb.spaces.end_hats["lam_n"]))
+    return float(np.max(np.abs(g - g_h))) > END_GAP_TOL * max(displacement_scale(solution),
+                                                               float(np.max(np.abs(g))))
 
 
 def _clamped_ends(solution: Solution) -> list[tuple[np.ndarray, int]]:
@@ -327,7 +353,7 @@ def _inconsistent_thesis_ends(solution: Solution, clamped: list) -> list:
     values, _ = replace(pb.spaces.gamma_c, scene=consistent).end_values(
         scene.loads.displacement)
     gaps = pb.spaces.gamma_c.gap_at_vertices()
-    tol = END_GAP_TOL * max(_displacement_scale(solution), float(np.max(np.abs(gaps))))
+    tol = END_GAP_TOL * max(displacement_scale(solution), float(np.max(np.abs(gaps))))
     points = pb.spaces.contact.end_points()
     out = []
     for point, _ in clamped:
