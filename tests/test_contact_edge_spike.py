@@ -46,9 +46,10 @@ BOUND = "1 + x*x/16 + (y + 1)"  # a Tresca bound that varies along Gamma_C
 
 
 @cache
-def solutions():
+def solutions(discrete_gap: str = "nodal"):
     case = manufactured_case(CASE)
     scene = case.scene()
+    scene = replace(scene, contact=replace(scene.contact, discrete_gap=discrete_gap))
     return case, [solve_scene(scene, level) for level in LEVELS]
 
 
@@ -75,9 +76,12 @@ def test_pressure_error_converges_at_first_order_or_better_on_every_level():
     assert min(orders(errors, "pressure_max")) >= MIN_ORDER_MAX, orders(errors, "pressure_max")
 
 
-def test_the_largest_nodal_pressure_error_is_at_the_last_node_in_contact():
-    """Against the same projection of the exact sigma_n, p_h is worst at a last contact node."""
-    case, sols = solutions()
+def test_with_the_gap_itself_the_largest_nodal_pressure_error_is_at_the_last_node_in_contact():
+    """Against the same projection of the exact sigma_n, p_h is worst at a last contact node
+    when g itself enters g(tau) (``contact.discrete_gap = "thesis"``). The nodal gap g_h
+    shrinks that spike three- to fourfold on levels 2-4 (0.042 -> 0.013 on level 3, where an
+    interior node's error is then the largest); the bound below holds for both."""
+    case, sols = solutions("thesis")
     for sol in sols:
         prof = contact_profile(case, sol)
         worst = prof["x"][np.argmax(np.abs(prof["pressure"] - prof["pressure_of_exact"]))]
@@ -87,7 +91,11 @@ def test_the_largest_nodal_pressure_error_is_at_the_last_node_in_contact():
 def test_the_spike_is_bounded_by_the_half_plane_response_to_the_kink_of_lambda_n():
     """Where p_h is too compressive at a last contact node, the excess is at most
     E* kink / pi (E* = E / (1 - nu^2)), and it is first order: excess / h~ does not grow."""
-    case, sols = solutions()
+    for discrete_gap in ("nodal", "thesis"):
+        spike_bounded(*solutions(discrete_gap))
+
+
+def spike_bounded(case, sols):
     e_star = case.material.E / (1.0 - case.material.nu ** 2)
     scaled = []
     for sol in sols:

@@ -86,11 +86,11 @@ from .values import (
     FORMULAS,
 )
 
-__all__ = ["CONTACT_ENDS", "Contact", "DISCRETE_GAPS", "FORMULAS", "FRICTION_LAWS",
-           "FRICTION_METRICS", "Friction", "GEOMETRY_KINDS", "Geometry", "LENGTH_UNITS", "LOOP_ORDERS", "Loads",
-           "METRICS", "Material", "NORMAL_STRESSES", "ROLES", "SECTIONS", "SOLVER_METHODS",
-           "STRESS_UNITS", "Scene", "SceneError", "SceneTypeError", "Solver", "Units",
-           "apply_overrides", "check_level", "contact_junctions", "contact_samples",
-           "ensure_valid", "foundation_line", "gap_at", "load_scene", "read_toml", "role_of",
-           "scene_from_dict", "shipped_scenes", "validate", "validate_geometry",
-           "BENCHMARK_KINDS", "Benchmark"]
+__all__ = ["BENCHMARK_KINDS", "Benchmark", "CONTACT_ENDS", "Contact", "DISCRETE_GAPS", "FORMULAS",
+           "FRICTION_LAWS", "FRICTION_METRICS", "Friction", "GEOMETRY_KINDS", "Geometry",
+           "LENGTH_UNITS", "LOOP_ORDERS", "Loads", "METRICS", "Material", "NORMAL_STRESSES",
+           "ROLES", "SECTIONS", "SOLVER_METHODS", "STRESS_UNITS", "Scene", "SceneError",
+           "SceneTypeError", "Solver", "Units", "apply_overrides", "check_level",
+           "contact_junctions", "contact_samples", "ensure_valid", "foundation_line", "gap_at",
+           "load_scene", "read_toml", "role_of", "scene_from_dict", "shipped_scenes", "validate",
+           "validate_geometry"]
