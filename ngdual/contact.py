@@ -172,6 +172,16 @@ class ContactBoundary:
                 out.append(gap_at(self.scene.contact, points[positions], normals[positions]))
         return np.concatenate(dofs), np.concatenate(ends)
 
+    def discrete_gap_at_vertices(self, prolongation: sp.csr_matrix, end_hats: sp.csr_matrix
+                                 ) -> np.ndarray:
+        """The gap the discrete problem sees, at the fine vertices (``path_points`` order):
+        g_h = I_h~ g for ``contact.discrete_gap = "nodal"``, g itself for ``"thesis"``; so
+        g_h - lambda_n^h is the discrete normal displacement u_n^h. Arguments as in
+        :meth:`gap_interpolant`."""
+        if self.scene.contact.discrete_gap == "thesis":
+            return self.gap_at_vertices()
+        return self.vertex_values(self.gap_interpolant(prolongation, end_hats))
+
     def gap_interpolant(self, prolongation: sp.csr_matrix, end_hats: sp.csr_matrix
                         ) -> np.ndarray:
         """Fine trace coefficients of g_h = I_h~ g, the P1 interpolant of g on the h~ mesh.

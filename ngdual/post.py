@@ -36,7 +36,9 @@ class ContactTraces:
 
     Edge quantities (sigma_n, sigma_t: constant per fine edge for RT_0) are given
     at edge midpoints ``edge_xy``; nodal ones at the fine vertices ``node_xy``.
-    ``coarse_*``, ``pressure`` and ``shear`` refer to the h~ nodes with a dof.
+    ``coarse_*``, ``pressure`` and ``shear`` refer to the h~ nodes with a dof. ``gap`` is
+    the gap the discrete problem sees (g_h = I_h~ g by default, ``contact.discrete_gap``),
+    so that ``gap - lam_n`` is the discrete normal displacement u_n^h.
 
     ``pressure`` p_h and ``shear`` q_h are what the discrete contact conditions of (3.62)
     control: the moments d_C(mu_i, sigma) = int sigma_{n,t} mu_i ds over the h~ hats mu_i,
@@ -128,7 +130,9 @@ def contact_traces(solution: Solution) -> ContactTraces:
     return ContactTraces(gamma_c.midpoints, gamma_c.lengths, s_n, s_t,
                          np.array(active, dtype=bool), node_xy,
                          gamma_c.vertex_values(fine_n), gamma_c.vertex_values(fine_t),
-                         pb.spaces.gamma_c.gap_at_vertices(), coarse_xy, lam_n_c, lam_t_c,
+                         gamma_c.discrete_gap_at_vertices(pb.spaces.prolongations["lam_n"],
+                                                          pb.spaces.end_hats["lam_n"]),
+                         coarse_xy, lam_n_c, lam_t_c,
                          in_contact, projected[0], projected[1], contact.end_points(),
                          projected[2], projected[3], status, solution.nu is not None)
 
