@@ -43,6 +43,40 @@ TRACE_RULES = {ngs.SEGM: ngs.IntegrationRule(ngs.SEGM, TRACE_ORDER)}
 EXACT_VOLUME_RULES = {ngs.TRIG: ngs.IntegrationRule(ngs.TRIG, 4)}
 
 
+def peers_form(trial: dict, test: dict, lame: tuple[float, float]
+               ) -> ngs.comp.SumOfIntegrals:
+    """The PEERS block of (3.62) on T_h, with its exact volume rule:
+
+        a~(sigma, tau) + b(u, tau) + b(v, sigma) + s(eta, tau) + s(xi, sigma),
+
+    a~ the compliance form (3.32) for Lame's ``lame = (lambda, mu)``, b(u, tau) =
+    int u . div tau dx and s(eta, tau) = int eta as(tau) dx.
+
+    Parameters
+    ----------
+    trial, test : dict
+        Trial and test functions keyed by the names of :data:`ngdual.peers.PEERS`, from
+        any product space that holds the PEERS triple: the conforming one of
+        :func:`assemble` or the broken one of :class:`ngdual.solvers.hybrid.HybridSystem`.
+    lame : tuple of float
+        Lame's constants (lambda, mu).
+    """
+    lam, mu = lame
+
+    def parts(f):
+        return (peers.stress(f["r1"], f["r2"], f["b1"], f["b2"]),
+                peers.stress_divergence(f["r1"], f["r2"]), ngs.CF((f["u1"], f["u2"])), f["eta"])
+
+    sig, div_sig, u, eta = parts(trial)
+    tau, div_tau, v, xi = parts(test)
+    dx = ngs.dx(intrules=EXACT_VOLUME_RULES)
+    # three integrals, each compiled on its own: the element matrices of a~, b, s are summed
+    # in this order in every assembly
+    return (ngs.InnerProduct(peers.compliance(sig, lam, mu), tau).Compile() * dx  # a~
+            + (u * div_tau + v * div_sig).Compile() * dx                         # b
+            + (eta * peers.asym(tau) + xi * peers.asym(sig)).Compile() * dx)      # s
+
+
 def boundary_regex(labels: list[str]) -> str:
     return "|".join(labels)
 
@@ -199,23 +233,14 @@ def _forms(scene: Scene, fes: ngs.FESpace, names: list[str]):
     mesh = fes.mesh
     trial = dict(zip(names, fes.TrialFunction()))
     test = dict(zip(names, fes.TestFunction()))
-    lam, mu = scene.material.lame
     n = ngs.specialcf.normal(2)
     t = ngs.CF((n[1], -n[0]))
-
-    def parts(f):
-        sig = peers.stress(f["r1"], f["r2"], f["b1"], f["b2"])
-        return (sig, peers.stress_divergence(f["r1"], f["r2"]),
-                peers.stress_traction(f["r1"], f["r2"]), ngs.CF((f["u1"], f["u2"])), f["eta"])
-
-    sig, div_sig, trac_sig, u, eta = parts(trial)
-    tau, div_tau, trac_tau, v, xi = parts(test)
+    trac_sig = peers.stress_traction(trial["r1"], trial["r2"])
+    trac_tau = peers.stress_traction(test["r1"], test["r2"])
+    v = ngs.CF((test["u1"], test["u2"]))
     a = ngs.BilinearForm(fes)
+    a += peers_form(trial, test, scene.material.lame)
     d = ngs.BilinearForm(fes) if {"phi1", "lam_n"} & set(names) else None
-    dx = ngs.dx(intrules=EXACT_VOLUME_RULES)
-    a += ngs.InnerProduct(peers.compliance(sig, lam, mu), tau).Compile() * dx  # a~(sigma, tau)
-    a += (u * div_tau + v * div_sig).Compile() * dx                            # b(u, tau)
-    a += (eta * peers.asym(tau) + xi * peers.asym(sig)).Compile() * dx         # s(eta, tau)
     rhs = ngs.LinearForm(fes)
     f = ngs.CF(tuple(Expression(e).coefficient() for e in scene.loads.body_force))
     rhs += -f * v * ngs.dx(intrules=LOAD_RULES)                               # -f(v)

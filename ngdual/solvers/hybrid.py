@@ -40,7 +40,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .. import peers
-from ..forms import DiscreteProblem, boundary_regex
+from ..forms import DiscreteProblem, boundary_regex, peers_form
 from ..sparse import to_scipy
 from .settings import Model
 
@@ -137,7 +137,6 @@ class HybridSystem:
         self.problem = problem
         mesh = problem.fes.mesh
         self.mesh = mesh
-        lam, mu = model.lame
         rt = ngs.HDiv(mesh, order=0, discontinuous=True)
         bubble, p0 = peers.cubic_bubbles(mesh), ngs.L2(mesh, order=0)
         facet = ngs.FacetFESpace(mesh, order=0)
@@ -150,23 +149,15 @@ class HybridSystem:
         test = dict(zip(self.names, self.fes.TestFunction()))
         n = ngs.specialcf.normal(2)
 
-        def parts(f):
-            sig = peers.stress(f["r1"], f["r2"], f["b1"], f["b2"])
-            return (sig, peers.stress_divergence(f["r1"], f["r2"]),
-                    ngs.CF((f["r1"] * n, f["r2"] * n)), ngs.CF((f["u1"], f["u2"])), f["eta"],
-                    ngs.CF((f["m1"], f["m2"])))
+        def traction(f):  # sigma . n_T on the element boundary (the bubbles' Curl has none)
+            return ngs.CF((f["r1"] * n, f["r2"] * n))
 
-        sig, div_sig, trac_sig, u, eta, m = parts(trial)
-        tau, div_tau, trac_tau, v, xi, k = parts(test)
         a = ngs.BilinearForm(self.fes, condense=True)
-        # the integrands are polynomials of degree <= 4 (RT_0 + Curl of cubic bubbles times
-        # the same, or times P1): exact rules of that degree, on compiled integrands
-        dx = ngs.dx(intrules={ngs.TRIG: ngs.IntegrationRule(ngs.TRIG, 4)})
+        a += peers_form(trial, test, model.lame)
+        m, k = ngs.CF((trial["m1"], trial["m2"])), ngs.CF((test["m1"], test["m2"]))
+        # mu . tau n_T is constant on every element edge (P0 times the RT_0 normal trace)
         dT = ngs.dx(element_boundary=True, intrules={ngs.SEGM: ngs.IntegrationRule(ngs.SEGM, 2)})
-        a += ngs.InnerProduct(peers.compliance(sig, lam, mu), tau).Compile() * dx
-        a += (u * div_tau + v * div_sig).Compile() * dx
-        a += (eta * peers.asym(tau) + xi * peers.asym(sig)).Compile() * dx
-        a += (m * trac_tau + k * trac_sig).Compile() * dT
+        a += (m * traction(test) + k * traction(trial)).Compile() * dT
         with _tasks(self.mesh):
             a.Assemble()
         # the only local load is -f(v) in the u rows: taken from the assembled F of (3.62)
