@@ -51,7 +51,8 @@ from .contact import gap_coefficient
 from .expr import Expression
 from .forms import boundary_regex
 from .mesh import element_diameters
-from .quantities import fields
+from .quantities import fields, require_solution
+from .scene import SceneError, SceneTypeError
 from .solvers.result import Solution
 
 SIGMA_TERMS = ("residual", "asymmetry", "curl", "jump_interior", "jump_dirichlet",
@@ -214,8 +215,13 @@ def estimate(solution: Solution, asymmetry: str = "l2") -> Estimate:
     -------
     Estimate
     """
+    require_solution(solution)
+    if not isinstance(asymmetry, str):
+        raise SceneTypeError("asymmetry", f"must be one of {', '.join(ASYMMETRY_NORMS)}, got "
+                                          f"{type(asymmetry).__name__}")
     if asymmetry not in ASYMMETRY_NORMS:
-        raise ValueError(f"asymmetry must be one of {ASYMMETRY_NORMS}, got {asymmetry!r}")
+        raise SceneError("asymmetry", f"unknown norm {asymmetry!r}; use one of "
+                                      + ", ".join(ASYMMETRY_NORMS))
     start = time.perf_counter()
     pb = solution.problem
     scene, spaces = pb.scene, pb.spaces

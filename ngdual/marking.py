@@ -22,17 +22,29 @@ import math
 
 import numpy as np
 
+from .scene import SceneError, SceneTypeError
+
 STRATEGIES = ("max", "fraction", "dorfler")
 
 
 def _check(eta, theta: float) -> np.ndarray:
-    eta = np.asarray(eta, dtype=float)
+    """``eta`` as an array of floats; a SceneError (SceneTypeError for a wrong type) naming
+    ``eta`` or ``theta`` if they are not indicators and a parameter in [0, 1]."""
+    wanted = "a 1D array of the element indicators eta_T >= 0 (e.g. nd.estimate(s).eta)"
+    if isinstance(eta, (str, bytes)) or eta is None:
+        raise SceneTypeError("eta", f"must be {wanted}, got {type(eta).__name__}")
+    try:
+        eta = np.asarray(eta, dtype=float)
+    except (TypeError, ValueError):
+        raise SceneTypeError("eta", f"must be {wanted}, got {type(eta).__name__}") from None
     if eta.ndim != 1:
-        raise ValueError(f"eta must be a 1D array, got shape {eta.shape}")
+        raise SceneError("eta", f"must be {wanted}, got shape {eta.shape}")
     if not np.all(np.isfinite(eta)) or np.any(eta < 0):
-        raise ValueError("eta must be finite and >= 0")
+        raise SceneError("eta", f"must be finite and >= 0 ({wanted})")
+    if isinstance(theta, bool) or not isinstance(theta, (int, float, np.integer, np.floating)):
+        raise SceneTypeError("theta", f"must be a number in [0, 1], got {type(theta).__name__}")
     if not 0 <= theta <= 1:
-        raise ValueError(f"theta must lie in [0, 1], got {theta!r}")
+        raise SceneError("theta", f"must lie in [0, 1], got {theta!r}")
     return eta
 
 
@@ -84,6 +96,7 @@ def mark_dorfler(eta, theta: float) -> np.ndarray:
 def mark(eta, theta: float, strategy: str = "dorfler") -> np.ndarray:
     """Dispatch to :func:`mark_max`, :func:`mark_fraction` or :func:`mark_dorfler`."""
     functions = {"max": mark_max, "fraction": mark_fraction, "dorfler": mark_dorfler}
-    if strategy not in functions:
-        raise ValueError(f"unknown marking {strategy!r}; use one of {', '.join(STRATEGIES)}")
+    if not isinstance(strategy, str) or strategy not in functions:
+        raise SceneError("strategy", f"unknown marking {strategy!r}; use one of "
+                                     + ", ".join(STRATEGIES))
     return functions[strategy](eta, theta)

@@ -18,7 +18,7 @@ from .checks import ForceBalance, contact_forces
 from .checks import in_contact as _in_contact
 from .friction import hat_projection
 from .io import versions
-from .quantities import fields, norms
+from .quantities import fields, norms, require_contact
 from .scene import SceneError, SceneTypeError
 from .solvers.result import Solution
 
@@ -173,6 +173,7 @@ def force_balance(solution: Solution) -> ForceBalance:
     multiplier force, their mismatch and the tension in the h~ hat moments, relative to
     a force scale that does not vanish when nothing touches
     (:class:`ngdual.checks.ForceBalance`)."""
+    solution = require_contact(solution, "force balance")
     return contact_forces(solution)
 
 

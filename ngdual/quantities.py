@@ -15,7 +15,29 @@ import ngsolve as ngs
 import numpy as np
 
 from . import peers
+from .scene import SceneError, SceneTypeError
 from .solvers.result import Solution
+
+
+def require_solution(value, name: str = "solution") -> Solution:
+    """``value`` if it is a :class:`~ngdual.solvers.result.Solution`; a SceneTypeError
+    naming the argument ``name`` otherwise (the check of every function of the public API
+    that reads a solution)."""
+    if not isinstance(value, Solution):
+        raise SceneTypeError(name, f"must be an ngdual Solution (see nd.solve), got "
+                                   f"{type(value).__name__}")
+    return value
+
+
+def require_contact(value, what: str, name: str = "solution") -> Solution:
+    """:func:`require_solution`, and a SceneError naming ``name`` if its scene has no
+    contact boundary: there is no ``what`` on Gamma_C (e.g. ``"force balance"``)."""
+    solution = require_solution(value, name)
+    scene = solution.problem.scene
+    if not scene.has_contact:
+        raise SceneError(name, f"scene {scene.name!r} has no contact boundary "
+                               f"(boundary.contact is empty): no {what} on Gamma_C")
+    return solution
 
 
 @dataclass
@@ -34,7 +56,7 @@ class Fields:
 
 def fields(solution: Solution) -> Fields:
     """Fine-mesh GridFunction and coefficient functions of every unknown."""
-    pb = solution.problem
+    pb = require_solution(solution).problem
     gf = ngs.GridFunction(pb.fes)
     gf.vec.FV().NumPy()[:] = pb.to_fine(solution.x)
     c = dict(zip(pb.names, gf.components))
@@ -51,7 +73,7 @@ def _boundary_integral(cf, mesh: ngs.Mesh, labels: list[str]) -> float:
 
 def norms(solution: Solution) -> dict:
     """Norms of Tables 3.2/3.3: ||sigma|| in H(div), the others in L^2."""
-    f = fields(solution)
+    f = fields(require_solution(solution))
     pb = solution.problem
     mesh, scene = pb.fes.mesh, pb.scene
     out = {

@@ -16,11 +16,16 @@ def cmd_figures(args) -> int:
     from ..io import check_output_dir
     from ..scene import Geometry
     from ..studies.figures import DEFAULT_MAX_LEVEL, THESIS_MAX_LEVEL, run_figures
+    from ..studies.figures.run import select_scripts
 
     max_level = DEFAULT_MAX_LEVEL if args.max_level is None else args.max_level
     number_flag(max_level, "--max-level", 2, THESIS_MAX_LEVEL, integer=True)
     if args.workers is not None:
         number_flag(args.workers, "--workers", 1, 256, integer=True)
+    try:
+        select_scripts(args.only, args.source)
+    except SceneError as err:  # named by the Python argument; the user typed the flag
+        raise SceneError(f"--{err.field}", err.problems[0][1]) from None
     check_output_dir(args.out, "--out")
     if args.gallery:
         check_output_dir(args.gallery, "--gallery")

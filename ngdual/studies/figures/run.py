@@ -24,6 +24,7 @@ from datetime import datetime
 from pathlib import Path
 
 from ...io import versions, write_json
+from ...scene import SceneError
 from ..sweep import Runner, Task
 from .index import write_index
 from .output import Context
@@ -33,19 +34,40 @@ SOURCE_ENV = "NGDUAL_FIGURES_DIR"
 
 
 def figures_dir(source: str | Path | None = None) -> Path:
-    """``--source``, else ``NGDUAL_FIGURES_DIR``, else ``figures/`` of the source checkout."""
+    """``source`` (``--source``), else ``NGDUAL_FIGURES_DIR``, else ``figures/`` of the
+    source checkout; a SceneError naming ``source`` if it is not a folder."""
     folder = Path(source or os.environ.get(SOURCE_ENV)
                   or Path(__file__).resolve().parents[3] / "figures")
     if not folder.is_dir():
-        raise FileNotFoundError(f"no figures folder at {folder}: the figure scripts ship with "
-                                f"the source checkout (pip install -e .); point {SOURCE_ENV} or "
-                                "--source at its figures/ folder")
+        raise SceneError("source", f"no figures folder at {folder}: the figure scripts ship "
+                                   f"with the source checkout (pip install -e .); point "
+                                   f"{SOURCE_ENV} or --source at its figures/ folder")
     return folder
 
 
 def figure_scripts(source: str | Path | None = None) -> list[Path]:
     """The figure scripts (``figures/*.py`` not starting with ``_``), sorted by name."""
     return sorted(p for p in figures_dir(source).glob("*.py") if not p.name.startswith("_"))
+
+
+def select_scripts(only: list[str] | None = None, source: str | Path | None = None
+                   ) -> list[Path]:
+    """The figure scripts to run: every one, or those whose name contains one of ``only``
+    (``--only``); a SceneError naming ``only`` for a name that matches no script, or
+    ``source`` for a folder without scripts. Nothing is created before this check."""
+    scripts = figure_scripts(source)
+    if not scripts:
+        raise SceneError("source", f"no figure scripts (*.py) in {figures_dir(source)}")
+    if only is None:
+        return scripts
+    if isinstance(only, str) or not all(isinstance(name, str) for name in only):
+        raise SceneError("only", f"must be a list of script names, got {only!r}")
+    stems = [p.stem for p in scripts]
+    unknown = [name for name in only if not any(name in stem for stem in stems)]
+    if unknown:
+        raise SceneError("only", f"no figure script matches {', '.join(map(repr, unknown))}; "
+                                 f"the scripts are {', '.join(stems)}")
+    return [p for p in scripts if any(name in p.stem for name in only)]
 
 
 @contextmanager
@@ -81,14 +103,10 @@ def run_figures(max_level: int | None = None, out: str | Path = "figures-output"
     start = time.perf_counter()
     max_level = max_level or DEFAULT_MAX_LEVEL
     plan = Plan(max_level)
+    scripts = select_scripts(only, source)
+    modules = {p.stem: load_script(p) for p in scripts}
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    scripts = figure_scripts(source)
-    if only:
-        scripts = [p for p in scripts if any(pat in p.stem for pat in only)]
-        if not scripts:
-            raise ValueError(f"no figure script matches {only}")
-    modules = {p.stem: load_script(p) for p in scripts}
     summary = {"max_level": max_level, "plan": plan.describe(), "out": str(out),
                "scheduler": scheduler or "LocalCluster", "workers": workers,
                "processes": processes,
