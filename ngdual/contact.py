@@ -99,16 +99,7 @@ class ContactBoundary:
               space: ngs.FESpace) -> ContactBoundary:
         """Gamma_C from its coarse meshes and the fine trace space (:func:`trace_space`)."""
         vertices, htilde_edge = coarse.fine_edges()
-        mesh, labels = space.mesh, set(scene.labels("contact"))
-        dofs_of = {}
-        for el in mesh.Elements(ngs.BND):
-            if el.mat in labels:
-                a, b = (v.nr for v in el.vertices)
-                # by ElementId: ten times faster than by the element object
-                da, db = space.GetDofNrs(ngs.ElementId(ngs.BND, el.nr))
-                dofs_of[(a, b)], dofs_of[(b, a)] = (da, db), (db, da)
-        edge_dofs = np.array([dofs_of[(int(a), int(b))] for a, b in vertices],
-                             dtype=int).reshape(-1, 2)
+        edge_dofs = coarse.fine_edge_dofs(space)
         pts = [ch.path_points for ch in coarse.chains]
         starts = np.vstack([p[:-1] for p in pts])
         ends = np.vstack([p[1:] for p in pts])
@@ -127,7 +118,7 @@ class ContactBoundary:
 
     def prolongation(self, n_fine: int, ends: bool = False) -> sp.csr_matrix:
         """Coarse h~ P1 dofs (or the fixed-end hats, ``ends=True``) -> fine trace dofs."""
-        return self.coarse.p1_edge_prolongation(self.edge_dofs, n_fine, ends)
+        return self.coarse.p1_prolongation(self.edge_dofs, n_fine, ends)
 
     def hat_means(self, prolongation: sp.csr_matrix) -> sp.csr_matrix:
         """M (n_edges x N_C): the mean of every coarse function on every fine edge."""

@@ -86,20 +86,6 @@ def _trace_space(mesh: ngs.Mesh, labels: list[str]) -> ngs.FESpace:
     return ngs.Compress(ngs.H1(mesh, order=1, definedon=mesh.Boundaries(boundary_regex(labels))))
 
 
-def _vertex_dof(space: ngs.FESpace):
-    """The map fine vertex -> its dof in the P1 trace ``space`` of a boundary part.
-
-    Read once from the boundary elements by ``ElementId``: ``GetDofNrs`` of a compressed
-    space per vertex ``NodeId`` costs 0.1-0.3 ms a call, seconds on level 8.
-    """
-    dofs = {}
-    for el in space.mesh.Elements(ngs.BND):
-        for v, d in zip(el.vertices, space.GetDofNrs(ngs.ElementId(ngs.BND, el.nr))):
-            if d >= 0:
-                dofs[v.nr] = d
-    return dofs.__getitem__
-
-
 @dataclass
 class Spaces:
     """Fine component spaces, the coarse boundary meshes and their prolongations.
@@ -127,11 +113,10 @@ class Spaces:
             neumann = coarse.neumann
             space = _trace_space(mesh, scene.labels("neumann"))
             comps["phi1"] = comps["phi2"] = space
-            dof_of_vertex = _vertex_dof(space)
-            prolong["phi1"] = prolong["phi2"] = neumann.p1_prolongation(dof_of_vertex,
-                                                                        space.ndof)
-            end_hats["phi1"] = end_hats["phi2"] = neumann.p1_prolongation(
-                dof_of_vertex, space.ndof, ends=True)
+            edge_dofs = neumann.fine_edge_dofs(space)
+            prolong["phi1"] = prolong["phi2"] = neumann.p1_prolongation(edge_dofs, space.ndof)
+            end_hats["phi1"] = end_hats["phi2"] = neumann.p1_prolongation(edge_dofs, space.ndof,
+                                                                          ends=True)
         gamma_c = None
         if scene.has_contact:
             contact = coarse.contact

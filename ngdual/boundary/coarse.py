@@ -1,21 +1,21 @@
-"""Coarse boundary meshes and the multiplier spaces on Gamma_N, Gamma_C and A_C.
+"""The coarse meshes h~ and h^ of the multipliers and their P1 spaces.
 
 The multipliers live on meshes coarser than the trace of T_h (Section 3.2):
 phi, lambda_t, lambda_n on h~ = 2h (P1, zero at the end points of their
 boundary part) and nu on h^ = h~ or 2h~ (P0). A coarse mesh is built from the
-fine boundary edges of a boundary part: the edges are ordered into chains and
-grouped ``factor`` at a time, so every fine edge lies entirely on one coarse
-edge (the nesting assumed in Section 3.2) and h~ ~ factor * h locally, on
-uniform and on locally refined meshes alike.
+fine boundary edges of a boundary part: the edges are ordered into chains
+(:mod:`ngdual.boundary.chains`) and grouped ``factor`` at a time, so every fine edge lies
+entirely on one coarse edge (the nesting assumed in Section 3.2) and h~ ~ factor * h
+locally, on uniform and on locally refined meshes alike.
 
 After a local refinement of T_h the coarse meshes follow the fine one
 (:meth:`CoarseMesh.follow`, :class:`BoundaryMeshes`) instead of being grouped
 afresh, which keeps them nested from one adaptive step to the next.
 
-A coarse P1 function is represented by its values at the fine boundary
-vertices: :meth:`CoarseMesh.p1_prolongation` is the matrix mapping coarse
-nodal values to the nodal values of the fine trace space, through which all
-forms assembled by NGSolve on the fine trace are restricted to the coarse space.
+A coarse P1 function is represented by its values at both ends of every fine boundary
+edge: :meth:`CoarseMesh.p1_prolongation` is the matrix mapping coarse nodal values to the
+coefficients of a fine P1 trace space, through which all forms assembled by NGSolve on the
+fine trace are restricted to the coarse space.
 """
 
 from __future__ import annotations
@@ -27,111 +27,7 @@ import ngsolve as ngs
 import numpy as np
 import scipy.sparse as sp
 
-from .scene import contact_junctions
-
-
-@dataclass(frozen=True)
-class Chain:
-    """A connected piece of a boundary part: fine vertices in order along it.
-
-    ``ccw`` is true when the order runs with the boundary's orientation (the body on
-    the left), which fixes the sign of the outward normals (:func:`edge_normals`).
-    """
-
-    vertices: np.ndarray
-    points: np.ndarray
-    closed: bool
-    ccw: bool = True
-
-    @property
-    def path_vertices(self) -> np.ndarray:
-        """Vertices along the chain, the first repeated at the end of a closed chain."""
-        return np.append(self.vertices, self.vertices[0]) if self.closed else self.vertices
-
-    @property
-    def path_points(self) -> np.ndarray:
-        """Coordinates of :attr:`path_vertices`."""
-        return np.vstack([self.points, self.points[:1]]) if self.closed else self.points
-
-    @property
-    def arclength(self) -> np.ndarray:
-        """Arc length at every vertex of :attr:`path_points`."""
-        steps = np.linalg.norm(np.diff(self.path_points, axis=0), axis=1)
-        return np.concatenate([[0.0], np.cumsum(steps)])
-
-    @property
-    def n_edges(self) -> int:
-        return len(self.vertices) if self.closed else len(self.vertices) - 1
-
-
-def boundary_chains(mesh: ngs.Mesh, labels: list[str], breaks: frozenset = frozenset()
-                    ) -> list[Chain]:
-    """Order the fine boundary edges carrying one of ``labels`` into chains.
-
-    A chain ends where the boundary part ends and at the vertices ``breaks`` (the kinks
-    of Gamma_C, where the normal and tangential multipliers are discontinuous).
-    """
-    return [piece for chain in _chains(mesh, labels) for piece in _split_at(chain, breaks)]
-
-
-def _split_at(chain: Chain, breaks: frozenset) -> list[Chain]:
-    """``chain`` cut at the vertices in ``breaks`` (a closed chain opens at the first)."""
-    cuts = [k for k, v in enumerate(chain.vertices) if int(v) in breaks]
-    if not cuts:
-        return [chain]
-    verts, pts = chain.vertices, chain.points
-    if chain.closed:
-        k = cuts[0]
-        verts = np.append(np.roll(verts, -k), verts[k])
-        pts = np.vstack([np.roll(pts, -k, axis=0), pts[k:k + 1]])
-        cuts = [c - k if c >= k else c - k + len(chain.vertices) for c in cuts]
-        cuts = sorted(cuts) + [len(verts) - 1]
-    else:
-        cuts = [c for c in cuts if 0 < c < len(verts) - 1] + [len(verts) - 1]
-    pieces, start = [], 0
-    for c in cuts:
-        if c > start:
-            pieces.append(Chain(verts[start:c + 1], pts[start:c + 1], False, chain.ccw))
-        start = c
-    return pieces
-
-
-def _chains(mesh: ngs.Mesh, labels: list[str]) -> list[Chain]:
-    """Connected chains of the fine boundary edges carrying one of ``labels``."""
-    wanted = set(labels)
-    segments = [tuple(v.nr for v in el.vertices) for el in mesh.Elements(ngs.BND)
-                if el.mat in wanted]
-    directed = set(segments)
-    neighbours: dict[int, list[int]] = {}
-    for a, b in segments:
-        neighbours.setdefault(a, []).append(b)
-        neighbours.setdefault(b, []).append(a)
-    coords = mesh.ngmesh.Coordinates()  # (nv, 2), in the vertex numbers of NGSolve
-    unvisited, chains = set(neighbours), []
-    while unvisited:
-        ends = sorted(v for v in unvisited if len(neighbours[v]) == 1)
-        start = ends[0] if ends else min(unvisited)
-        order, prev = [start], None
-        unvisited.discard(start)
-        while True:
-            nxt = [w for w in neighbours[order[-1]] if w != prev and w in unvisited]
-            if not nxt:
-                break
-            prev = order[-1]
-            order.append(nxt[0])
-            unvisited.discard(nxt[0])
-        closed = not ends
-        verts = np.array(order)
-        ccw = (order[0], order[1]) in directed
-        chains.append(Chain(verts, coords[verts], closed, ccw))
-    return chains
-
-
-def edge_normals(chain: Chain) -> np.ndarray:
-    """Outward unit normals of the fine edges of ``chain``, in chain order."""
-    d = np.diff(chain.path_points, axis=0)
-    n = np.column_stack([d[:, 1], -d[:, 0]]) / np.linalg.norm(d, axis=1)[:, None]
-    return n if chain.ccw else -n
+from .chains import Chain, EndRule, boundary_chains, edge_normals, end_rule
 
 
 def _group(n_edges: int, factor: int) -> np.ndarray:
@@ -168,51 +64,6 @@ def _split(points: np.ndarray, arclength: np.ndarray, factor: int) -> list[int]:
         if length < best_length * (1 - 1e-12):
             best, best_length = cut, length
     return [int(p) for p in points[best[1:]]]
-
-
-@dataclass(frozen=True)
-class EndRule:
-    """Where the chains of a boundary part break and which of their ends are free.
-
-    ``breaks``: fine vertex numbers where a chain is cut; ``free_points``: coordinates
-    of the chain ends that carry a dof (all other ends of open chains are fixed).
-    """
-
-    breaks: frozenset = frozenset()
-    free_points: tuple = ()
-
-    def is_free(self, point: np.ndarray) -> bool:
-        return any(np.linalg.norm(point - q) <= 1e-9 * (1 + np.linalg.norm(q))
-                   for q in self.free_points)
-
-    def free_ends(self, chains) -> tuple[tuple[bool, bool], ...]:
-        return tuple((False, False) if ch.closed
-                     else (self.is_free(ch.points[0]), self.is_free(ch.points[-1]))
-                     for ch in chains)
-
-
-def end_rule(scene, mesh: ngs.Mesh, role: str) -> EndRule:
-    """The :class:`EndRule` of Gamma_C (``role = "contact"``) or Gamma_N (``"neumann"``).
-
-    Gamma_C breaks at its kinks, and its multipliers are free there; with
-    ``contact.ends = "consistent"`` they are also free where Gamma_C meets Gamma_N, and
-    phi on Gamma_N is free where Gamma_N meets Gamma_C. Every other end (where a part
-    meets Gamma_D, and all ends for ``"thesis"``) is fixed (see :class:`ngdual.scene.Contact`).
-    """
-    junctions = contact_junctions(scene) if scene.has_contact else []
-    kinks = [p for p, kind, _ in junctions if kind == "kink"]
-    touching = [p for p, kind, _ in junctions if kind == "neumann"]
-    consistent = scene.contact.ends == "consistent"
-    if role == "contact":
-        labels = set(scene.labels("contact"))
-        # only the vertices of Gamma_C can be kinks (a full vertex scan costs seconds at L8)
-        candidates = {v.nr: np.array(mesh[v].point) for el in mesh.Elements(ngs.BND)
-                      if el.mat in labels for v in el.vertices} if kinks else {}
-        breaks = frozenset(nr for nr, xy in candidates.items()
-                           if any(np.linalg.norm(xy - k) <= 1e-9 * (1 + np.linalg.norm(k))
-                                  for k in kinks))
-        return EndRule(breaks, tuple(kinks) + (tuple(touching) if consistent else ()))
-    return EndRule(frozenset(), tuple(touching) if consistent else ())
 
 
 @dataclass(frozen=True)
@@ -386,17 +237,38 @@ class CoarseMesh:
             return np.zeros((0, 2), dtype=int), np.zeros(0, dtype=int)
         return np.vstack(pairs).astype(int), np.concatenate(owner)
 
-    def p1_prolongation(self, fine_dof_of_vertex, n_fine: int, ends: bool = False
-                        ) -> sp.csr_matrix:
-        """Matrix of the coarse P1 hats evaluated at the fine vertices.
+    def fine_edge_dofs(self, space: ngs.FESpace) -> np.ndarray:
+        """(n, 2) dofs of the fine P1 trace ``space`` at the start and the end of every fine
+        edge, in the order of :meth:`fine_edges`.
 
-        With ``ends=True`` only the hats of the chain end nodes (excluded from the
+        Read from the boundary elements by ``ElementId``: ``GetDofNrs`` of a compressed space
+        by element object or vertex ``NodeId`` costs ten times as much, seconds on level 8.
+        """
+        dofs_of = {}
+        for el in space.mesh.Elements(ngs.BND):
+            a, b = (v.nr for v in el.vertices)
+            dofs = space.GetDofNrs(ngs.ElementId(ngs.BND, el.nr))
+            if len(dofs) == 2 and min(dofs) >= 0:  # an edge of the space's boundary part
+                dofs_of[(a, b)], dofs_of[(b, a)] = tuple(dofs), tuple(dofs[::-1])
+        vertices, _ = self.fine_edges()
+        return np.array([dofs_of[(int(a), int(b))] for a, b in vertices],
+                        dtype=int).reshape(-1, 2)
+
+    def p1_prolongation(self, edge_dofs: np.ndarray, n_fine: int, ends: bool = False
+                        ) -> sp.csr_matrix:
+        """Matrix of the coarse P1 hats at both ends of every fine edge.
+
+        With ``ends=True`` only the hats of the fixed chain end nodes (excluded from the
         space, but needed to lift non-zero end values) are returned.
 
         Parameters
         ----------
-        fine_dof_of_vertex : callable
-            Maps a fine vertex number to its dof in the fine trace space.
+        edge_dofs : numpy.ndarray
+            (n_fine_edges, 2) dofs of the fine trace space at the start and the end of every
+            fine edge (:meth:`fine_edge_dofs`). The space may be continuous (phi on Gamma_N:
+            neighbouring edges share the dof of their common vertex, where both give the
+            hats the same value) or discontinuous from edge to edge (lambda on Gamma_C,
+            needed at its kinks).
         n_fine : int
             Number of dofs of the fine trace space.
 
@@ -404,38 +276,7 @@ class CoarseMesh:
         -------
         scipy.sparse.csr_matrix of shape (n_fine, n_p1_dofs).
         """
-        rows, cols, vals = [], [], []
-        offset = 0
-        for c, chain in enumerate(self.chains):
-            s, nodes = chain.arclength, self.nodes[c]
-            carriers = self.end_positions(c) if ends else self.dof_positions(c)
-            dof_of_pos = {int(p): offset + k for k, p in enumerate(carriers)}
-            offset += len(carriers)
-            for e in range(len(nodes) - 1):
-                a, b = nodes[e], nodes[e + 1]
-                for p in range(a, b + 1):
-                    if p == b and (b != nodes[-1] or chain.closed):
-                        continue  # a shared node belongs to the next edge
-                    t = (s[p] - s[a]) / (s[b] - s[a])
-                    fine = fine_dof_of_vertex(int(chain.vertices[p % len(chain.vertices)]))
-                    for pos, w in ((a, 1 - t), (b, t)):
-                        key = int(pos) % chain.n_edges if chain.closed else int(pos)
-                        if key in dof_of_pos and w > 0:
-                            rows.append(fine)
-                            cols.append(dof_of_pos[key])
-                            vals.append(w)
-        return sp.csr_matrix((vals, (rows, cols)), shape=(n_fine, offset))
-
-    def p1_edge_prolongation(self, edge_dofs: np.ndarray, n_fine: int, ends: bool = False
-                             ) -> sp.csr_matrix:
-        """The coarse P1 hats at both ends of every fine edge, for a fine space that is
-        discontinuous from edge to edge (needed at the kinks of Gamma_C).
-
-        ``edge_dofs`` (n_fine_edges, 2): the fine dofs at the start and the end of every
-        fine edge, in the chain order of :meth:`fine_edges`. ``ends`` as in
-        :meth:`p1_prolongation`. Returns a csr_matrix of shape (n_fine, n_dofs).
-        """
-        rows, cols, vals = [], [], []
+        entries = {}
         offset, edge = 0, 0
         for c, chain in enumerate(self.chains):
             s, nodes = chain.arclength, self.nodes[c]
@@ -450,11 +291,10 @@ class CoarseMesh:
                     for pos, w in ((a, 1 - t), (b, t)):
                         key = pos % chain.n_edges if chain.closed else pos
                         if key in dof_of_pos and w > 0:
-                            rows.append(edge_dofs[edge + k, end])
-                            cols.append(dof_of_pos[key])
-                            vals.append(w)
+                            entries[int(edge_dofs[edge + k, end]), dof_of_pos[key]] = w
             edge += chain.n_edges
-        return sp.csr_matrix((vals, (rows, cols)), shape=(n_fine, offset))
+        rows, cols = (np.array([rc[i] for rc in entries], dtype=int) for i in (0, 1))
+        return sp.csr_matrix((list(entries.values()), (rows, cols)), shape=(n_fine, offset))
 
     def p1_mass_stiffness(self) -> tuple[np.ndarray, np.ndarray]:
         """Dense P1 mass M and arc-length stiffness L on the coarse dofs."""

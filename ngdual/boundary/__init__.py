@@ -1,0 +1,8 @@
+"""Boundary meshes: the fine boundary edges in chains and the coarse meshes h~, h^ of the
+multipliers on Gamma_N, Gamma_C and A_C, with their P1 spaces (Section 3.2)."""
+
+from .chains import Chain, EndRule, boundary_chains, edge_normals, end_rule
+from .coarse import BoundaryMeshes, CoarseMesh
+
+__all__ = ["BoundaryMeshes", "Chain", "CoarseMesh", "EndRule", "boundary_chains",
+           "edge_normals", "end_rule"]
