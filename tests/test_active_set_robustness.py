@@ -128,7 +128,7 @@ def test_damped_newton_ends_the_cycle_without_the_qp(monkeypatch):
 
     def no_qp(*args):
         raise AssertionError("the QP fallback was called")
-    monkeypatch.setattr(semismooth, "_qp_fallback", no_qp)
+    monkeypatch.setattr(semismooth, "contact_qp", no_qp)
     calls = []
     newton = active_set.semismooth_newton
 

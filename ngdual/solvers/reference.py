@@ -18,20 +18,25 @@ With friction and a given bound F, (3.62) is the KKT system of the QP in (sigma,
 (stationarity in nu is nu_j = sign (Q_F lambda_t)_j, i.e. (3.62)_7); Coulomb
 friction iterates this QP on F = mu_f |sigma_n| of (3.123) to a fixed point
 (:func:`solve_qp_friction`).
+
+Condensed onto Gamma_C, the same problem is a small dense QP in the contact multipliers
+(:func:`contact_qp`), the fallback of the semismooth Newton method when its active sets cycle.
 """
 
 from __future__ import annotations
 
 import time
+import warnings
 
 import cvxpy as cp
 import numpy as np
+import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..forms import DiscreteProblem
 from ..friction import build_friction_forms, tresca_bound
-from ..tolerances import CLARABEL_REFERENCE
+from ..tolerances import CLARABEL_REFERENCE, CLARABEL_TOLERANCES
 from .result import ConvergenceError, Solution
 from .settings import Model
 
@@ -204,3 +209,42 @@ def _residuals(A, B, C_n, g, b, sigma, y, lam) -> dict:
         "complementarity": float(abs(lam @ traction)
                                  / ((np.linalg.norm(lam) * np.linalg.norm(traction)) or 1.0)),
     }
+
+
+def contact_qp(G: np.ndarray, b: np.ndarray, Q: np.ndarray, n_c: int
+               ) -> tuple[np.ndarray, np.ndarray] | None:
+    """The contact problem condensed onto Gamma_C as the convex QP it is, by Clarabel:
+
+        min 1/2 z^T G z - b^T z + ||Q lambda_t||_1   s.t.  lambda_n >= 0,
+
+    z = (lambda_n, lambda_t) of length 2 ``n_c``, t(z) = b - G z the traction moments, Q = Q_F
+    (:mod:`ngdual.solvers.semismooth`, whose fallback it is). Returns (z, nu), nu the
+    multipliers of |Q lambda_t| <= s clipped to [-1, 1], or None if Clarabel returns no
+    solution. It starts the Newton polish, so it is solved to CLARABEL_TOLERANCES only.
+    """
+    scale_t = np.max(np.abs(b), initial=0.0) or 1.0
+    d = np.sqrt(np.diag(G))
+    Gs = G / np.outer(d, d)  # z = y / d: unit diagonal
+    R = sla.cholesky(0.5 * (Gs + Gs.T) + 1e-15 * np.eye(len(d)), lower=False)
+    y = cp.Variable(len(d))
+    s = cp.Variable(Q.shape[0])
+    Qs = sp.csr_matrix(Q / d[n_c:][None, :] / scale_t)
+    upper, lower = Qs @ y[n_c:] <= s, -Qs @ y[n_c:] <= s
+    positive = y[:n_c] >= 0
+    objective = 0.5 * cp.sum_squares(R @ y) - (b / d / scale_t) @ y + cp.sum(s) if Q.shape[0] \
+        else 0.5 * cp.sum_squares(R @ y) - (b / d / scale_t) @ y
+    constraints = [positive, upper, lower] if Q.shape[0] else [positive]
+    with warnings.catch_warnings():
+        # "solution may be inaccurate": it is only the start of the Newton polish
+        warnings.simplefilter("ignore", UserWarning)
+        try:
+            cp.Problem(cp.Minimize(objective), constraints).solve(
+                solver=cp.CLARABEL, **CLARABEL_TOLERANCES)
+        except cp.error.SolverError:
+            return None
+    if y.value is None:
+        return None
+    z = scale_t * np.asarray(y.value) / d
+    nu = np.asarray(upper.dual_value - lower.dual_value) if Q.shape[0] else np.zeros(0)
+    z[:n_c] = np.maximum(z[:n_c], 0.0)
+    return z, np.clip(nu, -1, 1)

@@ -41,17 +41,17 @@ smooth, not differentiable, so there is no global convergence proof, and along a
 direction it can grow at once (a multiplier nu far beyond [-1, 1] on a stick edge that must
 slip): then (alpha < ``MIN_STEP``) a full step is taken again, at most ``MAX_ESCAPES``
 times. Failing all that (or after ``max_iter`` steps) the problem is solved as the convex QP
-it is (Clarabel through cvxpy), and the same iteration restarts from the QP's solution
-(one or two steps to round-off). Measured on 500 random problems (200 of them with Tresca
-bounds varying by 1e3 between edges, a third of those with duplicated rows of Q_F, as for
-h^ = h~): the QP was needed for 5 of the 433 without duplicated rows (full steps and QP
+it is (:func:`ngdual.solvers.reference.contact_qp`), and the same iteration restarts from the
+QP's solution (one or two steps to round-off). Measured on 500 random problems (200 of them
+with Tresca bounds varying by 1e3 between edges, a third of those with duplicated rows of Q_F,
+as for h^ = h~): the QP was needed for 5 of the 433 without duplicated rows (full steps and QP
 only: 27 of the 300 easy ones alone); on a Cattaneo-Mindlin block the damped steps end a
 cycle that took 25 steps and the QP in 17.
 
 Tolerance: the conditions are residuals relative to the size of their terms; a backward
 stable solve of a Newton system attains about eps times the condition number of G
 (:func:`kkt_tolerance`: SAFETY * eps * max(kappa_1(G), dim G); kappa_1(G) doubles per level,
-so 4e-13 to 1.4e-11 on levels 1-6 of Example 3.46, formerly a fixed 1e-10).
+so 4e-13 to 1.4e-11 on levels 1-6 of Example 3.46).
 The result is always checked (:func:`kkt_residuals`); a :class:`ConvergenceError` names
 every condition that fails, with its value and the tolerance.
 """
@@ -61,14 +61,13 @@ from __future__ import annotations
 import warnings
 from dataclasses import dataclass
 
-import cvxpy as cp
 import numpy as np
 import scipy.linalg as sla
 import scipy.linalg.lapack as lapack
 import scipy.optimize as spo
-import scipy.sparse as sp
 
-from ..tolerances import CLARABEL_TOLERANCES, friction_vanishes
+from ..tolerances import friction_vanishes
+from .reference import contact_qp
 from .result import ConvergenceError
 
 EPS = float(np.finfo(float).eps)
@@ -298,7 +297,7 @@ def semismooth_newton(G: np.ndarray, b: np.ndarray, n_c: int, Q: np.ndarray | No
         return found
     # no convergence (the line search stalled, or max_iter): the convex QP gives the
     # sets, the damped Newton iteration polishes from there
-    qp = _qp_fallback(G, b, Q, n_c)
+    qp = contact_qp(G, b, Q, n_c)
     if qp is not None:
         z, nu = qp
         found = _iterate(G, b, Q, z, nu, n_c, has_friction, max_iter, tol, history, best)
@@ -382,36 +381,3 @@ def _iterate(G, b, Q, z, nu, n_c, has_friction, max_iter, tol, history, best):
         if value < lowest[0]:
             lowest, since_lowest = (value, z, nu), 0
     return None
-
-
-def _qp_fallback(G, b, Q, n_c):
-    """min 1/2 z^T G z - b^T z + ||Q lambda_t||_1, lambda_n >= 0, by Clarabel: (z, nu).
-
-    None if Clarabel returns no solution.
-    """
-    scale_t = np.max(np.abs(b), initial=0.0) or 1.0
-    d = np.sqrt(np.diag(G))
-    Gs = G / np.outer(d, d)  # z = y / d: unit diagonal
-    R = sla.cholesky(0.5 * (Gs + Gs.T) + 1e-15 * np.eye(len(d)), lower=False)
-    y = cp.Variable(len(d))
-    s = cp.Variable(Q.shape[0])
-    Qs = sp.csr_matrix(Q / d[n_c:][None, :] / scale_t)
-    upper, lower = Qs @ y[n_c:] <= s, -Qs @ y[n_c:] <= s
-    positive = y[:n_c] >= 0
-    objective = 0.5 * cp.sum_squares(R @ y) - (b / d / scale_t) @ y + cp.sum(s) if Q.shape[0] \
-        else 0.5 * cp.sum_squares(R @ y) - (b / d / scale_t) @ y
-    constraints = [positive, upper, lower] if Q.shape[0] else [positive]
-    with warnings.catch_warnings():
-        # "solution may be inaccurate": it is only the start of the Newton polish
-        warnings.simplefilter("ignore", UserWarning)
-        try:
-            cp.Problem(cp.Minimize(objective), constraints).solve(
-                solver=cp.CLARABEL, **CLARABEL_TOLERANCES)
-        except cp.error.SolverError:
-            return None
-    if y.value is None:
-        return None
-    z = scale_t * np.asarray(y.value) / d
-    nu = np.asarray(upper.dual_value - lower.dual_value) if Q.shape[0] else np.zeros(0)
-    z[:n_c] = np.maximum(z[:n_c], 0.0)
-    return z, np.clip(nu, -1, 1)
