@@ -16,7 +16,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "ngdual"
 
 # (stage, module prefixes), in the order the data flows
 STAGES = [
-    ("foundation", ["expr", "geometry", "tolerances", "rates", "sparse"]),
+    ("foundation", ["expr", "extras", "geometry", "tolerances", "rates", "sparse"]),
     ("scene", ["scene", "scenes"]),
     ("mesh", ["mesh", "budget", "io"]),
     ("spaces", ["peers", "boundary", "contact"]),

@@ -32,6 +32,7 @@ from __future__ import annotations
 import argparse
 import sys
 
+from ..extras import MissingExtraError
 from ..scene import SceneError
 from .output import EXIT_BAD_INPUT, EXIT_INTERNAL, EXIT_NOT_CONVERGED, EXIT_WARNINGS
 from .pipeline import cmd_adapt, cmd_dofs, cmd_scenes, cmd_solve
@@ -191,7 +192,7 @@ def main(argv: list[str] | None = None) -> int:
         return args.func(args)
     try:
         return args.func(args)
-    except SceneError as err:
+    except (SceneError, MissingExtraError) as err:  # the message names the field or the extra
         print(f"ngdual: error: {err}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except MemoryError:

@@ -24,6 +24,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from threadpoolctl import threadpool_limits
 
+from ..extras import require
 from ..tolerances import BLAS_THREADS
 
 ORDERINGS = ("amd", "metis")
@@ -37,8 +38,7 @@ def fill_reducing_order(H: sp.spmatrix, method: str = "amd") -> np.ndarray:
     if n == 0:
         return np.zeros(0, dtype=int)
     if method == "metis":
-        import pymetis
-
+        pymetis = require("pymetis", "metis")
         graph = sp.csr_matrix(H, copy=True)
         graph.setdiag(0)
         graph.eliminate_zeros()

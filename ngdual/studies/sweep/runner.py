@@ -14,6 +14,7 @@ import warnings
 from collections.abc import Iterable
 from pathlib import Path
 
+from ...extras import require
 from ..variants import VARIANTS
 from .records import Task, load_record, record_path, remove_stale_temporaries, write_record
 from .work import execute, load_scene_with
@@ -69,16 +70,16 @@ class Runner:
 
     def client(self):
         if self._client is None:
-            from dask.distributed import Client, LocalCluster
+            distributed = require("dask.distributed", "studies")
 
             if self.scheduler:
-                self._client = Client(self.scheduler)
+                self._client = distributed.Client(self.scheduler)
             else:
-                self._cluster = LocalCluster(
+                self._cluster = distributed.LocalCluster(
                     n_workers=self.workers if self.processes else 1, threads_per_worker=1,
                     processes=self.processes, dashboard_address=None, memory_limit=0,
                     **({"env": WORKER_ENV} if self.processes else {}))
-                self._client = Client(self._cluster)
+                self._client = distributed.Client(self._cluster)
             self._client.run(warm_up)
         return self._client
 
@@ -108,8 +109,9 @@ class Runner:
     def run(self, tasks: Iterable[Task], folder: str | Path, desc: str = "sweep"
             ) -> list[dict | None]:
         """Records of ``tasks`` (None where a task could not finish), computing the missing."""
-        from dask.distributed import as_completed
         from tqdm import tqdm
+
+        as_completed = require("dask.distributed", "studies").as_completed
 
         tasks = list(tasks)
         folder = Path(folder)

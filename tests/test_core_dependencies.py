@@ -1,0 +1,148 @@
+"""``import ngdual``, ``nd.solve``, ``nd.adapt`` and ``ngdual solve`` need only the core.
+
+The packages of the extras (``setup.cfg``), with every package they pull in that the core
+does not, are blocked in a subprocess by an import hook, as if they were not installed;
+the subprocess then solves a scene with contact and Coulomb friction on level 1, adapts
+it one step and runs the README's first command. A command that needs an extra names it
+(:func:`ngdual.extras.require`).
+"""
+
+import configparser
+import json
+import os
+import subprocess
+import sys
+from importlib import metadata
+from pathlib import Path
+
+import pytest
+from packaging.requirements import Requirement
+from packaging.utils import canonicalize_name
+
+from ngdual.cli.output import EXIT_BAD_INPUT
+from ngdual.extras import MissingExtraError, require
+
+SETUP_CFG = Path(__file__).resolve().parents[1] / "setup.cfg"
+
+
+def requirements() -> tuple[list[str], dict[str, list[str]]]:
+    """install_requires and extras_require of setup.cfg, an extra's ``ngdual[...]`` expanded."""
+    cfg = configparser.ConfigParser()
+    cfg.read(SETUP_CFG)
+    lines = lambda text: [s.strip() for s in text.splitlines() if s.strip()]  # noqa: E731
+    declared = {name: lines(text) for name, text in cfg["options.extras_require"].items()}
+
+    def expand(reqs: list[str]) -> list[str]:
+        out = []
+        for text in reqs:
+            req = Requirement(text)
+            out += expand([r for e in sorted(req.extras) for r in declared[e]]) \
+                if req.name == "ngdual" else [text]
+        return out
+
+    return lines(cfg["options"]["install_requires"]), {e: expand(r) for e, r in declared.items()}
+
+
+def closure(reqs: list[str]) -> set[str]:
+    """The installed distributions ``reqs`` need, with their dependencies (markers evaluated)."""
+    found, seen, todo = set(), set(), [Requirement(r) for r in reqs]
+    while todo:
+        req = todo.pop()
+        name = canonicalize_name(req.name)
+        if (req.marker and not req.marker.evaluate({"extra": ""})) \
+                or (name, frozenset(req.extras)) in seen:
+            continue
+        seen.add((name, frozenset(req.extras)))
+        try:
+            needs = metadata.requires(name) or []
+        except metadata.PackageNotFoundError:
+            continue
+        found.add(name)
+        for text in needs:
+            sub = Requirement(text)
+            if sub.marker is None or any(sub.marker.evaluate({"extra": e})
+                                         for e in ("", *req.extras)):
+                sub.marker = None
+                todo.append(sub)
+    return found
+
+
+def blocked_modules() -> list[str]:
+    """Top-level import names installed only by the extras."""
+    core, extras = requirements()
+    needed = closure(core) | {"ngdual", "pip", "setuptools", "wheel"}
+    optional = closure([r for reqs in extras.values() for r in reqs]) - needed
+    names = set()
+    for module, dists in metadata.packages_distributions().items():
+        dists = {canonicalize_name(d) for d in dists}
+        if dists & optional and not dists & needed and module.isidentifier():
+            names.add(module)
+    return sorted(names)
+
+
+CORE_ONLY = r"""
+import importlib.abc, json, sys
+
+BLOCKED = set(json.loads(sys.argv[1]))
+
+class Uninstalled(importlib.abc.MetaPathFinder):
+    def find_spec(self, name, path=None, target=None):
+        if name.partition(".")[0] in BLOCKED:
+            raise ModuleNotFoundError(f"No module named {name!r} (blocked)", name=name)
+
+sys.meta_path.insert(0, Uninstalled())
+
+import warnings
+import ngdual as nd
+from ngdual.cli import main
+
+scene = nd.load_scene("thesis-3.46-coulomb", ["geometry.level=1"])
+with warnings.catch_warnings():
+    warnings.simplefilter("ignore")  # the thesis ends warn; the solve is what is tested
+    solution = nd.solve(scene)
+    history = nd.adapt(scene, steps=2, level=1)
+status = main(["solve", "thesis-3.46-coulomb", "--level", "1", "--out", sys.argv[2]])
+figures = main(["figures", "--only", "tab_3_1", "--max-level", "2", "--out", sys.argv[2] + "-f"])
+loaded = sorted({m.partition(".")[0] for m in sys.modules} & BLOCKED)
+print(json.dumps({"converged": bool(solution.converged), "steps": len(history),
+                  "elements": [r["elements"] for r in history], "cli": status,
+                  "figures": figures, "loaded": loaded}))
+"""
+
+
+@pytest.fixture(scope="module")
+def blocked():
+    names = blocked_modules()
+    assert {"dask", "distributed", "pymetis", "jupytext", "sphinx", "selenium",
+            "hypothesis"} <= set(names), names
+    return names
+
+
+def test_the_extras_packages_are_not_in_install_requires(blocked):
+    core, _ = requirements()
+    core_names = {canonicalize_name(Requirement(r).name) for r in core}
+    assert not core_names & {"dask", "distributed", "pymetis", "clarabel", "jupytext"}
+    assert "clarabel" in closure(core)       # the QP solver the solvers name comes with cvxpy
+    assert {"ngsolve", "netgen-mesher", "numpy", "scipy", "cvxpy", "cvxopt",
+            "matplotlib"} <= core_names
+
+
+def test_solve_adapt_and_the_cli_solve_run_with_the_extras_uninstalled(blocked, tmp_path):
+    env = {**os.environ, "MPLBACKEND": "Agg"}
+    run = subprocess.run([sys.executable, "-c", CORE_ONLY, json.dumps(blocked),
+                          str(tmp_path / "out")], capture_output=True, text=True, env=env,
+                         cwd=tmp_path, timeout=600)
+    assert run.returncode == 0, run.stderr[-3000:]
+    result = json.loads(run.stdout.strip().splitlines()[-1])
+    assert result["converged"] and result["steps"] == 2 and result["cli"] == 0, result
+    assert result["elements"][1] > result["elements"][0]          # the mesh was refined
+    assert result["loaded"] == []
+    assert (tmp_path / "out" / "result.json").is_file()
+    # a study names the extra it needs, as bad input rather than as a bug
+    assert result["figures"] == EXIT_BAD_INPUT
+    assert 'pip install "ngdual[studies]"' in run.stderr
+
+
+def test_a_missing_extra_is_named_with_its_install_command():
+    with pytest.raises(MissingExtraError, match=r'pip install "ngdual\[studies\]"'):
+        require("ngdual_no_such_package", "studies")
