@@ -170,12 +170,12 @@ def _cgroup_memory() -> tuple[float, float] | None:
     return None
 
 
-def describe_available() -> str:
-    """The memory of :func:`available_memory` and the limit it comes from, for messages:
-    e.g. ``"the 1.2 GiB the address-space limit (ulimit -v) leaves"``."""
+def describe_available(have: float | None = None) -> str:
+    """``have`` bytes (default: :func:`available_memory`) and the limit they come from, for
+    messages: e.g. ``"the 1.2 GiB the address-space limit (ulimit -v) leaves"``."""
     limits = _memory_limits()
     source = min(limits, key=limits.get)
-    return f"the {_gib(limits[source])} {source}"
+    return f"the {_gib(limits[source] if have is None else have)} {source}"
 
 
 def check(geo: Geometry, level: int | None = None, field_name: str = "geometry.level",
@@ -196,7 +196,7 @@ def check(geo: Geometry, level: int | None = None, field_name: str = "geometry.l
                 # too fine before any refinement: blame the size that makes it so
                 field_name, remedy = _finest_size(geo)
         raise SceneError(field_name, f"{where} needs {size.describe(mesh_only)}, more than "
-                                     f"{describe_available()}; choose {remedy}, or pass "
+                                     f"{describe_available(have)}; choose {remedy}, or pass "
                                      "--allow-large (allow_large=True) to try anyway")
     return size
 
