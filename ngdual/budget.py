@@ -108,13 +108,7 @@ def available_memory() -> float:
 def _memory_limits() -> dict[str, float]:
     """Bytes usable under each limit that applies, by its name in a message."""
     resident, reserved = _process_memory()
-    try:
-        import psutil
-
-        machine = float(psutil.virtual_memory().available) + resident
-    except ImportError:  # pragma: no cover - psutil comes with dask.distributed
-        machine = float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
-    limits = {"this machine has available": machine}
+    limits = {"this machine has available": _machine_available() + resident}
     soft, _ = resource.getrlimit(resource.RLIMIT_AS)
     if soft != resource.RLIM_INFINITY:
         limits["the address-space limit (ulimit -v) leaves"] = float(soft) - (reserved - resident)
@@ -123,6 +117,24 @@ def _memory_limits() -> dict[str, float]:
         limit, used = group
         limits["the cgroup's memory limit leaves"] = limit - (used - resident)
     return limits
+
+
+def _machine_available() -> float:
+    """Bytes of memory the machine has available: psutil's estimate (psutil comes with the
+    studies extra), else the kernel's MemAvailable, else the physical size."""
+    try:
+        import psutil
+
+        return float(psutil.virtual_memory().available)
+    except ImportError:
+        pass
+    try:
+        for line in Path("/proc/meminfo").read_text().splitlines():
+            if line.startswith("MemAvailable:"):
+                return float(line.split()[1]) * 1024  # kB
+    except OSError:  # pragma: no cover - not Linux
+        pass
+    return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
 
 
 def _process_memory() -> tuple[float, float]:

@@ -156,6 +156,14 @@ def test_the_budget_is_the_smallest_of_the_machine_and_the_cgroup(tmp_path, monk
     assert budget.available_memory() > 0.5 * GIB
 
 
+@pytest.mark.skipif(not Path("/proc/meminfo").is_file(), reason="needs Linux")
+def test_without_psutil_the_machine_memory_is_the_kernels_estimate(monkeypatch):
+    psutil = pytest.importorskip("psutil")
+    expected = psutil.virtual_memory().available
+    monkeypatch.setitem(sys.modules, "psutil", None)  # the studies extra not installed
+    assert budget._machine_available() == pytest.approx(expected, rel=0.2)
+
+
 PRLIMIT = shutil.which("prlimit")
 needs_prlimit = pytest.mark.skipif(PRLIMIT is None or not sys.platform.startswith("linux"),
                                    reason="needs Linux and prlimit")
