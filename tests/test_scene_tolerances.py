@@ -20,7 +20,7 @@ from ngdual.boundary import BoundaryMeshes
 from ngdual.forms import assemble
 from ngdual.mesh import build_mesh, moved_mesh
 from ngdual.quantities import fields
-from ngdual.scene import SceneError, read_toml, scene_from_dict
+from ngdual.scene import DISCRETE_GAPS, SceneError, read_toml, scene_from_dict
 from ngdual.scene.domain import round_off
 from ngdual.solvers import solve_problem
 
@@ -158,11 +158,17 @@ def test_rotated_and_translated_shipped_scenes_are_accepted(name, degrees, shift
 LEVELS = {"hertz-cylinder": 2, "flat-punch": 2, "cattaneo-mindlin": 2}
 
 
+@pytest.mark.parametrize("discrete_gap", DISCRETE_GAPS)
 @pytest.mark.parametrize("name", ["hertz-cylinder", "flat-punch", "cattaneo-mindlin"])
-def test_a_rotated_scene_on_the_rotated_mesh_has_the_same_force_and_stress_norm(name):
+def test_a_rotated_scene_on_the_rotated_mesh_has_the_same_force_and_stress_norm(name,
+                                                                                discrete_gap):
+    """Measured: 1e-14 to 7e-14 relative with the direct solves, 2e-11 to 5e-11 with the
+    Coulomb fixed point of cattaneo-mindlin (level 2, either discrete gap)."""
     degrees = 30.0
-    original = scene_from_dict(shipped(name))
-    turned = scene_from_dict(moved_document(shipped(name), degrees))
+    data = shipped(name)
+    data.setdefault("contact", {})["discrete_gap"] = discrete_gap
+    original = scene_from_dict(data)
+    turned = scene_from_dict(moved_document(data, degrees))
     mesh = build_mesh(original.geometry, LEVELS[name])
     first = solve_on(original, mesh)
     second = solve_on(turned, moved_mesh(mesh, rotation(degrees)))
