@@ -25,7 +25,9 @@ import scipy.sparse as sp
 
 from .boundary import CoarseMesh, edge_normals
 from .expr import Expression
-from .scene import Scene, foundation_line, gap_at
+from .geometry import tangent
+from .scene import Scene, gap_at
+from .scene.domain import foundation_gap
 
 
 def trace_space(mesh: ngs.Mesh, labels: list[str]) -> ngs.FESpace:
@@ -56,10 +58,8 @@ def gap_coefficient(scene: Scene) -> ngs.CoefficientFunction:
     contact = scene.contact
     if contact.foundation is None:
         return Expression(contact.gap_formula).coefficient()
-    point, n_f = foundation_line(contact)
     n = ngs.specialcf.normal(2)
-    distance = (ngs.x - point[0]) * n_f[0] + (ngs.y - point[1]) * n_f[1]
-    return distance / (-(n[0] * n_f[0] + n[1] * n_f[1]))
+    return foundation_gap(contact, ngs.x, ngs.y, n[0], n[1])
 
 
 @dataclass(frozen=True)
@@ -114,7 +114,7 @@ class ContactBoundary:
     @property
     def tangents(self) -> np.ndarray:
         """t = (n_2, -n_1), the tangent of (3.24)."""
-        return np.column_stack([self.normals[:, 1], -self.normals[:, 0]])
+        return tangent(self.normals)
 
     def prolongation(self, n_fine: int, ends: bool = False) -> sp.csr_matrix:
         """Coarse h~ P1 dofs (or the fixed-end hats, ``ends=True``) -> fine trace dofs."""
@@ -197,7 +197,6 @@ class ContactBoundary:
         if self.scene.contact.ends == "thesis" or not len(points):
             return np.zeros(len(points)), np.zeros(len(points))
         normals = self.coarse.end_normals()
-        tangents = np.column_stack([normals[:, 1], -normals[:, 0]])
         u = np.column_stack([Expression(e).numpy(points[:, 0], points[:, 1]) for e in u_d])
         g = gap_at(self.scene.contact, points, normals)
-        return g - np.sum(u * normals, axis=1), -np.sum(u * tangents, axis=1)
+        return g - np.sum(u * normals, axis=1), -np.sum(u * tangent(normals), axis=1)

@@ -50,6 +50,7 @@ from . import peers
 from .contact import gap_coefficient
 from .expr import Expression
 from .forms import boundary_regex
+from .geometry import tangent
 from .mesh import element_diameters
 from .quantities import fields, require_solution
 from .scene import SceneError, SceneTypeError
@@ -115,11 +116,6 @@ class Estimate:
     def summed(self) -> dict[str, float]:
         """sum_T of every squared term (their sum is ``total**2``)."""
         return {k: float(np.sum(v)) for k, v in self.terms.items()}
-
-
-def _tangent():
-    n = ngs.specialcf.normal(2)
-    return n, ngs.CF((n[1], -n[0]))
 
 
 def _interpolate(mesh: ngs.Mesh, cfs) -> list[ngs.GridFunction]:
@@ -229,7 +225,8 @@ def estimate(solution: Solution, asymmetry: str = "l2") -> Estimate:
     lam, mu = scene.material.lame
     f = fields(solution)
     h = element_diameters(mesh)
-    n, t = _tangent()
+    n = ngs.specialcf.normal(2)
+    t = tangent(n)
 
     # w_h = C^{-1} sigma_h + eta_h and a_h = (sigma_12 - sigma_21) / 2, as P2 functions per element
     w_cf = peers.compliance(f.sigma, lam, mu) + ngs.CF((0, f.eta, -f.eta, 0), dims=(2, 2))

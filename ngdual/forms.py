@@ -25,6 +25,7 @@ from . import peers
 from .boundary import BoundaryMeshes, CoarseMesh
 from .contact import ContactBoundary, gap_coefficient, trace_space
 from .expr import Expression
+from .geometry import tangent
 from .scene import Scene
 from .sparse import to_scipy
 
@@ -219,7 +220,7 @@ def _forms(scene: Scene, fes: ngs.FESpace, names: list[str]):
     trial = dict(zip(names, fes.TrialFunction()))
     test = dict(zip(names, fes.TestFunction()))
     n = ngs.specialcf.normal(2)
-    t = ngs.CF((n[1], -n[0]))
+    t = tangent(n)
     trac_sig = peers.stress_traction(trial["r1"], trial["r2"])
     trac_tau = peers.stress_traction(test["r1"], test["r2"])
     v = ngs.CF((test["u1"], test["u2"]))

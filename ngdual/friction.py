@@ -27,6 +27,7 @@ from . import peers
 from .contact import ContactBoundary
 from .expr import Expression
 from .forms import DiscreteProblem, boundary_regex
+from .geometry import tangent
 from .sparse import to_scipy
 from .tolerances import friction_vanishes
 
@@ -160,7 +161,7 @@ def _edge_functionals(problem: DiscreteProblem) -> tuple[sp.csr_matrix, sp.csr_m
     test = space.TestFunction()
     traction = peers.stress_traction(trial["r1"], trial["r2"])
     n = ngs.specialcf.normal(2)
-    t = ngs.CF((n[1], -n[0]))
+    t = tangent(n)
     ds = ngs.ds(definedon=fes.mesh.Boundaries(boundary_regex(problem.scene.labels("contact"))))
     n_edges = len(gamma_c)
     ends = sp.csr_matrix((np.ones(2 * n_edges), (np.repeat(np.arange(n_edges), 2),

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import ngsolve as ngs
 import numpy as np
 
 MAX_ARC_PIECE = np.pi / 4  # netgen gets an arc as rational quadratic splines of <= 45 degrees
@@ -29,6 +30,21 @@ MAX_ARC_PIECE = np.pi / 4  # netgen gets an arc as rational quadratic splines of
 # hertz-cylinder rotated by 30 degrees: gaps of -1.9e-15 on a domain of size 8); 1e-10 is
 # five decades above that and far below any length a scene means.
 ROUND_OFF = 1e-10
+
+
+def tangent(normal):
+    """t = (n_2, -n_1), the tangent of (3.24) to the outward unit normal n.
+
+    ``normal`` is one normal or an array of them (..., 2), or NGSolve's normal coefficient
+    function (``ngsolve.specialcf.normal(2)``), whose tangent is a coefficient function.
+    Along a counter-clockwise boundary t runs against the direction of travel.
+
+    >>> tangent(np.array([0.6, -0.8]))
+    array([-0.8, -0.6])
+    """
+    if isinstance(normal, np.ndarray):
+        return np.stack([normal[..., 1], -normal[..., 0]], axis=-1)
+    return ngs.CF((normal[1], -normal[0]))
 
 
 @dataclass(frozen=True)
@@ -76,8 +92,7 @@ class Side:
     def tangent(self, at_end: bool) -> np.ndarray:
         """Unit tangent in the direction of travel at the start or the end of the side."""
         _, normals = self.sample(2)
-        n = normals[-1 if at_end else 0]
-        return np.array([-n[1], n[0]])
+        return -tangent(normals[-1 if at_end else 0])
 
     def spline_pieces(self) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
         """(start, control point, end) of rational quadratic splines that are the arc exactly."""

@@ -17,6 +17,7 @@ import numpy as np
 from .checks import ForceBalance, contact_forces
 from .checks import in_contact as _in_contact
 from .friction import hat_projection
+from .geometry import tangent
 from .io import versions
 from .quantities import fields, norms, require_contact
 from .scene import SceneError, SceneTypeError
@@ -108,11 +109,12 @@ def contact_traces(solution: Solution) -> ContactTraces:
             e = np.searchsorted(nodes, k, side="right") - 1
             active.append(int(nodes[e]) in contact_pos or int(nodes[e + 1]) in contact_pos)
     # sigma n on every fine edge, evaluated just inside the body at the edge midpoint
-    for mid, normal, length in zip(gamma_c.midpoints, gamma_c.normals, gamma_c.lengths):
+    for mid, normal, along, length in zip(gamma_c.midpoints, gamma_c.normals, gamma_c.tangents,
+                                          gamma_c.lengths):
         st = np.array(sigma(mesh(*(mid - 1e-9 * length * normal)))).reshape(2, 2)
         traction = st @ normal
         s_n.append(normal @ traction)
-        s_t.append(np.array([normal[1], -normal[0]]) @ traction)
+        s_t.append(along @ traction)
     node_xy = np.vstack([chain.path_points for chain in contact.chains])
     coarse_xy = contact.node_points()
     s_n, s_t = np.array(s_n), np.array(s_t)
@@ -240,7 +242,7 @@ def _write_contact_vtu(solution: Solution, path: str) -> str:
     tr = contact_traces(solution)
     gamma_c = solution.problem.spaces.gamma_c
     n_node = gamma_c.vertex_normals()
-    t_node = np.column_stack([n_node[:, 1], -n_node[:, 0]])  # t = (n_2, -n_1), as in (3.24)
+    t_node = tangent(n_node)
     lam = tr.lam_n[:, None] * n_node + tr.lam_t[:, None] * t_node
     u = (tr.gap - tr.lam_n)[:, None] * n_node - tr.lam_t[:, None] * t_node
     traction = tr.sigma_n[:, None] * gamma_c.normals + tr.sigma_t[:, None] * gamma_c.tangents

@@ -216,12 +216,24 @@ def foundation_line(contact: Contact) -> tuple[np.ndarray, np.ndarray]:
     return np.asarray(f["point"], dtype=float), normal / np.linalg.norm(normal)
 
 
+def foundation_gap(contact: Contact, x, y, n_x, n_y):
+    """The gap g from the foundation line at (x, y) with outward normal n = (n_x, n_y): the
+    distance along n to the line through p with unit normal n_f (towards the body),
+
+        g = (x - p) . n_f / (-n . n_f),
+
+    for numpy arrays (:func:`gap_at`) and NGSolve coefficient functions alike
+    (:func:`ngdual.contact.gap_coefficient`, where n is NGSolve's normal).
+    """
+    point, n_f = foundation_line(contact)
+    return ((x - point[0]) * n_f[0] + (y - point[1]) * n_f[1]) / (-(n_x * n_f[0] + n_y * n_f[1]))
+
+
 def gap_at(contact: Contact, xy: np.ndarray, normals: np.ndarray) -> np.ndarray:
     """The gap g at points of Gamma_C with outward normals ``normals`` (see :class:`Contact`)."""
     if contact.foundation is None:
         return Expression(contact.gap_formula).numpy(xy[:, 0], xy[:, 1])
-    point, n_f = foundation_line(contact)
-    return ((xy - point) @ n_f) / (-(normals @ n_f))
+    return foundation_gap(contact, xy[:, 0], xy[:, 1], normals[:, 0], normals[:, 1])
 
 
 def _validate_foundation(scene: Scene) -> None:
@@ -300,7 +312,7 @@ def validate_contact(scene: Scene, u_d: list[Expression]) -> None:
     for p, u in zip(ends, values):
         k = int(np.argmin(np.linalg.norm(xy - p, axis=1)))
         g = float(gap_at(con, xy[k:k + 1], normals[k:k + 1])[0])
-        slide = abs(u @ np.array([normals[k, 1], -normals[k, 0]]))
+        slide = abs(u @ geometry.tangent(normals[k]))
         if scene.friction.law != "none" and slide > tolerance:
             # the friction functional q(nu, lambda_t) is posed on the lambda_t dofs only
             raise SceneError("loads.displacement", f"with friction the prescribed "

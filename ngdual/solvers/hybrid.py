@@ -41,6 +41,7 @@ import scipy.sparse as sp
 
 from .. import peers
 from ..forms import DiscreteProblem, boundary_regex, peers_form
+from ..geometry import tangent
 from ..sparse import to_scipy
 from .settings import Model
 
@@ -67,7 +68,7 @@ class ContactEdges:
     @property
     def tangents(self) -> np.ndarray:
         """t = (n_2, -n_1), the tangent of (3.24)."""
-        return np.column_stack([self.normals[:, 1], -self.normals[:, 0]])
+        return tangent(self.normals)
 
     def __len__(self) -> int:
         return len(self.edges)
@@ -267,6 +268,9 @@ class HybridSystem:
                          ).reshape(-1, 2)
         rt = edges[:, 1]
         flux = fluxes[0][rt]
+        # NGSolve's normal of the assembled forms, read from the RT_0 fluxes, rather than
+        # gamma_c.normals from the vertex coordinates: the two agree to round-off, and these
+        # are the normals with which F's moments below were integrated
         normals = np.column_stack([fluxes[1][rt], fluxes[2][rt]]) / flux[:, None]
         normals /= np.linalg.norm(normals, axis=1)[:, None]
         # the sigma rows of F hold int_e (g - lift_n) tau_n - int_e lift_t tau_t on e

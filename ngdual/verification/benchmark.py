@@ -19,7 +19,7 @@ import numpy as np
 from ..scene import Scene, foundation_line
 from ..solvers.result import Solution
 from .analytic import cattaneo_mindlin, flat_punch, hertz, wedge
-from .traction import traction_profile
+from .traction import plane_direction, traction_profile
 
 SAMPLES = 16  # points per fine edge of Gamma_C where the exact traction is evaluated
 
@@ -46,15 +46,6 @@ def exact_solution(scene: Scene, P: float, Q: float = 0.0):
     if bench.kind == "wedge":
         return wedge(P, bench.slope, mat.E, mat.nu)
     return None
-
-
-def plane_direction(scene: Scene) -> np.ndarray:
-    """The unit tangent of the foundation line (x_1 without a foundation line): the
-    direction of the analytic profile's coordinate and of a positive Q."""
-    if scene.contact.foundation is None:
-        return np.array([1.0, 0.0])
-    _, n_f = foundation_line(scene.contact)
-    return np.array([n_f[1], -n_f[0]])
 
 
 def center_coordinate(scene: Scene) -> float:

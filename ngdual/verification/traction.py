@@ -39,8 +39,9 @@ import numpy as np
 from scipy.optimize import brentq
 
 from ..friction import hat_projection
+from ..geometry import tangent
 from ..post import contact_traces, force_balance
-from ..scene import foundation_line
+from ..scene import Scene, foundation_line
 from ..solvers.result import Solution
 from .analytic import CattaneoMindlin
 
@@ -127,8 +128,8 @@ def _plane_coordinate(solution: Solution, points: np.ndarray) -> np.ndarray:
     contact = solution.problem.scene.contact
     if contact.foundation is None:
         return points[:, 0].copy()
-    point, n_f = foundation_line(contact)
-    return (points - point) @ np.array([n_f[1], -n_f[0]])
+    point, _ = foundation_line(contact)
+    return (points - point) @ plane_direction(solution.problem.scene)
 
 
 def traction_profile(solution: Solution) -> TractionProfile:
@@ -140,7 +141,7 @@ def traction_profile(solution: Solution) -> TractionProfile:
     hats = gamma_c.hat_means(pb.spaces.prolongations["lam_n"])          # dof hats
     end_hats = gamma_c.hat_means(pb.spaces.end_hats["lam_n"])           # fixed-end hats
     length = gamma_c.lengths
-    along = np.sign(gamma_c.tangents @ _plane_direction(solution))
+    along = np.sign(gamma_c.tangents @ plane_direction(solution.problem.scene))
     sigma_n = np.concatenate([hat_projection(h, length, traces.sigma_n)
                               for h in (hats, end_hats)])
     sigma_t = np.concatenate([hat_projection(h, length, along * traces.sigma_t)
@@ -167,13 +168,13 @@ def traction_profile(solution: Solution) -> TractionProfile:
                           contact[columns])
 
 
-def _plane_direction(solution: Solution) -> np.ndarray:
-    """The unit vector of increasing plane coordinate."""
-    contact = solution.problem.scene.contact
-    if contact.foundation is None:
+def plane_direction(scene: Scene) -> np.ndarray:
+    """The unit tangent of the foundation line (x_1 without a foundation line): the
+    direction of the analytic profile's coordinate and of a positive Q."""
+    if scene.contact.foundation is None:
         return np.array([1.0, 0.0])
-    _, n_f = foundation_line(contact)
-    return np.array([n_f[1], -n_f[0]])
+    _, n_f = foundation_line(scene.contact)
+    return tangent(n_f)
 
 
 # --- exact integration of P1 minus an exact profile ------------------------------------------

@@ -62,6 +62,7 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from ...expr import Expression
+from ...geometry import tangent
 from .result import ContactEdges, PrimalResult
 
 
@@ -179,7 +180,7 @@ def solve_primal(mesh: ngs.Mesh, *, E: float, nu: float, dirichlet, neumann=(), 
     fes = ngs.VectorH1(mesh, order=order, dirichlet="|".join(dirichlet))
     u, v = fes.TnT()
     n = ngs.specialcf.normal(2)
-    t = ngs.CF((n[1], -n[0]))
+    t = tangent(n)
     h = ngs.specialcf.mesh_size
     beta = gamma0 * E / h
     g = scalar_cf(gap)

@@ -7,6 +7,8 @@ from dataclasses import dataclass, field
 import ngsolve as ngs
 import numpy as np
 
+from ...geometry import tangent
+
 
 @dataclass
 class ContactEdges:
@@ -40,8 +42,7 @@ class ContactEdges:
         n = np.column_stack([d[:, 1], -d[:, 0]]) / length[:, None]
         flip = np.einsum("ij,ij->i", n, 0.5 * (p0 + p1) - cen) < 0
         n[flip] *= -1
-        t = np.column_stack([n[:, 1], -n[:, 0]])
-        return cls(p0, p1, length, n, t)
+        return cls(p0, p1, length, n, tangent(n))
 
     def locate(self, points: np.ndarray) -> np.ndarray:
         """The index of the nearest edge for each point (shape (N, 2))."""

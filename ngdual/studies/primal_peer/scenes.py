@@ -13,19 +13,17 @@ from .result import ContactEdges, PrimalResult
 
 def _scene_gap(contact, mesh: ngs.Mesh, labels: list[str]) -> ngs.CoefficientFunction:
     """The scene's gap as a CF (a formula, or the distance to the foundation line along the
-    outward normal of Gamma_C, as :func:`ngdual.scene.gap_at`). The CF is also evaluated
-    inside the body (the pressure at points), where no normal exists: a foundation line
-    needs a straight Gamma_C, whose normal is then a constant."""
-    from ...scene import foundation_line
+    outward normal of Gamma_C, :func:`ngdual.scene.domain.foundation_gap`). The CF is also
+    evaluated inside the body (the pressure at points), where no normal exists: a foundation
+    line needs a straight Gamma_C, whose normal is then a constant."""
+    from ...scene.domain import foundation_gap
 
     if contact.foundation is None:
         return scalar_cf(contact.gap_formula)
-    point, n_f = foundation_line(contact)
     normals = ContactEdges.of(mesh, labels).normal
     if np.ptp(normals, axis=0).max() > 1e-12:
         raise ValueError("a foundation line needs a straight Gamma_C for the peer")
-    return (((ngs.x - point[0]) * n_f[0] + (ngs.y - point[1]) * n_f[1])
-            / float(-(normals[0] @ n_f)))
+    return foundation_gap(contact, ngs.x, ngs.y, float(normals[0, 0]), float(normals[0, 1]))
 
 
 def solve_scene_primal(scene, level: int, order: int, **kw) -> tuple[PrimalResult, float]:
