@@ -221,18 +221,19 @@ class HybridSystem:
             rt = dirichlet[:, 1]
             c0[m1 + dirichlet[:, 0]] = -F1[rt] / fluxes[0][rt]
             c0[m2 + dirichlet[:, 0]] = -F2[rt] / fluxes[0][rt]
-        if len(neumann):
-            space = pb.spaces.components["phi1"]
-            dof = np.array([[space.GetDofNrs(ngs.NodeId(ngs.VERTEX, int(v)))[0] for v in e[2:]]
-                            for e in neumann])
+        if pb.spaces.neumann is not None:  # mu_e = the edge mean of the coarse P1 phi
+            coarse = pb.spaces.neumann
+            facet_of = {frozenset(int(v) for v in row[2:]): row[0] for row in neumann}
+            facets = np.array([facet_of[frozenset((int(a), int(b)))]
+                               for a, b in coarse.fine_edges()[0]])
+            dof = coarse.fine_edge_dofs(pb.spaces.components["phi1"])
             P = pb.spaces.prolongations["phi1"].tocsr()
             mean = (0.5 * (P[dof[:, 0]] + P[dof[:, 1]])).tocoo()
-            lift_range = pb.fes.Range(pb.names.index("phi1"))
-            lift2_range = pb.fes.Range(pb.names.index("phi2"))
-            for comp, start, lr in ((0, m1, lift_range), (1, m2, lift2_range)):
-                put(start + neumann[mean.row, 0], blocks[3 + comp] + mean.col, mean.data)
-                lift = pb.lift[lr.start:lr.stop]
-                c0[start + neumann[:, 0]] = 0.5 * (lift[dof[:, 0]] + lift[dof[:, 1]])
+            for comp, start in ((0, m1), (1, m2)):
+                put(start + facets[mean.row], blocks[3 + comp] + mean.col, mean.data)
+                lift_range = pb.fes.Range(pb.names.index(("phi1", "phi2")[comp]))
+                lift = pb.lift[lift_range.start:lift_range.stop]
+                c0[start + facets] = 0.5 * (lift[dof[:, 0]] + lift[dof[:, 1]])
         ce = self.contact
         j = np.arange(n_c)
         for comp, start in ((0, m1), (1, m2)):
