@@ -15,8 +15,9 @@ or the active-set method), :class:`Solution`. Adaptivity (Chapter 4): :func:`est
 (the indicators of eq. 4.50), :func:`mark`, :func:`adapt` (SOLVE, ESTIMATE, MARK,
 REFINE). Post-processing: :func:`fields`, :func:`norms`, :func:`contact_traces`,
 :func:`force_balance`, :func:`result_record`. Plotting (each returns a matplotlib figure):
-:func:`plot_contact_traces`, :func:`plot_element_field`, :func:`plot_mesh`; saving one is
-the caller's choice, :func:`save_figure`.
+:func:`plot_geometry` (the domain, its boundary parts and the mesh), :func:`plot_contact_traces`,
+:func:`plot_element_field`, :func:`plot_von_mises`, :func:`plot_mesh`; saving one is the
+caller's choice, :func:`save_figure`.
 
 The names are loaded lazily (PEP 562): ``import ngdual`` imports neither NGSolve nor
 matplotlib, so that the command line starts fast; the first use of a name imports its
@@ -48,7 +49,9 @@ _PUBLIC = {
     "result_record": ("ngdual.post", "result_record"),
     "plot_contact_traces": ("ngdual.plot", "plot_contact_traces"),
     "plot_element_field": ("ngdual.plot", "plot_element_field"),
+    "plot_geometry": ("ngdual.plot", "plot_geometry"),
     "plot_mesh": ("ngdual.plot", "plot_mesh"),
+    "plot_von_mises": ("ngdual.plot", "plot_von_mises"),
     "save_figure": ("ngdual.plot", "save_figure"),
 }
 

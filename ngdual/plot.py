@@ -1,4 +1,6 @@
-"""Matplotlib figures (no computation here: inputs are arrays from :mod:`ngdual.post`).
+"""Matplotlib figures (no computation here: inputs are arrays from :mod:`ngdual.post`, or a
+scene with its mesh for the two pictures every lecture starts from, :func:`plot_geometry`
+and :func:`plot_von_mises`).
 
 Every ``plot_*`` function returns a :class:`matplotlib.figure.Figure`; saving it is the
 caller's choice, :func:`save_figure`. Importing this module leaves matplotlib's backend
@@ -366,6 +368,66 @@ def plot_mesh(points: np.ndarray, triangles: np.ndarray, title: str = "",
     ax.legend(handles=[*ax.get_legend_handles_labels()[0][:1], *handles], loc="upper center",
               bbox_to_anchor=(0.5, -0.25 if aspect < 0.5 else -0.12), ncol=2, fontsize=8)
     return fig
+
+
+BOUNDARY_ROLES = {"dirichlet": (r"$\Gamma_D$", "tab:blue"), "neumann": (r"$\Gamma_N$", "tab:green"),
+                  "contact": (r"$\Gamma_C$", "tab:red")}
+
+
+def plot_geometry(scene, mesh=None, level: int | None = None, title: str = "") -> Figure:
+    """The domain of ``scene`` with its boundary parts Γ_D, Γ_N, Γ_C in colour, every side
+    named, and the mesh (``mesh``, or the one of ``level``, default the scene's level).
+
+    >>> import ngdual as nd
+    >>> fig = nd.plot_geometry(nd.load_scene("thesis-3.46-coulomb"), level=1)  # doctest: +SKIP
+    """
+    import ngsolve as ngs
+    from matplotlib.collections import LineCollection
+
+    from .mesh import build_mesh, mesh_arrays
+
+    mesh = build_mesh(scene.geometry, level) if mesh is None else mesh
+    points, triangles = mesh_arrays(mesh)
+    edges: dict = {}
+    for element in mesh.Elements(ngs.BND):
+        edges.setdefault(element.mat, []).append([v.nr for v in element.vertices])
+    width, height = np.ptp(points, axis=0)
+    fig, ax = plt.subplots(figsize=(9, max(3.2, 7 * height / width + 1.6)))
+    ax.triplot(points[:, 0], points[:, 1], triangles, color="0.6", lw=0.4)
+    centre = points.mean(axis=0)
+    for role, (symbol, colour) in BOUNDARY_ROLES.items():
+        sides = {label: points[np.array(edges[label])] for label in scene.labels(role)
+                 if label in edges}
+        if not sides:
+            continue
+        ax.add_collection(LineCollection(np.concatenate(list(sides.values())), colors=colour,
+                                         lw=3.5, label=f"{symbol}: {', '.join(sides)}"))
+        for label, side in sides.items():
+            middle = side.mean(axis=(0, 1))
+            inward = 22 * (centre - middle) / (np.linalg.norm(centre - middle) or 1.0)
+            ax.annotate(f"{symbol} ({label})", middle, xytext=tuple(inward),
+                        textcoords="offset points", color=colour, ha="center", va="center",
+                        fontsize=9, bbox={"fc": "white", "ec": "none", "alpha": 0.85, "pad": 1})
+    _coordinates(ax, scene.units)
+    ax.margins(0.1)
+    ax.set_title(title or f"{scene.name}: boundary parts and mesh ({mesh.ne} triangles)")
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=3, fontsize=9,
+              frameon=False)
+    fig.tight_layout()
+    return fig
+
+
+def plot_von_mises(mesh, sigma, nu: float, title: str, clip: float | None = CORNER_CLIP,
+                   vmax: float | None = None, units=None) -> Figure:
+    """The plane-strain von Mises stress of ``sigma`` (:func:`ngdual.post.von_mises`) per
+    element, on a colour scale ending at the ``clip`` percentile (corner singularities)
+    or at ``vmax`` (one scale for several pictures): :func:`plot_element_field`."""
+    from .post import element_values, von_mises
+
+    points, triangles, values = element_values(mesh, von_mises(sigma, nu))
+    return plot_element_field(points, triangles, values, title,
+                              unit_label("von Mises stress", _stress(units)), clip=clip,
+                              units=units, vmax=vmax)
 
 
 # --- saving, and the JSON sidecar of ngdual figures ----------------------------------------------

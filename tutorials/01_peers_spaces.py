@@ -62,19 +62,13 @@ import ngdual as nd
 from ngdual import peers
 from ngdual.forms import assemble
 from ngdual.mesh import build_mesh
-from ngdual.studies.tutorials import (
-    output_dir,
-    plot_geometry,
-    quick_mode,
-    save_figure,
-    save_results,
-)
+from ngdual.sparse import to_scipy
+from ngdual.studies.tutorials import Lesson
 
-QUICK = quick_mode()
+lesson = Lesson("01_peers_spaces")                       # figures and results.json go here
+QUICK = lesson.quick
 DOF_LEVELS = [1, 2, 3] if QUICK else [1, 2, 3, 4, 5]     # Table 3.1 rows to reproduce
 INF_SUP_LEVELS = [1, 2] if QUICK else [1, 2, 3, 4]       # meshes for the eigenvalue problem
-OUT = output_dir("01_peers_spaces")
-print(f"quick mode: {QUICK}; figures and results.json go to {OUT}")
 
 # %% [markdown]
 # ## The domain and the mesh
@@ -85,9 +79,7 @@ print(f"quick mode: {QUICK}; figures and results.json go to {OUT}")
 
 # %%
 thesis = nd.load_scene("thesis-3.46-frictionless")
-save_figure(plot_geometry(thesis, level=1,
-                          title="Example 3.46, level 1: boundary parts and mesh"),
-            OUT / "geometry.png")
+lesson.save(nd.plot_geometry(thesis, level=1), "geometry")
 
 # %% [markdown]
 # ## 1. The PEERS spaces and their degrees of freedom
@@ -148,15 +140,8 @@ for level in DOF_LEVELS:
 clamped = nd.load_scene("thesis-3.46-frictionless",
                         ["boundary.dirichlet=['left', 'right', 'bottom', 'top']",
                          "boundary.neumann=[]", "boundary.contact=[]"])
-save_figure(plot_geometry(clamped, level=1, title="Example 3.46 clamped on all sides"),
-            OUT / "geometry_clamped.png")
-
-
-def to_scipy(matrix) -> sp.csr_matrix:
-    """An assembled NGSolve matrix as a SciPy CSR matrix."""
-    rows, cols, vals = matrix.COO()
-    return sp.csr_matrix((np.asarray(vals), (np.asarray(rows), np.asarray(cols))),
-                         shape=(matrix.height, matrix.width))
+lesson.save(nd.plot_geometry(clamped, level=1, title="Example 3.46 clamped on all sides"),
+            "geometry_clamped")
 
 
 def gram_matrix(problem) -> sp.csr_matrix:
@@ -223,7 +208,7 @@ ax.set_ylabel(r"smallest singular value $\beta_h$")
 ax.set_title("Discrete inf-sup constant (Lemma 3.28)")
 ax.grid(True, which="both", alpha=0.3)
 ax.legend()
-save_figure(fig, OUT / "inf_sup.png")
+lesson.save(fig, "inf_sup")
 
 # %% [markdown]
 # Why the bubbles are divergence free: a bubble $b_T$ vanishes on $\partial T$, so
@@ -232,8 +217,7 @@ save_figure(fig, OUT / "inf_sup.png")
 # only enrich the antisymmetric part of $\tau$, which $s(\xi, \tau)$ tests.
 
 # %%
-results = {"quick": QUICK, "dofs": dof_rows, "inf_sup": inf_sup_rows}
-print(f"wrote {save_results('01_peers_spaces', results)}")
+lesson.results({"dofs": dof_rows, "inf_sup": inf_sup_rows})
 
 # %% [markdown]
 # ## Exercises

@@ -39,23 +39,14 @@ import numpy as np
 import ngdual as nd
 from ngdual.expr import Expression
 from ngdual.scene import Geometry, Loads, Material
-from ngdual.studies.tutorials import (
-    draw,
-    output_dir,
-    plot_geometry,
-    plot_von_mises,
-    quick_mode,
-    save_figure,
-    save_results,
-)
+from ngdual.studies.tutorials import Lesson
 
-QUICK = quick_mode()
+lesson = Lesson("02_locking")                            # figures and results.json go here
+QUICK = lesson.quick
 LOCKING_LEVELS = [1, 2] if QUICK else [1, 2, 3, 4]       # refinements of the square mesh
 NUS = [0.3, 0.45, 0.49, 0.499, 0.4999]                   # Poisson ratios of the sweep
 SHEAR_MODULUS = 1.0                                      # μ is kept fixed while ν -> 1/2
 MAXH = 0.25                                              # netgen mesh size of level 1
-OUT = output_dir("02_locking")
-print(f"quick mode: {QUICK}; figures and results.json go to {OUT}")
 
 # %% [markdown]
 # ## 1. The manufactured solution
@@ -127,9 +118,9 @@ def square_scene(nu: float) -> nd.Scene:
     return scene
 
 
-save_figure(plot_geometry(square_scene(NUS[0]), level=LOCKING_LEVELS[-1],
-                          title=f"Unit square, clamped, level {LOCKING_LEVELS[-1]}"),
-            OUT / "geometry.png")
+lesson.save(nd.plot_geometry(square_scene(NUS[0]), level=LOCKING_LEVELS[-1],
+                             title=f"Unit square, clamped, level {LOCKING_LEVELS[-1]}"),
+            "geometry")
 
 
 def relative_l2(error, exact, mesh) -> float:
@@ -199,7 +190,7 @@ ax.set_ylabel("relative $L^2$ error")
 ax.set_title(f"Locking on the unit square, level {LOCKING_LEVELS[-1]}")
 ax.grid(True, which="both", alpha=0.3)
 ax.legend()
-save_figure(fig, OUT / "locking.png")
+lesson.save(fig, "locking")
 
 # %% [markdown]
 # ## 3. Under refinement
@@ -231,9 +222,9 @@ p1_u, p1_sigma = solve_p1(mesh, square_scene(nu_max).material)
 peers_sigma = nd.fields(incompressible).sigma
 top = float(np.max(nd.post.element_values(mesh, nd.post.von_mises(sigma_exact, nu_max))[2]))
 for name, field in (("exact", sigma_exact), ("PEERS", peers_sigma), ("P1", p1_sigma)):
-    save_figure(plot_von_mises(mesh, field, nu_max, f"{name}: von Mises stress, ν = {nu_max}, "
-                               f"level {level_max}", vmax=top),
-                OUT / f"von_mises_{name.lower()}.png")
+    lesson.save(nd.plot_von_mises(mesh, field, nu_max, f"{name}: von Mises stress, "
+                                  f"ν = {nu_max}, level {level_max}", vmax=top),
+                f"von_mises_{name.lower()}")
 
 # %% [markdown]
 # Where the large $P_1$ stress *error* of Section 2 sits: in the mean stress
@@ -259,7 +250,7 @@ for ax, (name, values) in zip(axes, mean_stress.items()):
 fig.colorbar(art, ax=axes, label="mean stress $p_h = (\\sigma_{11} + \\sigma_{22})/2$ "
              "(exact: 0)")
 fig.suptitle(f"Mean stress at ν = {nu_max}, level {level_max}, one colour scale")
-save_figure(fig, OUT / "mean_stress.png")
+lesson.save(fig, "mean_stress")
 mean_stress_max = {name: float(np.max(np.abs(v))) for name, v in mean_stress.items()}
 
 # %% [markdown]
@@ -267,12 +258,11 @@ mean_stress_max = {name: float(np.max(np.abs(v))) for name, v in mean_stress.ite
 # script this cell draws nothing.
 
 # %%
-draw(nd.post.von_mises(peers_sigma, nu_max), mesh, "von_mises")
+lesson.draw(nd.post.von_mises(peers_sigma, nu_max), mesh, "von_mises")
 
 # %%
-results = {"quick": QUICK, "locking_sweep": sweep, "convergence": convergence, "ratios": ratios,
-           "mean_stress_max": mean_stress_max}
-print(f"wrote {save_results('02_locking', results)}")
+lesson.results({"locking_sweep": sweep, "convergence": convergence, "ratios": ratios,
+                "mean_stress_max": mean_stress_max})
 
 # %% [markdown]
 # ## Exercises

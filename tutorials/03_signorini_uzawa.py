@@ -25,14 +25,11 @@
 # $\tilde h = 2h$ (eq. (3.61)).
 #
 # **What you will learn.**
-# 1. Algorithm 3.38 (Uzawa): one linear saddle-point solve with a fixed matrix per step,
-#    then a projection of $\lambda_n$ onto the cone $\lambda_n \ge 0$.
-# 2. The projection $P^+$ as a small convex quadratic program posed in cvxpy, and why its
-#    metric $W$ matters (Remark 3.40): $P^+$ is *not* componentwise clipping.
-# 3. How the step length $\rho$ and the metric (`"h12"` vs `"euclidean"`) change the
-#    number of iterations, on one mesh and under refinement, and what a too large $\rho$
-#    does.
-# 4. How to check the result against an independent solver (one convex QP, `solve_qp`).
+# Algorithm 3.38 (Uzawa): one linear saddle-point solve with a fixed matrix per step, then
+# a projection $P^+$ of $\lambda_n$ onto the cone $\lambda_n \ge 0$ in a metric $W$: why
+# $P^+$ is a small QP and not componentwise clipping (Remark 3.40), how the step length
+# $\rho$ and the metric set the number of iterations, and that the result is the one
+# convex QP of the whole problem.
 #
 # **References.** M. Andres, *Dual-dual formulations for frictional contact problems in
 # mechanics*, PhD thesis, Leibniz Universität Hannover, 2011: Section 3.3, eqs.
@@ -60,17 +57,10 @@ from ngdual.solvers.projections import NonnegativeProjection, metric_matrix
 from ngdual.solvers.reference import solve_qp
 from ngdual.solvers.settings import Model, UzawaSettings
 from ngdual.solvers.uzawa import uzawa
-from ngdual.studies.tutorials import (
-    draw,
-    output_dir,
-    plot_geometry,
-    plot_von_mises,
-    quick_mode,
-    save_figure,
-    save_results,
-)
+from ngdual.studies.tutorials import Lesson
 
-QUICK = quick_mode()
+lesson = Lesson("03_signorini_uzawa")                    # figures and results.json go here
+QUICK = lesson.quick
 LEVEL = 2 if QUICK else 4                                # mesh level of Example 3.46
 RHOS = [0.25, 0.5, 1.0, 1.5]                             # step lengths of Algorithm 3.38
 TOO_LARGE_RHO = 3.0                                      # beyond the convergence range
@@ -80,14 +70,25 @@ METRICS = ["h12", "euclidean"]
 REFINEMENT_LEVELS = [1, 2, 3] if QUICK else [1, 2, 3, 4, 5]
 EPS = 1e-8                                               # stopping tolerance (step 5)
 EPS_COMPARE = 1e-10                                      # tighter, for the comparison with the QP
-OUT = output_dir("03_signorini_uzawa")
-print(f"quick mode: {QUICK}; level {LEVEL}; output in {OUT}")
+
+# %% [markdown]
+# ## The scene and the answer
+#
+# $\Gamma_D$ the clamped ends, $\Gamma_N$ the top with the parabolic traction, $\Gamma_C$
+# the bottom above the foundation. `nd.solve` gives the answer this tutorial takes apart:
+# $p_h = -\sigma_n \ge 0$ where the gap $\lambda_n$ has closed, zero where it is open.
+# (`ends = "thesis"` forces $u_n = g$ at the clamped corners, so the solve warns there:
+# the thesis' setting, kept to reproduce its tables.)
+
+# %%
+scene = nd.load_scene("thesis-3.46-frictionless")
+lesson.save(nd.plot_geometry(scene, level=LEVEL), "geometry")
+lesson.save(nd.plot_contact_traces(nd.contact_traces(nd.solve(scene, LEVEL)),
+                                   f"Example 3.46 without friction, level {LEVEL}"),
+            "contact_traces")
 
 # %% [markdown]
 # ## 1. The algebraic problem
-#
-# The block $[-4,4]\times[-1,1]$: $\Gamma_D$ the clamped ends, $\Gamma_N$ the top with the
-# parabolic traction, $\Gamma_C$ the bottom above the foundation.
 #
 # `assemble` builds the matrix of (3.103) once. The unknown vector is ordered
 # $[\sigma \mid u, \eta, \varphi, \lambda_t \mid \lambda_n]$; `problem.sigma`,
@@ -95,16 +96,11 @@ print(f"quick mode: {QUICK}; level {LEVEL}; output in {OUT}")
 # `problem.block(rows, cols)` cuts out $A$, $B$ and $C_n$.
 
 # %%
-scene = nd.load_scene("thesis-3.46-frictionless")
-save_figure(plot_geometry(scene, level=LEVEL,
-                          title=f"Example 3.46: boundary parts and mesh, level {LEVEL}"),
-            OUT / "geometry.png")
 problem = assemble(scene, build_mesh(scene.geometry, LEVEL))
 A = problem.block(problem.sigma, problem.sigma)
 B = problem.block(problem.sigma, problem.mult)
 C_n = problem.block(problem.sigma, problem.lam_n)
-print(f"dofs per space (Table 3.1): {problem.spaces.dofs()}")
-print(f"A: {A.shape}, B: {B.shape}, C_n: {C_n.shape}")
+print(f"dofs (Table 3.1): {problem.spaces.dofs()}; A {A.shape}, B {B.shape}, C_n {C_n.shape}")
 
 # %% [markdown]
 # ## 2. One Uzawa step by hand, and the projection $P^+$ as a QP
@@ -189,14 +185,10 @@ for metric in METRICS:
 # For small $\rho$ the contraction factor is about $1 - c\rho$, so halving $\rho$ doubles
 # the number of iterations.
 #
-# Too large a step and the iteration no longer contracts. A short run is enough to see
-# it: with $\rho = 3$ the increments stop decreasing after a few steps and the iteration
-# oscillates (or diverges, in which case `uzawa` raises `ConvergenceError`). Theorem 3.39
-# explains why: $\lambda \mapsto P^+(\lambda + \rho\,\Phi(\sigma(\lambda)))$ is a
-# contraction only for $\rho$ below a bound set by the ellipticity of $\tilde a$ (in
-# ngdual's scaling about 2; where exactly depends on the mesh: on level 4, $\rho = 2$
-# already stalls). ngdual reports this through `converged`; it never passes an
-# unconverged iterate off as a solution.
+# Too large a step and the iteration no longer contracts: with $\rho = 3$ the increments
+# stop decreasing (Theorem 3.39: a contraction only for $\rho$ below a bound set by the
+# ellipticity of $\tilde a$, about 2 in ngdual's scaling). `converged` says so; ngdual
+# never passes an unconverged iterate off as a solution.
 
 # %%
 overshoot = uzawa(problem, UzawaSettings.from_scene(scene, rho=TOO_LARGE_RHO, eps=EPS, metric="h12",
@@ -216,16 +208,15 @@ axes[0].semilogy(range(1, len(overshoot.history) + 1), overshoot.history, "r--",
                  label=f"ρ = {TOO_LARGE_RHO} ({SHORT_RUN} steps)")
 axes[0].set_ylabel("relative increment (step 5)")
 axes[0].legend()
-save_figure(fig, OUT / "uzawa_histories.png")
+lesson.save(fig, "uzawa_histories")
 
 # %% [markdown]
 # ## 4. Iterations under refinement (Remark 3.40)
 #
-# The convergence proof works in the $H^{1/2}(\Gamma_C)$ inner product and carries over to
-# any metric $W$ whose norm is *equivalent* to it; if the equivalence constants do not
-# depend on $h$, neither does the contraction factor. The `"h12"` metric (a discrete
-# $H^{1/2}_{00}$ interpolation norm) is such a metric. The Euclidean one is not: its
-# equivalence constants degrade like $1/h$, and the iteration count grows accordingly.
+# The proof works in $H^{1/2}(\Gamma_C)$ and carries over to any metric $W$ *equivalent*
+# to it with constants independent of $h$, such as `"h12"` (a discrete $H^{1/2}_{00}$
+# norm): then the iteration count does not grow. The Euclidean metric's constants degrade
+# like $1/h$, and so does the count.
 
 # %%
 by_level = {metric: [] for metric in METRICS}
@@ -241,12 +232,11 @@ for level in REFINEMENT_LEVELS:
 fig, ax = plt.subplots(figsize=(6, 4))
 for metric in METRICS:
     ax.plot(REFINEMENT_LEVELS, by_level[metric], "o-", label=f"metric {metric!r}")
-ax.set_xlabel("level (h halves per level)")
-ax.set_ylabel("Uzawa iterations, ρ = 1")
-ax.set_xticks(REFINEMENT_LEVELS)
+ax.set(xlabel="level (h halves per level)", ylabel="Uzawa iterations, ρ = 1",
+       xticks=REFINEMENT_LEVELS)
 ax.grid(True, alpha=0.3)
 ax.legend()
-save_figure(fig, OUT / "iterations_per_level.png")
+lesson.save(fig, "iterations_per_level")
 
 # %% [markdown]
 # ## 5. An independent check: the whole problem as one QP
@@ -266,47 +256,20 @@ tight = uzawa(problem, UzawaSettings.from_scene(scene, rho=1.0, eps=EPS_COMPARE,
 reference = solve_qp(problem, Model.of(scene))
 
 
-def relative_difference(a, b):
+def relative(a, b):
     return float(np.linalg.norm(a - b) / np.linalg.norm(b))
 
 
-agreement = {
-    "sigma": relative_difference(tight.part(*peers.STRESS), reference.part(*peers.STRESS)),
-    "lam_n": relative_difference(tight.part("lam_n"), reference.part("lam_n")),
-    "nodes_in_contact": [nd.result_record(s)["contact"]["nodes_in_contact"]
-                         for s in (tight, reference)],
-}
+agreement = {"sigma": relative(tight.part(*peers.STRESS), reference.part(*peers.STRESS)),
+             "lam_n": relative(tight.part("lam_n"), reference.part("lam_n")),
+             "nodes_in_contact": [nd.result_record(s)["contact"]["nodes_in_contact"]
+                                  for s in (tight, reference)]}
 print(f"Uzawa vs QP: sigma {agreement['sigma']:.1e}, lambda_n {agreement['lam_n']:.1e}, "
       f"nodes in contact {agreement['nodes_in_contact']}")
-print("contact residuals of the Uzawa solution:",
-      {k: f"{v:.1e}" for k, v in tight.residuals.items()})
-
-# %% [markdown]
-# The traces on $\Gamma_C$: $\sigma_n \le 0$ everywhere, and $\lambda_n - g = -u_n$
-# reaches $-g$ (gap closed, $\lambda_n = 0$) exactly where $\sigma_n < 0$.
 
 # %%
-save_figure(nd.plot_contact_traces(nd.contact_traces(tight),
-                                    f"Example 3.46 without friction: traces on Γ_C, level {LEVEL}"),
-            OUT / "contact_traces.png")
-
-# %% [markdown]
-# The stress in the body: the von Mises stress of the Uzawa solution. The corners where
-# the clamped ends meet $\Gamma_C$ are singular (Tutorial 6), so the colour scale is
-# clipped at the 97th percentile of the element values (stated on the colour bar). In a
-# notebook, NGSolve's webgui adds an interactive view.
-
-# %%
-mesh = problem.fes.mesh
-sigma_h = nd.fields(tight).sigma
-save_figure(plot_von_mises(mesh, sigma_h, scene.material.nu,
-                           f"Example 3.46 without friction: von Mises stress, level {LEVEL}"),
-            OUT / "von_mises.png")
-draw(nd.post.von_mises(sigma_h, scene.material.nu), mesh, "von_mises")
-
-# %%
-results = {
-    "quick": QUICK, "level": LEVEL,
+lesson.results({
+    "level": LEVEL,
     "projection": projection_check,
     "iterations": {metric: {str(rho): runs[(metric, rho)].iterations["outer"] for rho in RHOS}
                    for metric in METRICS},
@@ -316,8 +279,7 @@ results = {
     "iterations_per_level": {"levels": REFINEMENT_LEVELS, **by_level},
     "agreement": agreement,
     "residuals": tight.residuals,
-}
-print(f"wrote {save_results('03_signorini_uzawa', results)}")
+})
 
 # %% [markdown]
 # ## Exercises

@@ -45,18 +45,11 @@ from ngdual.solvers.nested import nested_uzawa
 from ngdual.solvers.projections import metric_matrix
 from ngdual.solvers.result import ConvergenceError
 from ngdual.solvers.settings import NestedUzawaSettings
-from ngdual.studies.tutorials import (
-    output_dir,
-    plot_geometry,
-    quick_mode,
-    save_figure,
-    save_results,
-)
+from ngdual.studies.tutorials import Lesson
 
-QUICK = quick_mode()
+lesson = Lesson("05_friction_inf_sup")              # figures and results.json go here
+QUICK = lesson.quick
 GAP0_LEVELS = [1, 2, 3] if QUICK else [1, 2, 3, 4]  # levels of the g = 0 study
-OUT = output_dir("05_friction_inf_sup")
-print(f"quick mode: {QUICK}; levels {GAP0_LEVELS}; output in {OUT}")
 
 # %% [markdown]
 # ## The scene
@@ -67,10 +60,9 @@ print(f"quick mode: {QUICK}; levels {GAP0_LEVELS}; output in {OUT}")
 # %%
 gap0 = {factor: nd.load_scene("thesis-3.46-coulomb-gap0", [f"contact.hhat_factor={factor}"])
         for factor in (1, 2)}
-save_figure(plot_geometry(gap0[2], level=GAP0_LEVELS[0],
-                          title=f"Example 3.46, g = 0: boundary parts and mesh, "
-                                f"level {GAP0_LEVELS[0]}"),
-            OUT / "geometry.png")
+lesson.save(nd.plot_geometry(gap0[2], level=GAP0_LEVELS[0],
+                             title=f"Example 3.46, g = 0: boundary parts, level {GAP0_LEVELS[0]}"),
+            "geometry")
 
 # %% [markdown]
 # ## 1. Counting: why $\hat h = 2\tilde h$
@@ -146,7 +138,7 @@ ax.set_ylim(-1.4, 1.4)
 ax.set_title(r"$\hat h = \tilde h$, $\mathcal{F} \equiv 1$: the checkerboard $\nu$ no hat can see")
 ax.legend(fontsize=8, loc="lower right")
 ax.grid(alpha=0.3)
-save_figure(fig, OUT / "checkerboard.png")
+lesson.save(fig, "checkerboard")
 
 # %% [markdown]
 # $\beta$ stays the same on every level for $\hat h = 2\tilde h$ (in the mesh-dependent
@@ -204,19 +196,17 @@ ax.set_xticks(GAP0_LEVELS)
 ax.set_title("Coulomb, g = 0: nested Uzawa")
 ax.grid(True, which="both", alpha=0.3)
 ax.legend()
-save_figure(fig, OUT / "gap0_iterations.png")
+lesson.save(fig, "gap0_iterations")
 
 # %%
-results = {
-    "quick": QUICK,
+lesson.results({
     "inf_sup": [{"level": r["level"], "hhat_h": {k: r[1][k] for k in ("N_A", "N_C", "beta")},
                  "hhat_2h": {k: r[2][k] for k in ("N_A", "N_C", "beta")},
                  "kernel_hhat_h": r[1]["kernel"]} for r in inf_sup_rows],
     "inf_sup_inner": {k: inner[k] for k in ("N_A", "N_C", "beta")},
     "gap0": {"hhat_h": gap0_runs[1], "hhat_2h": gap0_runs[2]},
     "failure_messages": failure_messages,
-}
-print(f"wrote {save_results('05_friction_inf_sup', results)}")
+})
 
 # %% [markdown]
 # ## Exercises

@@ -29,25 +29,15 @@
 # %%
 import json
 
-import numpy as np
-
 import ngdual as nd
 from ngdual.cli import main as ngdual_cli
 from ngdual.mesh import mesh_size
-from ngdual.studies.tutorials import (
-    draw,
-    output_dir,
-    plot_geometry,
-    plot_von_mises,
-    quick_mode,
-    save_figure,
-    save_results,
-)
+from ngdual.studies.tutorials import Lesson
 
-QUICK = quick_mode()
+lesson = Lesson("08_your_own_scene")           # figures, scene files, results.json go here
+QUICK = lesson.quick
 LEVELS = [1, 2] if QUICK else [1, 2, 3, 4]
-OUT = output_dir("08_your_own_scene")
-print(f"quick mode: {QUICK}; levels {LEVELS}; output in {OUT}")
+OUT = lesson.out
 
 # %% [markdown]
 # ## 1. Writing the scene
@@ -93,7 +83,7 @@ metric = "h12"
 scene_file = OUT / "stamp.toml"
 scene_file.write_text(SCENE)
 scene = nd.load_scene(scene_file)
-save_figure(plot_geometry(scene, level=LEVELS[0]), OUT / "geometry.png")
+lesson.save(nd.plot_geometry(scene, level=LEVELS[0]), "geometry")
 print(f"loaded {scene.name!r}: {len(scene.geometry.points)} corners, "
       f"contact on {scene.labels('contact')}, friction law {scene.friction.law!r}")
 
@@ -166,20 +156,20 @@ for row in levels:
           f"{row['iterations']:4d} {row['nodes_in_contact']:10d} {row['sigma_X']:10.4e}")
 
 # %% [markdown]
-# Pictures of the finest level: the von Mises stress (matplotlib, saved as PNG, the
-# colour scale clipped at the 97th percentile because of the corners, see below; in a
-# notebook also NGSolve's interactive webgui) and the traces on $\Gamma_C$.
+# Pictures of the finest level: the von Mises stress (the colour scale clipped at a
+# percentile stated on the colour bar, because of the corners, see below; in a notebook
+# also NGSolve's interactive webgui) and the traces on $\Gamma_C$.
 
 # %%
 mesh = solution.problem.fes.mesh
 sigma_h = nd.fields(solution).sigma
-save_figure(plot_von_mises(mesh, sigma_h, scene.material.nu,
-                           f"von Mises stress, {scene.name}, level {LEVELS[-1]}"),
-            OUT / "von_mises.png")
-save_figure(nd.plot_contact_traces(nd.contact_traces(solution),
-                                    f"Traces on Γ_C, {scene.name}, level {LEVELS[-1]}"),
-            OUT / "contact_traces.png")
-draw(nd.post.von_mises(sigma_h, scene.material.nu), mesh, "von_mises")
+lesson.save(nd.plot_von_mises(mesh, sigma_h, scene.material.nu,
+                              f"von Mises stress, {scene.name}, level {LEVELS[-1]}"),
+            "von_mises")
+lesson.save(nd.plot_contact_traces(nd.contact_traces(solution),
+                                   f"Traces on Γ_C, {scene.name}, level {LEVELS[-1]}"),
+            "contact_traces")
+lesson.draw(nd.post.von_mises(sigma_h, scene.material.nu), mesh, "von_mises")
 
 # %% [markdown]
 # Two things stand out, and both are mathematics rather than bugs:
@@ -204,15 +194,12 @@ print(f"exit status {status}; result.json: converged {cli_record['converged']}, 
       f"nodes in contact {cli_record['contact']['nodes_in_contact']}")
 
 # %%
-results = {"quick": QUICK, "caught": caught,
-           "expected_fields": ["boundary.contact", "boundary", "contact.ends", "material.nu",
-                               "contact.gap", "material.youngs_modulus", "geometry.points"],
-           "cli_bad_input_status": bad_status,
-           "cli_bad_input_wrote": (OUT / "never-written").exists(),
-           "cli_status": status, "levels": levels,
-           "sigma_X_change": float(np.abs(np.diff([row["sigma_X"] for row in levels])).max()
-                                   / levels[-1]["sigma_X"]) if len(levels) > 1 else None}
-print(f"wrote {save_results('08_your_own_scene', results)}")
+lesson.results({"caught": caught,
+                "expected_fields": ["boundary.contact", "boundary", "contact.ends", "material.nu",
+                                    "contact.gap", "material.youngs_modulus", "geometry.points"],
+                "cli_bad_input_status": bad_status,
+                "cli_bad_input_wrote": (OUT / "never-written").exists(),
+                "cli_status": status, "levels": levels})
 
 # %% [markdown]
 # ## Exercises

@@ -14,11 +14,12 @@ import ngdual as nd
 from ngdual import peers
 from ngdual.forms import Spaces, assemble
 from ngdual.mesh import build_mesh
-from ngdual.studies.tutorials import output_dir, quick_mode, save_figure, save_results
+from ngdual.sparse import to_scipy
+from ngdual.studies.tutorials import Lesson
 
-QUICK = quick_mode()
+lesson = Lesson("01_peers_spaces_solutions")
+QUICK = lesson.quick
 LEVELS = [1, 2] if QUICK else [1, 2, 3, 4]
-OUT = output_dir("01_peers_spaces_solutions")
 
 # %% [markdown]
 # ## Exercise 1: the inf-sup constant in the $L^2$ norm
@@ -37,12 +38,6 @@ OUT = output_dir("01_peers_spaces_solutions")
 clamped = nd.load_scene("thesis-3.46-frictionless",
                         ["boundary.dirichlet=['left', 'right', 'bottom', 'top']",
                          "boundary.neumann=[]", "boundary.contact=[]"])
-
-
-def to_scipy(matrix) -> sp.csr_matrix:
-    rows, cols, vals = matrix.COO()
-    return sp.csr_matrix((np.asarray(vals), (np.asarray(rows), np.asarray(cols))),
-                         shape=(matrix.height, matrix.width))
 
 
 def gram_matrix(problem, with_div: bool) -> sp.csr_matrix:
@@ -103,7 +98,7 @@ ax.set_ylabel("singular value of B")
 ax.set_title("Extreme singular values of b + s in two norms on X_h")
 ax.grid(True, which="both", alpha=0.3)
 ax.legend(fontsize=8)
-save_figure(fig, OUT / "singular_values.png")
+lesson.save(fig, "singular_values")
 
 # %% [markdown]
 # ## Exercise 2: counting with Euler's formula
@@ -136,5 +131,4 @@ for level in LEVELS:
 print("Euler's formula reproduces all eight rows of Table 3.1")
 
 # %%
-save_results("01_peers_spaces_solutions",
-             {"singular_values": singular, "growth_of_largest": growth})
+lesson.results({"singular_values": singular, "growth_of_largest": growth})

@@ -11,12 +11,12 @@ import numpy as np
 from ngdual.expr import Expression
 from ngdual.mesh import mesh_arrays, polygon_mesh
 from ngdual.scene import Material
-from ngdual.studies.tutorials import output_dir, quick_mode, save_figure, save_results
+from ngdual.studies.tutorials import Lesson
 
-QUICK = quick_mode()
+lesson = Lesson("02_locking_solutions")
+QUICK = lesson.quick
 LEVELS = [1, 2] if QUICK else [1, 2, 3, 4]
 NUS = [0.3, 0.49, 0.499, 0.4999]
-OUT = output_dir("02_locking_solutions")
 
 # %% [markdown]
 # ## Exercise 1: $P_2$ on the same meshes
@@ -84,7 +84,7 @@ ax.set_ylabel(r"relative $L^2$ error of $\sigma$")
 ax.set_title(f"Primal methods on the clamped square, level {LEVELS[-1]}")
 ax.grid(True, which="both", alpha=0.3)
 ax.legend()
-save_figure(fig, OUT / "primal_locking.png")
+lesson.save(fig, "primal_locking")
 
 # %% [markdown]
 # ## Exercise 2: how many divergence-free $P_1$ fields are there?
@@ -134,4 +134,4 @@ for level in LEVELS:
           f"2 V_int - T = {row['count']:4d}, divergence-free P1 fields: {row['kernel']}")
 
 # %%
-save_results("02_locking_solutions", {"primal_ratios": ratios, "divergence_free": divergence_free})
+lesson.results({"primal_ratios": ratios, "divergence_free": divergence_free})

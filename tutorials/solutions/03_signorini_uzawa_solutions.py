@@ -16,12 +16,12 @@ from ngdual.solvers.projections import NonnegativeProjection, metric_matrix
 from ngdual.solvers.reference import solve_qp
 from ngdual.solvers.settings import Model, UzawaSettings
 from ngdual.solvers.uzawa import uzawa
-from ngdual.studies.tutorials import output_dir, quick_mode, save_figure, save_results
+from ngdual.studies.tutorials import Lesson
 
-QUICK = quick_mode()
+lesson = Lesson("03_signorini_uzawa_solutions")
+QUICK = lesson.quick
 LEVELS = [1, 2] if QUICK else [1, 2, 3, 4]
 RHOS = [0.5, 1.0, 1.5, 2.0] if QUICK else list(np.arange(0.25, 2.51, 0.25))
-OUT = output_dir("03_signorini_uzawa_solutions")
 scene = load_scene("thesis-3.46-frictionless")
 problems = {level: assemble(scene, build_mesh(scene.geometry, level)) for level in LEVELS}
 
@@ -57,7 +57,7 @@ ax.set_ylabel("Uzawa iterations to $\\varepsilon = 10^{-8}$")
 ax.set_title("Exercise 1: iterations against $\\rho$ (missing point: no convergence)")
 ax.grid(True, which="both", alpha=0.3)
 ax.legend(fontsize=8)
-save_figure(fig, OUT / "optimal_rho.png")
+lesson.save(fig, "optimal_rho")
 
 # %% [markdown]
 # ## Exercise 2: the mass-matrix ($L^2$) metric
@@ -119,7 +119,7 @@ ax.set_ylabel(r"Uzawa iterations, $\rho = 1$")
 ax.set_title("Exercise 2: only the $H^{1/2}$ metric keeps the count fixed")
 ax.grid(True, alpha=0.3)
 ax.legend()
-save_figure(fig, OUT / "metrics_under_refinement.png")
+lesson.save(fig, "metrics_under_refinement")
 
 # %% [markdown]
 # ## Exercise 3: other gaps
@@ -142,6 +142,5 @@ for gap in ("abs(x)", "0.005 + 0.002*x*x"):
     print(f"g = {gap:18s}: nodes in contact, Uzawa {nodes[0]}, QP {nodes[1]}")
 
 # %%
-save_results("03_signorini_uzawa_solutions",
-             {"optimal": optimal, "mass_metric_iterations": mass_iterations,
-              "hand_vs_ngdual": hand_vs_ngdual, "gaps": gaps})
+lesson.results({"optimal": optimal, "mass_metric_iterations": mass_iterations,
+                "hand_vs_ngdual": hand_vs_ngdual, "gaps": gaps})

@@ -15,15 +15,15 @@ from ngdual.solvers.nested import nested_uzawa
 from ngdual.solvers.result import ConvergenceError
 from ngdual.solvers.settings import NestedUzawaSettings, UzawaSettings
 from ngdual.solvers.uzawa import uzawa
-from ngdual.studies.tutorials import output_dir, quick_mode, save_figure, save_results
+from ngdual.studies.tutorials import Lesson
 
-QUICK = quick_mode()
+lesson = Lesson("04_friction_solutions")
+QUICK = lesson.quick
 LEVEL = 3                                             # the first level with a stick zone
 RHO1S = [1.0] if QUICK else [0.5, 1.0, 1.5]
 RHO2S = [0.5, 1.0, 1.5] if QUICK else [0.25, 0.5, 1.0, 1.5]
 LARGE_RHO2S = [2.5, 8.0]
 MUS = [0.0, 0.1, 0.5, 1.0] if QUICK else [0.0, 0.1, 0.25, 0.5, 1.0]
-OUT = output_dir("04_friction_solutions")
 coulomb = nd.load_scene("thesis-3.46-coulomb")
 problem = assemble(coulomb, build_mesh(coulomb.geometry, LEVEL))
 
@@ -76,7 +76,7 @@ ax.set_ylabel("inner iterations (= solves)")
 ax.set_title(f"Coulomb, level {LEVEL}: cost of the two loop orders")
 ax.grid(alpha=0.3)
 ax.legend(fontsize=8)
-save_figure(fig, OUT / "step_lengths.png")
+lesson.save(fig, "step_lengths")
 
 # %% [markdown]
 # ## Exercise 2: the friction coefficient
@@ -115,14 +115,12 @@ fig, ax = plt.subplots(figsize=(6.5, 4))
 positive = [mu for mu in MUS if mu > 0]
 ax.plot(positive, [by_mu[str(mu)]["stick_nodes"] for mu in positive], "o-", label="stick")
 ax.plot(positive, [by_mu[str(mu)]["slip_nodes"] for mu in positive], "s-", label="slip")
-ax.set_xlabel(r"friction coefficient $\mu_f$")
-ax.set_ylabel(r"$\tilde h$-nodes in contact")
-ax.set_title(f"Coulomb friction, level {LEVEL}: stick grows with $\\mu_f$")
+ax.set(xlabel=r"friction coefficient $\mu_f$", ylabel=r"$\tilde h$-nodes in contact",
+       title=f"Coulomb friction, level {LEVEL}: stick grows with $\\mu_f$")
 ax.grid(alpha=0.3)
 ax.legend()
-save_figure(fig, OUT / "stick_slip.png")
+lesson.save(fig, "stick_slip")
 
 # %%
-save_results("04_friction_solutions",
-             {"sweep": sweep, "rho2s": RHO2S, "rho1s": RHO1S, "large_rho2": large,
-              "by_mu": by_mu})
+lesson.results({"sweep": sweep, "rho2s": RHO2S, "rho1s": RHO1S, "large_rho2": large,
+                "by_mu": by_mu})

@@ -13,12 +13,12 @@ from ngdual.friction import build_friction_forms
 from ngdual.mesh import build_mesh
 from ngdual.solvers.nested import nested_uzawa
 from ngdual.solvers.settings import NestedUzawaSettings
-from ngdual.studies.tutorials import output_dir, quick_mode, save_figure, save_results
+from ngdual.studies.tutorials import Lesson
 
-QUICK = quick_mode()
+lesson = Lesson("05_friction_inf_sup_solutions")
+QUICK = lesson.quick
 GAP_ABS_LEVEL = 3 if QUICK else 4
 KERNEL_LEVEL = 2
-OUT = output_dir("05_friction_inf_sup_solutions")
 
 # %% [markdown]
 # ## Exercise 1: $\hat h = \tilde h$ when (3.73) holds
@@ -61,7 +61,7 @@ ax.set_ylabel(r"$\lambda_t = -u_t$")
 ax.set_title(f"g = |x₁|, level {GAP_ABS_LEVEL}: both ĥ give the same λ_t")
 ax.grid(alpha=0.3)
 ax.legend()
-save_figure(fig, OUT / "gap_abs_lambda_t.png")
+lesson.save(fig, "gap_abs_lambda_t")
 
 # %% [markdown]
 # ## Exercise 2: a variable friction bound
@@ -109,12 +109,11 @@ ax.set_ylabel(r"kernel vector $\kappa_j$ (scaled)")
 ax.set_title("The kernel of $Q_\\mathcal{F}^T$ for ĥ = h̃: a weighted checkerboard")
 ax.grid(alpha=0.3)
 ax.legend()
-save_figure(fig, OUT / "kernel_variable_F.png")
+lesson.save(fig, "kernel_variable_F")
 
 # %%
-save_results("05_friction_inf_sup_solutions",
-             {"gap_abs_converged": [s.converged for s in gap_abs.values()],
-              "gap_abs_difference": gap_abs_difference,
-              "kernel_alternates": alternates,
-              "kernel_spread": float(np.abs(kernel_variable).max()
-                                     / np.abs(kernel_variable).min())})
+lesson.results({"gap_abs_converged": [s.converged for s in gap_abs.values()],
+                "gap_abs_difference": gap_abs_difference,
+                "kernel_alternates": alternates,
+                "kernel_spread": float(np.abs(kernel_variable).max()
+                                       / np.abs(kernel_variable).min())})

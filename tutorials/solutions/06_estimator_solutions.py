@@ -13,11 +13,11 @@ import numpy as np
 from ngdual.estimator import SIGMA_TERMS, U_TERMS, estimate
 from ngdual.scene import Geometry, Loads, Material, Scene, load_scene, validate
 from ngdual.solvers import solve_scene
-from ngdual.studies.tutorials import output_dir, quick_mode, save_figure, save_results
+from ngdual.studies.tutorials import Lesson
 
-QUICK = quick_mode()
+lesson = Lesson("06_estimator_solutions")
+QUICK = lesson.quick
 LEVELS = [1, 2, 3] if QUICK else [1, 2, 3, 4]
-OUT = output_dir("06_estimator_solutions")
 
 # %% [markdown]
 # ## Exercise 1: the patch test
@@ -100,7 +100,7 @@ ax.set_title("Exercise 2 (Table 4.2): the largest asymmetry indicator,\n"
              "attained in a lower corner where $\\Gamma_D$ meets $\\Gamma_C$")
 ax.grid(True, which="both", alpha=0.3)
 ax.legend()
-save_figure(fig, OUT / "table_4_2.png")
+lesson.save(fig, "table_4_2")
 
 # %% [markdown]
 # ## Exercise 3: $\sum_T \eta_T$ against $(\sum_T \eta_T^2)^{1/2}$
@@ -169,9 +169,8 @@ ax.set_ylabel(r"$\sum_T \eta_{tot,T} \,/\, (\sum_T \eta_{tot,T}^2)^{1/2}$")
 ax.set_title("Exercise 3: sum against square root of the sum of squares")
 ax.grid(True, which="both", alpha=0.3)
 ax.legend(fontsize=8)
-save_figure(fig, OUT / "sum_ratios.png")
+lesson.save(fig, "sum_ratios")
 
 # %%
-save_results("06_estimator_solutions",
-             {"patch_sigma": sigma_part, "patch_u": u_part, "table_4_2": table_4_2,
-              "sum_ratios": ratios})
+lesson.results({"patch_sigma": sigma_part, "patch_u": u_part, "table_4_2": table_4_2,
+                "sum_ratios": ratios})

@@ -18,16 +18,16 @@ from ngdual.mesh import build_mesh, mesh_arrays
 from ngdual.rates import fitted_rate
 from ngdual.scene import load_scene
 from ngdual.solvers import solve_problem, solve_scene
-from ngdual.studies.tutorials import output_dir, quick_mode, save_figure, save_results
+from ngdual.studies.tutorials import Lesson
 from ngdual.verification import corner
 
-QUICK = quick_mode()
+lesson = Lesson("07_adaptivity_solutions")
+QUICK = lesson.quick
 TARGET_DOFS = 1500 if QUICK else 8000       # Exercise 1: refine until N reaches this
 THETAS = [0.2, 0.5, 0.8]
 THESIS_STEPS = 3 if QUICK else 5            # Exercise 2
 CORNER_STEPS = 4 if QUICK else 9            # Exercise 3
 UNIFORM_LEVELS = [1, 2, 3] if QUICK else [1, 2, 3, 4]
-OUT = output_dir("07_adaptivity_solutions")
 
 
 def adapt_until(scene, marking, theta, max_dofs, level=1, indicator="eta", error=None,
@@ -97,7 +97,7 @@ ax.set_ylabel("exact error e (Williams' corner solution)")
 ax.set_title(r"Exercise 1: Dörfler marking on the L-shape for three $\theta$")
 ax.grid(True, which="both", alpha=0.3)
 ax.legend()
-save_figure(fig, OUT / "dorfler_theta.png")
+lesson.save(fig, "dorfler_theta")
 
 # %% [markdown]
 # ## Exercise 2: which terms refine Example 3.46?
@@ -144,7 +144,7 @@ for ax, (indicator, label) in zip(axes, (("eta", r"$\eta_{tot,T}$ (4.50)"),
 axes[-1].set_xlabel("$x_1$")
 fig.suptitle(f"Exercise 2: Example 3.46 (Coulomb), fraction marking, {THESIS_STEPS} steps")
 fig.tight_layout()
-save_figure(fig, OUT / "meshes_by_indicator.png")
+lesson.save(fig, "meshes_by_indicator")
 
 # %% [markdown]
 # ## Exercise 3: the corners of Example 3.46
@@ -194,8 +194,7 @@ ax.set_ylabel(r"estimator $\eta = (\sum_T \eta_{tot,T}^2)^{1/2}$")
 ax.set_title("Exercise 3: incompatible data (g = 0.01) stall the estimator")
 ax.grid(True, which="both", alpha=0.3)
 ax.legend(fontsize=8)
-save_figure(fig, OUT / "corners_eta.png")
+lesson.save(fig, "corners_eta")
 
 # %%
-save_results("07_adaptivity_solutions",
-             {"dorfler": dorfler, "by_indicator": by_indicator, "corners": corners})
+lesson.results({"dorfler": dorfler, "by_indicator": by_indicator, "corners": corners})

@@ -8,43 +8,29 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import ngdual as nd
-from ngdual import post
-from ngdual.scene import SceneError, load_scene
-from ngdual.solvers import solve_scene
-from ngdual.studies.tutorials import (
-    output_dir,
-    plot_geometry,
-    plot_von_mises,
-    quick_mode,
-    save_figure,
-    save_results,
-)
+from ngdual.scene import Contact, Geometry, Loads, Material
+from ngdual.studies.tutorials import Lesson
 
-QUICK = quick_mode()
+lesson = Lesson("08_your_own_scene_solutions")
+QUICK = lesson.quick
 LEVELS = [1, 2, 3] if QUICK else [1, 2, 3, 4]
-OUT = output_dir("08_your_own_scene_solutions")
+OUT = lesson.out
 
-STAMP = """
-name = "stamp"
-[geometry]
-kind = "polygon"
-points = [[-1.0, 0.0], [1.0, 0.0], [1.0, 0.25], [0.4, 1.0], [-0.4, 1.0], [-1.0, 0.25]]
-labels = ["base", "right_clamp", "right_shoulder", "top", "left_shoulder", "left_clamp"]
-maxh = 0.25
-[boundary]
-dirichlet = ["left_clamp", "right_clamp"]
-neumann = ["right_shoulder", "top", "left_shoulder"]
-contact = ["base"]
-[material]
-E = 200000.0
-nu = 0.3
-[loads]
-traction = ["0", "-1500*(1 - x*x)"]
-[contact]
-gap = "0.001 + 0.05*x*x"
-"""
-stamp_file = OUT / "stamp.toml"
-stamp_file.write_text(STAMP)
+
+def stamp(load_factor: float = 1.0, gap: str = "0.001 + 0.05*x*x") -> nd.Scene:
+    """The stamp of Tutorial 8, its load scaled by ``load_factor``, above the gap ``gap``."""
+    labels = ["base", "right_clamp", "right_shoulder", "top", "left_shoulder", "left_clamp"]
+    scene = nd.Scene(name="stamp", material=Material(E=200000.0, nu=0.3),
+                     geometry=Geometry(kind="polygon", labels=labels, maxh=0.25, points=[
+                         [-1.0, 0.0], [1.0, 0.0], [1.0, 0.25], [0.4, 1.0], [-0.4, 1.0],
+                         [-1.0, 0.25]]),
+                     boundary={"dirichlet": labels[1::4], "neumann": labels[2:5],
+                               "contact": labels[:1]},
+                     loads=Loads(traction=["0", f"{-1500 * load_factor}*(1 - x*x)"]),
+                     contact=Contact(gap=gap))
+    nd.validate(scene)
+    return scene
+
 
 # %% [markdown]
 # ## Exercise 1: the load at first contact
@@ -67,19 +53,14 @@ stamp_file.write_text(STAMP)
 G0, LEVEL = 0.002, 2
 
 
-def stamp(load_factor: float, gap: str):
-    return load_scene(stamp_file, [f"loads.traction=['0', '{-1500 * load_factor}*(1 - x*x)']",
-                                   f"contact.gap='{gap}'"])
-
-
-unloaded = solve_scene(stamp(0.0, "1"), LEVEL).part("lam_n")
-loaded = solve_scene(stamp(1.0, "1"), LEVEL).part("lam_n")
+unloaded = nd.solve(stamp(0.0, "1"), LEVEL).part("lam_n")
+loaded = nd.solve(stamp(1.0, "1"), LEVEL).part("lam_n")
 U = unloaded - loaded
 closing = U > 0
 s_star = float(np.min(G0 * unloaded[closing] / U[closing]))
-near_contact = {factor: solve_scene(stamp(factor * s_star, str(G0)), LEVEL)
+near_contact = {factor: nd.solve(stamp(factor * s_star, str(G0)), LEVEL)
                 for factor in (0.95, 1.05)}
-touching = {factor: post.contact_summary(solution)["nodes_in_contact"]
+touching = {factor: nd.result_record(solution)["contact"]["nodes_in_contact"]
             for factor, solution in near_contact.items()}
 print(f"first contact at s* = {s_star:.4f}; nodes in contact at 0.95 s*: {touching[0.95]}, "
       f"at 1.05 s*: {touching[1.05]}")
@@ -97,7 +78,7 @@ ax.set_ylabel(r"remaining gap $\lambda_n = g - u_n$")
 ax.set_title(f"Exercise 1: first contact of the stamp at s* = {s_star:.3f} (g = {G0})")
 ax.grid(True, alpha=0.3)
 ax.legend()
-save_figure(fig, OUT / "first_contact.png")
+lesson.save(fig, "first_contact")
 
 # %% [markdown]
 # ## Exercise 2: an arch on two feet
@@ -151,24 +132,24 @@ for what, text in mistakes.items():
     path = OUT / f"arch-{what.replace(' ', '-')}.toml"
     path.write_text(text)
     try:
-        load_scene(path)
-    except SceneError as err:
+        nd.load_scene(path)
+    except nd.SceneError as err:
         arch_errors[what] = err.field
         print(f"{what}: {err}")
 (OUT / "arch.toml").write_text(arch_toml(points, ["outer_clamp", "inner_clamp"],
                                          ["outer", "inner"]))
-arch = load_scene(OUT / "arch.toml")
-arch_solution = solve_scene(arch, 2)
+arch = nd.load_scene(OUT / "arch.toml")
+arch_solution = nd.solve(arch, 2)
 # λ_n is the remaining gap at the coarse nodes: a node touches where it is (numerically) 0
 arch_gap = arch_solution.part("lam_n")
 arch_contact = int(np.sum(arch_gap <= 1e-6 * 0.0005))
 arch_mesh = arch_solution.problem.fes.mesh
-save_figure(plot_geometry(arch, mesh=arch_mesh,
-                          title="Exercise 2: the arch, its boundary parts and mesh (level 2)"),
-            OUT / "arch_geometry.png")
-save_figure(plot_von_mises(arch_mesh, nd.fields(arch_solution).sigma, arch.material.nu,
-                           "Exercise 2: von Mises stress in the arch on its two feet"),
-            OUT / "arch_von_mises.png")
+lesson.save(nd.plot_geometry(arch, mesh=arch_mesh,
+                             title="Exercise 2: the arch, its boundary parts and mesh (level 2)"),
+            "arch_geometry")
+lesson.save(nd.plot_von_mises(arch_mesh, nd.fields(arch_solution).sigma, arch.material.nu,
+                              "Exercise 2: von Mises stress in the arch on its two feet"),
+            "arch_von_mises")
 print(f"fixed arch: converged {arch_solution.converged}, remaining gap at the foot nodes "
       f"{np.array2string(arch_gap, precision=6)}: {arch_contact} of {len(arch_gap)} touch")
 
@@ -181,10 +162,10 @@ print(f"fixed arch: converged {arch_solution.converged}, remaining gap at the fo
 # contact zone is resolved.
 
 # %%
-scene = load_scene(stamp_file)
+scene = stamp()
 rows = []
 for level in LEVELS:
-    record = post.result_record(solve_scene(scene, level))
+    record = nd.result_record(nd.solve(scene, level))
     rows.append((level, record["norms"]["sigma_X"],
                  record["contact"]["nodes_in_contact"] / record["dofs"]["C"]))
 differences = np.abs(np.diff([r[1] for r in rows]))
@@ -194,7 +175,6 @@ for (level, norm, share) in rows:
 print(f"observed orders of |sigma|_X differences: {np.round(orders, 2)}")
 
 # %%
-save_results("08_your_own_scene_solutions",
-             {"s_star": s_star, "touching": {str(k): v for k, v in touching.items()},
-              "arch_errors": arch_errors, "arch_contact": arch_contact,
-              "refinement": rows})
+lesson.results({"s_star": s_star, "touching": {str(k): v for k, v in touching.items()},
+                "arch_errors": arch_errors, "arch_contact": arch_contact,
+                "refinement": rows})
