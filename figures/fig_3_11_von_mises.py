@@ -7,10 +7,10 @@ wash out the rest. The numbers give the largest values away from the corners and
 """
 
 import numpy as np
-from _common import UNITS, element_rows, field_summary, stress
 
 from ngdual import plot
 from ngdual.studies.figures import script_main
+from ngdual.studies.figures.kit import UNITS, element_rows, field_summary, stress
 
 THESIS = "Fig. 3.11"
 STUDIES = ("uniform-frictionless", "uniform-coulomb")

@@ -1,10 +1,10 @@
 """Fig. 3.13: displacement u_2^h in Omega (piecewise constant), mu_f = 0 and mu_f = 0.5."""
 
 import numpy as np
-from _common import UNITS, element_rows, length
 
 from ngdual import plot
 from ngdual.studies.figures import script_main
+from ngdual.studies.figures.kit import UNITS, element_rows, length
 
 THESIS = "Fig. 3.13"
 STUDIES = ("uniform-frictionless", "uniform-coulomb")

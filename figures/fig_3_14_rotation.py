@@ -6,10 +6,10 @@ body starts to slide; the extrema lie on the boundary.
 """
 
 import numpy as np
-from _common import UNITS, element_rows
 
 from ngdual import plot
 from ngdual.studies.figures import script_main
+from ngdual.studies.figures.kit import UNITS, element_rows
 
 THESIS = "Fig. 3.14"
 STUDIES = ("uniform-frictionless", "uniform-coulomb")

@@ -4,9 +4,8 @@ The thesis: no difference between the two cases (same traction t_0); by Theorem 
 sign of phi is opposite to that of u on Gamma_N.
 """
 
-from _common import neumann_multiplier
-
 from ngdual.studies.figures import script_main
+from ngdual.studies.figures.kit import neumann_multiplier
 
 THESIS = "Fig. 3.15"
 STUDIES = ("uniform-frictionless", "uniform-coulomb")

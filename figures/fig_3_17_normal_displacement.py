@@ -5,10 +5,10 @@ but with friction the contact zone is larger (ten more vertices in contact on le
 """
 
 import numpy as np
-from _common import curve_rows, length
 
 from ngdual import plot
 from ngdual.studies.figures import PROBLEM_TITLES, script_main
+from ngdual.studies.figures.kit import curve_rows, length
 
 THESIS = "Fig. 3.17"
 STUDIES = ("uniform-frictionless", "uniform-coulomb")

@@ -6,9 +6,8 @@ with friction (kinks where the body changes between slip and stick); F_abs is la
 friction.
 """
 
-from _common import gamma_c_stress
-
 from ngdual.studies.figures import PROBLEM_TITLES, script_main
+from ngdual.studies.figures.kit import gamma_c_stress
 
 THESIS = "Fig. 3.18"
 STUDIES = ("uniform-frictionless", "uniform-coulomb")

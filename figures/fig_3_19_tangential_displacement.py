@@ -5,10 +5,10 @@ With friction, the h~ nodes in contact are marked stick (green) or slip (red) as
 """
 
 import numpy as np
-from _common import curve_rows, length
 
 from ngdual import plot
 from ngdual.studies.figures import PROBLEM_TITLES, script_main
+from ngdual.studies.figures.kit import curve_rows, length
 
 THESIS = "Fig. 3.19"
 STUDIES = ("uniform-frictionless", "uniform-coulomb")

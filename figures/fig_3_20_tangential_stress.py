@@ -4,9 +4,8 @@ The thesis: zero without friction (free sliding); with friction the friction for
 tangentially, with the sign of lambda_t.
 """
 
-from _common import gamma_c_stress
-
 from ngdual.studies.figures import script_main
+from ngdual.studies.figures.kit import gamma_c_stress
 
 THESIS = "Fig. 3.20"
 STUDIES = ("uniform-frictionless", "uniform-coulomb")

@@ -9,10 +9,10 @@ sticks (the thesis: nu = sigma_t / (mu_f |sigma_n|) on all of A_C, Remark 3.15).
 """
 
 import numpy as np
-from _common import length
 
 from ngdual import plot
 from ngdual.studies.figures import script_main
+from ngdual.studies.figures.kit import length
 
 THESIS = "Fig. 3.21"
 STUDIES = ("uniform-coulomb",)

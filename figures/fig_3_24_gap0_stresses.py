@@ -6,10 +6,10 @@ kinks of sigma_t mark the change between slip and stick.
 """
 
 import numpy as np
-from _common import length, stress
 
 from ngdual import plot
 from ngdual.studies.figures import gap_tasks, outcome, require, script_main
+from ngdual.studies.figures.kit import length, stress
 
 THESIS = "Fig. 3.24"
 STUDIES = ("gaps",)

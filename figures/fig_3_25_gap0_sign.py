@@ -8,10 +8,10 @@ also requires the residual of nu lambda_t = |lambda_t| to be below eps_2.
 """
 
 import numpy as np
-from _common import length
 
 from ngdual import plot
 from ngdual.studies.figures import gap_tasks, outcome, require, script_main
+from ngdual.studies.figures.kit import length
 
 THESIS = "Fig. 3.25"
 STUDIES = ("gaps",)

@@ -9,10 +9,10 @@ Plan.uzawa_gap_level) is listed in the index. A case that did not converge is na
 """
 
 import numpy as np
-from _common import HHAT_CASES, HHAT_STYLE, hhat_numbers, hhat_solutions, length
 
 from ngdual import plot
 from ngdual.studies.figures import script_main
+from ngdual.studies.figures.kit import HHAT_CASES, HHAT_STYLE, hhat_numbers, hhat_solutions, length
 
 THESIS = "Fig. 3.26"
 STUDIES = ("gaps",)

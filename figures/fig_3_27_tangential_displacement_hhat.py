@@ -2,10 +2,10 @@
 (a) g = |x_1|, (b) g of (3.125), mu_f = 0.5."""
 
 import numpy as np
-from _common import HHAT_CASES, HHAT_STYLE, hhat_numbers, hhat_solutions, length
 
 from ngdual import plot
 from ngdual.studies.figures import script_main
+from ngdual.studies.figures.kit import HHAT_CASES, HHAT_STYLE, hhat_numbers, hhat_solutions, length
 
 THESIS = "Fig. 3.27"
 STUDIES = ("gaps",)

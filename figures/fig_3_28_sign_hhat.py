@@ -2,10 +2,10 @@
 (a) g = |x_1|, (b) g of (3.125), mu_f = 0.5 (piecewise constant on the h^ edges where F > 0)."""
 
 import numpy as np
-from _common import HHAT_CASES, hhat_numbers, hhat_solutions, length
 
 from ngdual import plot
 from ngdual.studies.figures import script_main
+from ngdual.studies.figures.kit import HHAT_CASES, hhat_numbers, hhat_solutions, length
 
 THESIS = "Fig. 3.28"
 STUDIES = ("gaps",)

@@ -5,10 +5,9 @@ the thesis shows the initial mesh and the meshes after 4, 8, ..., 28 steps. Shad
 triangles marked for the next refinement. One file per thesis figure (fig_4_01 ... fig_4_08).
 """
 
-from _common import UNITS
-
 from ngdual import plot
 from ngdual.studies.figures import adaptive_task, require, script_main
+from ngdual.studies.figures.kit import UNITS
 
 THESIS = "Figs. 4.1-4.8"
 STUDIES = ("adaptive",)

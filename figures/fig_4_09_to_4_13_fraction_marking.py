@@ -5,10 +5,9 @@ mesh; the thesis shows the meshes after 1, 3, 5, 7 and 9 steps. Shaded: the tria
 for the next refinement. One file per thesis figure (fig_4_09 ... fig_4_13).
 """
 
-from _common import UNITS
-
 from ngdual import plot
 from ngdual.studies.figures import adaptive_task, require, script_main
+from ngdual.studies.figures.kit import UNITS
 
 THESIS = "Figs. 4.9-4.13"
 STUDIES = ("adaptive",)

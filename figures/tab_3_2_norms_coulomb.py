@@ -4,9 +4,8 @@
 last three levels, the reference of the total error (3.124).
 """
 
-from _common import NORM_KEYS, norms_table
-
 from ngdual.studies.figures import script_main
+from ngdual.studies.figures.kit import NORM_KEYS, norms_table
 
 THESIS = "Table 3.2"
 STUDIES = ("uniform-coulomb",)

@@ -1,9 +1,8 @@
 """Table 4.1: norms and DOFs per step of the adaptive algorithm with max marking (theta = 0.5),
 mu_f = 0.5; compare with the uniform levels of Table 3.2."""
 
-from _common import NORM_KEYS, NORM_LABELS
-
 from ngdual.studies.figures import adaptive_task, markdown_table, require, script_main
+from ngdual.studies.figures.kit import NORM_KEYS, NORM_LABELS
 
 THESIS = "Table 4.1"
 STUDIES = ("adaptive",)

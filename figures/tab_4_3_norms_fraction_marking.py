@@ -1,9 +1,8 @@
 """Table 4.3: norms per step of the adaptive algorithm with fraction marking (theta = 0.2),
 mu_f = 0.5."""
 
-from _common import NORM_KEYS, NORM_LABELS
-
 from ngdual.studies.figures import adaptive_task, markdown_table, require, script_main
+from ngdual.studies.figures.kit import NORM_KEYS, NORM_LABELS
 
 THESIS = "Table 4.3"
 STUDIES = ("adaptive",)

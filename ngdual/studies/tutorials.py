@@ -29,6 +29,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..io import write_json
+from .sources import scripts_folder
 
 QUICK_ENV = "NGDUAL_QUICK"
 OUT_ENV = "NGDUAL_TUTORIAL_OUT"
@@ -122,9 +123,8 @@ class Tutorial:
 
 def tutorials_dir() -> Path:
     """The folder holding the tutorial sources: ``NGDUAL_TUTORIALS_DIR`` if set, else the
-    one shipped with ngdual (:func:`~ngdual.studies.sources.scripts_folder`)."""
-    from .sources import scripts_folder
-
+    one shipped with ngdual: ``tutorials/`` of the source checkout, or its copy inside an
+    installed wheel (:func:`~ngdual.studies.sources.scripts_folder`)."""
     return scripts_folder("tutorials")
 
 

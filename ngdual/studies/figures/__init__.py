@@ -4,9 +4,10 @@
 :mod:`~.tasks` (the studies: lists of sweep tasks), :mod:`~.numbers` (numbers derived
 from records), :mod:`~.truth` (true errors against an overkill), :mod:`~.output` (the
 :class:`Context` a figure script works with), :mod:`~.index` (``index.md``, markdown
-tables, the README gallery) and :mod:`~.run` (the run: sweep, scripts, index). The
-figure scripts themselves are ``figures/*.py`` of the source checkout; the names below
-are what they import.
+tables, the README gallery), :mod:`~.run` (the run: sweep, scripts, index) and
+:mod:`~.kit` (what several figure scripts share). The figure scripts themselves are
+``figures/*.py`` (found by :func:`ngdual.studies.sources.scripts_folder`); the names below
+and :mod:`~.kit` are what they import.
 """
 
 from .index import markdown_table, write_gallery

@@ -16,33 +16,24 @@ from __future__ import annotations
 
 import importlib.util
 import json
-import os
 import sys
 import time
-from contextlib import contextmanager
 from datetime import datetime
 from pathlib import Path
 
 from ...io import versions, write_json
 from ...scene import SceneError
+from ..sources import scripts_folder
 from ..sweep import Runner, Task
 from .index import write_index
 from .output import Context
 from .plan import DEFAULT_MAX_LEVEL, Plan
 
-SOURCE_ENV = "NGDUAL_FIGURES_DIR"
-
 
 def figures_dir(source: str | Path | None = None) -> Path:
-    """``source`` (``--source``), else ``NGDUAL_FIGURES_DIR``, else ``figures/`` of the
-    source checkout; a SceneError naming ``source`` if it is not a folder."""
-    folder = Path(source or os.environ.get(SOURCE_ENV)
-                  or Path(__file__).resolve().parents[3] / "figures")
-    if not folder.is_dir():
-        raise SceneError("source", f"no figures folder at {folder}: the figure scripts ship "
-                                   f"with the source checkout (pip install -e .); point "
-                                   f"{SOURCE_ENV} or --source at its figures/ folder")
-    return folder
+    """The figure scripts' folder: ``source`` (``--source``), else ``NGDUAL_FIGURES_DIR``,
+    else the one shipped with ngdual (:func:`~ngdual.studies.sources.scripts_folder`)."""
+    return scripts_folder("figures", source)
 
 
 def figure_scripts(source: str | Path | None = None) -> list[Path]:
@@ -70,23 +61,11 @@ def select_scripts(only: list[str] | None = None, source: str | Path | None = No
     return [p for p in scripts if any(name in p.stem for name in only)]
 
 
-@contextmanager
-def _script_folder_on_path(folder: Path):
-    """The script's folder first on ``sys.path`` while it is imported, as when Python runs
-    the script itself: the figure scripts share ``figures/_common.py``."""
-    sys.path.insert(0, str(folder))
-    try:
-        yield
-    finally:
-        sys.path.remove(str(folder))
-
-
 def load_script(path: Path):
     """Import a figure script; it must define ``THESIS``, ``STUDIES`` and ``run(ctx)``."""
     spec = importlib.util.spec_from_file_location(f"ngdual_figure_{path.stem}", path)
     module = importlib.util.module_from_spec(spec)
-    with _script_folder_on_path(path.parent):
-        spec.loader.exec_module(module)
+    spec.loader.exec_module(module)
     for name in ("THESIS", "STUDIES", "run"):
         if not hasattr(module, name):
             raise AttributeError(f"figure script {path} defines no {name}")

@@ -1,19 +1,24 @@
-"""Helpers shared by several figure scripts (not part of the package: only figures use them)."""
+"""What several figure scripts share: axis labels in the thesis scenes' units, the norms of
+Tables 3.2/3.3, the h^ cases of Figs. 3.26-3.28, CSV rows of fields and traces, and the
+panels of Figs. 3.15-3.20.
+
+The figure scripts (``figures/*.py``) import it as ``ngdual.studies.figures.kit``; no other
+module does, so that loading the thesis scene for :data:`UNITS` costs nothing elsewhere.
+"""
+
+from __future__ import annotations
 
 from pathlib import Path
 
 import numpy as np
 
-from ngdual import plot
-from ngdual.scene import load_scene
-from ngdual.studies.figures import (
-    PROBLEM_TITLES,
-    SCENES,
-    Context,
-    gap_tasks,
-    markdown_table,
-    outcome,
-)
+from ... import plot
+from ...scene import load_scene
+from .index import markdown_table
+from .numbers import outcome
+from .output import Context
+from .plan import PROBLEM_TITLES, SCENES
+from .tasks import gap_tasks
 
 # the units the thesis scenes declare ([units]; none: labels name the quantity alone)
 UNITS = load_scene(SCENES["frictionless"]).units
@@ -121,7 +126,6 @@ def field_summary(values: np.ndarray, points: np.ndarray, triangles: np.ndarray)
     k = int(np.argmax(values))
     return {"min": float(values.min()), "max": float(values.max()),
             "argmax": [round(float(c), 3) for c in centroids[k]]}
-
 
 
 def gamma_c_stress(ctx: Context, fields: dict, thesis: str, key: str, tex: str, what: str,
