@@ -5,7 +5,7 @@ friction mu_f = 0.5, both with consistent end values at the clamped sides (the t
 lambda = 0 there contradicts u = 0 on Gamma_D and leaves sigma ~ 1/r, not in L2: no error
 is finite), and the rigid flat punch.
 
-The error of every point is a true error (ngdual.verification.reference) against an
+The error of every point is a true error (ngdual.verification.overkill) against an
 overkill: ngdual's solution two uniform levels beyond the finest studied, checked by
 Richardson from the two levels below it (the overkill's own error is in the JSON and the
 index; a target below about twice it is not resolved). Two measures: the relative L2 error

@@ -1,22 +1,23 @@
 """The adaptive loop SOLVE -> ESTIMATE -> MARK -> REFINE of Section 4.2.
 
-:func:`adapt` solves the scene on its initial mesh, computes the indicators
-eta_{tot,T} of (4.50) (:mod:`ngdual.estimator`), marks with one of the
-strategies of :mod:`ngdual.marking`, refines the marked triangles with
-netgen's bisection (plus its conforming closure) and carries the coarse
-boundary meshes h~, h^ over to the new mesh, nested and with h~ ~ 2h locally
-(:meth:`ngdual.boundary.BoundaryMeshes.follow`). Each step adds one plain
-record to the returned history: DOFs, the summed estimator terms, the norms of
-SPEC section 6, iterations and the wall time of every phase; given reference
-norms (e.g. Aitken-extrapolated from uniform levels, :func:`reference_norms`),
-also the total error (3.124) and the effectivity index eta / e_tot
-(Table 4.4). Uniform refinement is ``marking="max", theta=0``.
+:func:`adapt` solves the scene on its initial mesh (:func:`ngdual.solvers.solve_on_mesh`),
+computes the indicators eta_{tot,T} of (4.50) (:mod:`ngdual.estimator`), marks with one of
+the strategies of :mod:`ngdual.marking`, refines the marked triangles with netgen's
+bisection (plus its conforming closure) and carries the coarse boundary meshes h~, h^ over
+to the new mesh, nested and with h~ ~ 2h locally
+(:meth:`ngdual.boundary.BoundaryMeshes.follow`). Each step adds one plain record to the
+returned history (:func:`step_record`): DOFs, the estimate and its terms, the norms of
+Tables 3.2/3.3, iterations and the wall time of every phase; given the norms of the exact
+solution (e.g. Aitken-extrapolated from uniform levels, :func:`reference_norms`), also the
+total error (3.124) and the effectivity index estimate / e_tot (Table 4.4). Uniform
+refinement is ``marking="max", theta=0``.
 """
 
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import asdict
 
 import ngsolve as ngs
@@ -24,15 +25,13 @@ import numpy as np
 
 from . import budget
 from .boundary import BoundaryMeshes
-from .estimator import Estimate, estimate
-from .forms import assemble
-from .marking import mark
+from .estimator import ASYMMETRY_NORMS, Estimate, estimate
+from .marking import STRATEGIES, mark
 from .mesh import build_mesh
-from .quadrature_check import check_formulas
 from .quantities import norms
 from .rates import extrapolated_norms, total_error
 from .scene import Scene, SceneError, SceneTypeError, check_level, ensure_valid
-from .solvers import check_unknowns, solve_problem, solve_scene
+from .solvers import solve_on_mesh, solve_scene
 from .solvers.result import Solution
 
 StepCallback = Callable[[dict, Solution, Estimate, np.ndarray | None], None]
@@ -55,6 +54,14 @@ def refine(mesh: ngs.Mesh, marked: np.ndarray) -> ngs.Mesh:
     return fine
 
 
+def refine_with_boundary(scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes,
+                         marked: np.ndarray) -> tuple[ngs.Mesh, BoundaryMeshes]:
+    """REFINE: the marked triangles of ``mesh`` refined (:func:`refine`) and the coarse
+    boundary meshes h~, h^ carried over to the new mesh."""
+    fine = refine(mesh, marked)
+    return fine, coarse.follow(scene, fine)
+
+
 def refine_towards(scene: Scene, mesh: ngs.Mesh, point, times: int
                    ) -> tuple[ngs.Mesh, BoundaryMeshes]:
     """``times`` refinements of the triangles touching the vertex ``point``, with the coarse
@@ -64,8 +71,7 @@ def refine_towards(scene: Scene, mesh: ngs.Mesh, point, times: int
     for _ in range(times):
         touching = np.array([any(np.allclose(mesh[v].point, point) for v in el.vertices)
                              for el in mesh.Elements()])
-        mesh = refine(mesh, touching)
-        coarse = coarse.follow(scene, mesh)
+        mesh, coarse = refine_with_boundary(scene, mesh, coarse, touching)
     return mesh, coarse
 
 
@@ -89,8 +95,9 @@ def adapt(scene: Scene, marking: str = "dorfler", theta: float = 0.5, steps: int
         Norms of the exact solution (keys of :func:`ngdual.quantities.norms`); adds
         the errors of (3.124) and the effectivity index to every record.
     on_step : callable, optional
-        ``on_step(record, solution, estimate, marked)`` after MARK (``marked`` is
-        None on the last step), before the mesh is refined: for output files.
+        ``on_step(record, solution, estimated, marked)`` after MARK (``estimated`` the
+        :class:`~ngdual.estimator.Estimate`, ``marked`` None on the last step), before the
+        mesh is refined: for output files.
     allow_large : bool
         Refine even when the next mesh's estimated memory exceeds what the machine has
         available (:mod:`ngdual.budget`; refused with a SceneError otherwise).
@@ -105,40 +112,39 @@ def adapt(scene: Scene, marking: str = "dorfler", theta: float = 0.5, steps: int
                            allow_large)
     budget.check(scene.geometry, level, "level", allow_large, method=scene.solver.method)
     mesh = build_mesh(scene.geometry, level)
-    check_formulas(scene, mesh)
     coarse = BoundaryMeshes.for_scene(scene, mesh)
     history = []
     for step in range(steps):
         # SOLVE
-        problem = assemble(scene, mesh, coarse)
-        check_unknowns(problem)
-        solution = solve_problem(problem)
+        solution = solve_on_mesh(scene, mesh, coarse)
         # ESTIMATE
-        indicators = estimate(solution, asymmetry)
-        record = step_record(step, solution, indicators, reference)
+        estimated = estimate(solution, asymmetry)
+        record = step_record(step, solution, estimated, reference)
         history.append(record)
+        last = step == steps - 1
         # MARK
         marked = None
-        if step < steps - 1:
-            start = time.perf_counter()
-            marked = mark(indicators.eta, theta, marking)
+        if not last:
+            with _timed(record, "mark"):
+                marked = mark(estimated.eta, theta, marking)
             record["marked"] = int(marked.sum())
-            record["timings_s"]["mark"] = time.perf_counter() - start
         if on_step is not None:
-            on_step(record, solution, indicators, marked)
-        if marked is None:
+            on_step(record, solution, estimated, marked)
+        if last:
             break
         # REFINE
         _check_refinement_size(scene, mesh, marked, allow_large)
-        start = time.perf_counter()
-        mesh = refine(mesh, marked)
-        coarse = coarse.follow(scene, mesh)
-        record["timings_s"]["refine"] = time.perf_counter() - start
+        with _timed(record, "refine"):
+            mesh, coarse = refine_with_boundary(scene, mesh, coarse, marked)
     return history
 
 
-MARKINGS = ("max", "fraction", "dorfler")
-ASYMMETRY_NORMS = ("hdiv", "l2")
+@contextmanager
+def _timed(record: dict, phase: str) -> Iterator[None]:
+    """Record the wall time of the block as ``record["timings_s"][phase]``."""
+    start = time.perf_counter()
+    yield
+    record["timings_s"][phase] = time.perf_counter() - start
 
 
 def _check_adapt_arguments(scene, marking, theta, steps, level, asymmetry, reference, on_step,
@@ -146,9 +152,9 @@ def _check_adapt_arguments(scene, marking, theta, steps, level, asymmetry, refer
     """A SceneError (SceneTypeError for a wrong type) naming the first bad argument."""
     ensure_valid(scene)
     check_level(level, "level", optional=True)
-    if marking not in MARKINGS:
+    if marking not in STRATEGIES:
         raise SceneError("marking", f"unknown marking {marking!r}; use one of "
-                                    + ", ".join(MARKINGS))
+                                    + ", ".join(STRATEGIES))
     if isinstance(theta, bool) or not isinstance(theta, (int, float)):
         raise SceneTypeError("theta", f"must be a number in [0, 1], got {theta!r}")
     if not 0 <= theta <= 1:
@@ -183,16 +189,18 @@ def _check_refinement_size(scene: Scene, mesh: ngs.Mesh, marked: np.ndarray,
                                   "pass --allow-large (allow_large=True)")
 
 
-def step_record(step: int, solution: Solution, indicators: Estimate,
+def step_record(step: int, solution: Solution, estimated: Estimate,
                 reference: dict | None = None) -> dict:
     """The history entry of one adaptive step (plain JSON-serialisable data).
 
-    ``estimator`` is eta = (sum_T eta_{tot,T}^2)^{1/2} of (4.50); ``estimator_terms[k]`` is
-    (sum_T term_k,T)^{1/2}, so ``estimator``^2 is the sum of their squares;
-    ``estimator_sum`` is sum_T eta_{tot,T} (the eta_tot of Table 4.4); ``warnings`` lists
-    the physics checks the step's solution fails (:mod:`ngdual.checks`). (The records of
-    ngdual < 0.2 called these ``eta``, ``eta_sum``, ...; ``eta`` is the rotation's name in
-    ``norms``. :func:`ngdual.studies.sweep.records.estimator` reads both.)
+    ``estimator`` is the estimate (sum_T eta_{tot,T}^2)^{1/2} of (4.50);
+    ``estimator_terms[k]`` is (sum_T term_k,T)^{1/2}, so ``estimator``^2 is the sum of their
+    squares; ``estimator_sum`` is sum_T eta_{tot,T} (the eta_tot of Table 4.4) and
+    ``estimator_max`` the largest indicator. ``norms`` are those of Tables 3.2/3.3, where
+    ``eta`` is the rotation. ``warnings`` lists the physics checks the step's solution
+    fails (:mod:`ngdual.checks`). With ``reference`` (the norms of the exact solution):
+    ``errors``, ``e_tot`` of (3.124) and the effectivity indices ``estimator`` / e_tot and
+    ``estimator_sum`` / e_tot.
     """
     pb = solution.problem
     mesh = pb.fes.mesh
@@ -201,29 +209,29 @@ def step_record(step: int, solution: Solution, indicators: Estimate,
     record = {
         "step": step,
         "elements": mesh.ne,
-        "h_min": float(indicators.h.min()),
-        "h_max": float(indicators.h.max()),
+        "h_min": float(estimated.h.min()),
+        "h_max": float(estimated.h.max()),
         "dofs": {**dofs, "total": int(sum(dofs.values()))},
         "converged": bool(solution.converged),
         "iterations": {k: int(v) for k, v in solution.iterations.items()},
-        "estimator": indicators.total,
-        "estimator_sum": indicators.total_sum,
-        "estimator_max": float(indicators.eta.max()),
-        "estimator_terms": {k: float(np.sqrt(v)) for k, v in indicators.summed().items()},
-        "asymmetry_norm": indicators.asymmetry,
+        "estimator": estimated.total,
+        "estimator_sum": estimated.total_sum,
+        "estimator_max": float(estimated.eta.max()),
+        "estimator_terms": {k: float(np.sqrt(v)) for k, v in estimated.summed().items()},
+        "asymmetry_norm": estimated.asymmetry,
         "norms": norms(solution),
         "warnings": [asdict(w) for w in solution.warnings],
         "marked": 0,
         "timings_s": {"assemble": float(timings.get("assemble", pb.assemble_seconds)),
                       "solve": float(timings.get("factorize", 0.0) + timings.get("condense", 0.0)
                                        + timings.get("solve", 0.0)),
-                      "estimate": indicators.seconds, "mark": 0.0, "refine": 0.0},
+                      "estimate": estimated.seconds, "mark": 0.0, "refine": 0.0},
     }
     if reference is not None:
         errors, e_tot = total_error(record["norms"], reference)
         record.update(errors=errors, e_tot=e_tot,
-                      effectivity=indicators.total / e_tot if e_tot > 0 else None,
-                      effectivity_sum=indicators.total_sum / e_tot if e_tot > 0 else None)
+                      effectivity=estimated.total / e_tot if e_tot > 0 else None,
+                      effectivity_sum=estimated.total_sum / e_tot if e_tot > 0 else None)
     return record
 
 

@@ -44,11 +44,11 @@ BLAS_THREADS = 1
 DIVERGENCE_FACTOR = 1e6
 
 # Clarabel (interior point, through cvxpy) to the accuracy of double precision: the QPs
-# either are the reference the iterative solvers are checked against to 1e-8 and below,
-# or start a polish on the active set they find.
+# either are the independent solver the iterative ones are checked against to 1e-8 and
+# below, or start a polish on the active set they find.
 CLARABEL_TOLERANCES = {"tol_gap_abs": 1e-12, "tol_gap_rel": 1e-12, "tol_feas": 1e-12}
-# the reference QP of the whole discrete problem: also the KKT ratio and a step bound
-CLARABEL_REFERENCE = {**CLARABEL_TOLERANCES, "tol_ktratio": 1e-10, "max_iter": 500}
+# the QP of the whole discrete problem (ngdual.solvers.qp): also the KKT ratio and a step bound
+CLARABEL_WHOLE_PROBLEM = {**CLARABEL_TOLERANCES, "tol_ktratio": 1e-10, "max_iter": 500}
 
 # Relative change of F at which the Coulomb fixed point of the active-set solver stops
 # (it also stops where the change stagnates at its round-off level).

@@ -3,7 +3,7 @@ solution of (3.62) that the thesis' Uzawa algorithms converge to, on every shipp
 
 Reference: Algorithm 3.38 / nested Uzawa (Algorithm 3.41, Remark 3.45) at tight tolerances;
 where nested Uzawa stagnates (a Coulomb bound made of round-off on a separated Gamma_C,
-h^ = h~ with g = 0 ...) the independent QP solver of :mod:`ngdual.solvers.reference`.
+h^ = h~ with g = 0 ...) the independent QP solver of :mod:`ngdual.solvers.qp`.
 Where h^ = h~ and the contact zone reaches the ends of Gamma_C, nu is not unique
 (Lemma 3.29), sigma is: only sigma (and F) are compared there.
 """
@@ -25,7 +25,7 @@ from ngdual.solvers import solve_problem, solve_scene
 from ngdual.solvers.active_set import active_set_solve
 from ngdual.solvers.cholesky import SchurCholesky
 from ngdual.solvers.hybrid import HybridSystem
-from ngdual.solvers.reference import solve_qp_friction
+from ngdual.solvers.qp import solve_qp_friction
 from ngdual.solvers.result import ConvergenceError
 from ngdual.solvers.semismooth import EPS, SAFETY, kkt_residuals, semismooth_newton
 from ngdual.solvers.settings import ActiveSetSettings, Model, UzawaSettings

@@ -17,7 +17,7 @@ from ngdual.mesh import build_mesh
 from ngdual.quantities import norms
 from ngdual.scene import load_scene
 from ngdual.solvers import solve_problem
-from ngdual.solvers.reference import solve_qp_friction
+from ngdual.solvers.qp import solve_qp_friction
 from ngdual.solvers.settings import Model
 
 RTOL = 1e-5

@@ -13,7 +13,7 @@ from ngdual.mesh import build_mesh
 from ngdual.quantities import norms
 from ngdual.scene import load_scene
 from ngdual.solvers import solve_problem, solve_scene
-from ngdual.solvers.reference import solve_qp_friction
+from ngdual.solvers.qp import solve_qp_friction
 from ngdual.solvers.result import ConvergenceError
 from ngdual.solvers.settings import Model
 

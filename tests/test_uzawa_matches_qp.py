@@ -16,7 +16,7 @@ from ngdual.forms import assemble
 from ngdual.mesh import build_mesh
 from ngdual.quantities import norms
 from ngdual.scene import load_scene
-from ngdual.solvers.reference import solve_qp
+from ngdual.solvers.qp import solve_qp
 from ngdual.solvers.settings import Model, UzawaSettings
 from ngdual.solvers.uzawa import uzawa
 

@@ -54,7 +54,7 @@ from ngdual.forms import assemble
 from ngdual.mesh import build_mesh
 from ngdual.solvers.linear import solve_linear
 from ngdual.solvers.projections import NonnegativeProjection, metric_matrix
-from ngdual.solvers.reference import solve_qp
+from ngdual.solvers.qp import solve_qp
 from ngdual.solvers.settings import Model, UzawaSettings
 from ngdual.solvers.uzawa import uzawa
 from ngdual.studies.tutorials import Lesson

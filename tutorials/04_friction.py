@@ -52,7 +52,7 @@ from ngdual.forms import assemble
 from ngdual.friction import build_friction_forms
 from ngdual.mesh import build_mesh
 from ngdual.solvers.nested import nested_uzawa
-from ngdual.solvers.reference import solve_qp_friction
+from ngdual.solvers.qp import solve_qp_friction
 from ngdual.solvers.settings import Model, NestedUzawaSettings
 from ngdual.studies.tutorials import Lesson
 

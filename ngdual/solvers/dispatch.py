@@ -1,5 +1,9 @@
 """Solve a scene: build only what it calls for, then run the matching algorithm.
 
+:func:`solve_scene` meshes a scene on a level; :func:`solve_on_mesh` is the SOLVE step on
+any mesh (the adaptive loop's too); :func:`solve_problem` runs the algorithm the settings
+call for:
+
 ``solver.method = "uzawa"`` (the thesis' algorithms):
 
 no contact boundary  -> one linear saddle-point solve
@@ -18,9 +22,11 @@ import time
 import warnings
 from collections.abc import Callable
 
+import ngsolve as ngs
 import numpy as np
 
 from .. import budget, checks
+from ..boundary import BoundaryMeshes
 from ..forms import DiscreteProblem, assemble
 from ..mesh import build_mesh
 from ..quadrature_check import check_formulas
@@ -44,19 +50,18 @@ def solve_scene(scene: Scene, level: int | None = None,
                 progress: Callable[[int, float], None] | None = None,
                 allow_large: bool = False,
                 status: Callable[[str], None] | None = None) -> Solution:
-    """Mesh, assemble and solve ``scene`` on ``level`` (default: the scene's level).
+    """Mesh ``scene`` on ``level`` (default: the scene's level) and solve it there.
 
     The scene is validated (once: a scene from :func:`ngdual.scene.load_scene` is not
-    checked again unless it was changed), the size of the mesh is estimated and refused
+    checked again unless it was changed) and the size of the mesh is estimated and refused
     if it would not fit in memory (``allow_large=True`` tries anyway,
-    :mod:`ngdual.budget`), and the formulas are checked on the mesh before assembly
-    (:mod:`ngdual.quadrature_check`). Bad input raises :class:`ngdual.scene.SceneError`
-    naming the argument or field; a solve that fails raises
-    :class:`ngdual.solvers.result.ConvergenceError`. ``progress(iteration, increment)`` is
-    called after every iteration of the contact solver, ``status(phase)`` when a phase
-    begins (meshing, assembling, factorising and solving), e.g. for a progress display.
-    Every failed physics check (``solution.warnings``, :mod:`ngdual.checks`) is
-    also issued as a Python warning of category
+    :mod:`ngdual.budget`); then :func:`solve_on_mesh` solves. Bad input raises
+    :class:`ngdual.scene.SceneError` naming the argument or field; a solve that fails
+    raises :class:`ngdual.solvers.result.ConvergenceError`. ``progress(iteration,
+    increment)`` is called after every iteration of the contact solver, ``status(phase)``
+    when a phase begins (meshing, assembling, factorising and solving), e.g. for a
+    progress display. Every failed physics check (``solution.warnings``,
+    :mod:`ngdual.checks`) is also issued as a Python warning of category
     :class:`~ngdual.solvers.result.PhysicsWarning`, so a notebook shows it.
     """
     start = time.perf_counter()
@@ -68,21 +73,54 @@ def solve_scene(scene: Scene, level: int | None = None,
     if not isinstance(allow_large, bool):
         raise SceneTypeError("allow_large", f"must be True or False, got {allow_large!r}")
     budget.check(scene.geometry, level, "level", allow_large, method=scene.solver.method)
-    status = status or (lambda phase: None)
     level = scene.geometry.level if level is None else level
-    status(f"meshing level {level}")
+    if status is not None:
+        status(f"meshing level {level}")
     mesh = build_mesh(scene.geometry, level)
-    check_formulas(scene, mesh)
-    status(f"assembling on {mesh.ne} triangles")
-    problem = assemble(scene, mesh)
-    problem.level = level
-    check_unknowns(problem)
-    status(f"factorising and solving, {problem.fes.ndof} unknowns")
-    solution = solve_problem(problem, solver_settings(scene), progress)
+    solution = solve_on_mesh(scene, mesh, level=level, progress=progress, status=status)
     solution.timings["total"] = time.perf_counter() - start
     for found in solution.warnings:
         warnings.warn(found.message, PhysicsWarning, stacklevel=2)
     return solution
+
+
+def solve_on_mesh(scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes | None = None, *,
+                  level: int | None = None, settings: Settings | None = None,
+                  progress: Callable[[int, float], None] | None = None,
+                  status: Callable[[str], None] | None = None) -> Solution:
+    """The SOLVE step on a given mesh: assemble (3.62) for a valid ``scene`` and solve it.
+
+    The formulas are checked on the mesh's quadrature points before assembly
+    (:mod:`ngdual.quadrature_check`), coarse boundary meshes that leave a multiplier without
+    unknowns are refused (:func:`check_unknowns`), and :func:`solve_problem` runs the
+    algorithm and the physics checks. :func:`solve_scene` and the adaptive loop
+    (:func:`ngdual.afem.adapt`) both solve through here.
+
+    Parameters
+    ----------
+    scene : Scene
+        A validated scene (:func:`ngdual.scene.ensure_valid`).
+    mesh : ngsolve.Mesh
+    coarse : BoundaryMeshes, optional
+        The h~/h^ meshes on ``mesh`` (default: built for the mesh); the adaptive loop
+        passes those that followed the refinement.
+    level : int, optional
+        The level ``mesh`` was built on (None for a locally refined mesh): recorded as
+        ``problem.level`` and named in the error messages.
+    settings : Settings, optional
+        Default :func:`~ngdual.solvers.settings.solver_settings` of ``scene``.
+    progress, status : callable, optional
+        As for :func:`solve_scene`.
+    """
+    check_formulas(scene, mesh)
+    if status is not None:
+        status(f"assembling on {mesh.ne} triangles")
+    problem = assemble(scene, mesh, coarse)
+    problem.level = level
+    check_unknowns(problem)
+    if status is not None:
+        status(f"factorising and solving, {problem.fes.ndof} unknowns")
+    return solve_problem(problem, settings, progress)
 
 
 def check_unknowns(problem: DiscreteProblem) -> None:
@@ -93,8 +131,7 @@ def check_unknowns(problem: DiscreteProblem) -> None:
     traction condition would silently not be imposed.
     """
     scene, dofs = problem.scene, problem.spaces.dofs()
-    level = getattr(problem, "level", None)
-    mesh = f"level {level}" if level is not None else "this mesh"
+    mesh = "this mesh" if problem.level is None else f"level {problem.level}"
     factor = scene.contact.htilde_factor
     for key, role, name in (("C", "contact", "lambda on Gamma_C"),
                             ("N", "neumann", "phi on Gamma_N")):

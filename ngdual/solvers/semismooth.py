@@ -41,7 +41,7 @@ smooth, not differentiable, so there is no global convergence proof, and along a
 direction it can grow at once (a multiplier nu far beyond [-1, 1] on a stick edge that must
 slip): then (alpha < ``MIN_STEP``) a full step is taken again, at most ``MAX_ESCAPES``
 times. Failing all that (or after ``max_iter`` steps) the problem is solved as the convex QP
-it is (:func:`ngdual.solvers.reference.contact_qp`), and the same iteration restarts from the
+it is (:func:`ngdual.solvers.qp.contact_qp`), and the same iteration restarts from the
 QP's solution (one or two steps to round-off). Measured on 500 random problems (200 of them
 with Tresca bounds varying by 1e3 between edges, a third of those with duplicated rows of Q_F,
 as for h^ = h~): the QP was needed for 5 of the 433 without duplicated rows (full steps and QP
@@ -67,7 +67,7 @@ import scipy.linalg.lapack as lapack
 import scipy.optimize as spo
 
 from ..tolerances import friction_vanishes
-from .reference import contact_qp
+from .qp import contact_qp
 from .result import ConvergenceError
 
 EPS = float(np.finfo(float).eps)

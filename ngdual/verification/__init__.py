@@ -10,7 +10,9 @@ observed orders (:func:`manufactured_study`, :func:`convergence_orders`,
 punch, a blunt wedge, Cattaneo-Mindlin); :mod:`ngdual.verification.traction`: the discrete
 pressure and shear traction on Gamma_C and their errors against them
 (:func:`traction_profile`, :func:`pressure_errors`, :func:`traction_errors`);
-:mod:`ngdual.verification.corner`: Williams' L-shaped corner problem.
+:mod:`ngdual.verification.corner`: Williams' L-shaped corner problem;
+:mod:`ngdual.verification.overkill`: where no exact solution is known, true errors against a
+solve several levels finer, from the plain arrays both are sampled to.
 :mod:`ngdual.verification.contact_benchmarks`: those errors per level on the shipped contact
 scenes, adaptive runs and the finite-box study; :mod:`ngdual.verification.report`: the
 tables of ``ngdual verify``.

@@ -77,7 +77,7 @@ def true_error_study(ctx: Context, problem: str) -> dict:
     Richardson check per measure.
     """
     from ...scene import load_scene
-    from ...verification.reference import true_errors
+    from ...verification.overkill import true_errors
 
     tp = TRUTH_PROBLEMS[problem]
     below, top = reference_tasks(ctx.plan, problem)

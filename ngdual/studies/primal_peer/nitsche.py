@@ -334,4 +334,4 @@ def solve_primal(mesh: ngs.Mesh, *, E: float, nu: float, dirichlet, neumann=(), 
 
 
 # --------------------------------------------------------------------------------------------
-# An ngdual scene solved by the peer, as the sample arrays of ngdual.verification.reference
+# An ngdual scene solved by the peer, as the sample arrays of ngdual.verification.overkill

@@ -51,12 +51,12 @@ def solve_scene_primal(scene, level: int, order: int, **kw) -> tuple[PrimalResul
 
 
 def primal_samples(scene, result: PrimalResult, subdivisions: int = 1) -> dict:
-    """The peer's solution as sample arrays (:mod:`ngdual.verification.reference`): sigma
+    """The peer's solution as sample arrays (:mod:`ngdual.verification.overkill`): sigma
     and u at the P2 nodes of every triangle (exact for P1 and P2), and the pressure at
     3-point Gauss points of every Gamma_C edge split into ``subdivisions`` parts (``p_x``,
     ``p_w``, ``p``), so that each part lies in one edge of a reference ``log2(subdivisions)``
     levels finer."""
-    from ...verification.reference import element_samples, gauss_samples
+    from ...verification.overkill import element_samples, gauss_samples
 
     lam, mu = scene.material.lame
     mesh = result.u.space.mesh

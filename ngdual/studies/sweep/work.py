@@ -47,7 +47,7 @@ def solve_task(scene: str, level: int, overrides: list[str] = (), fields: bool =
     ``seconds``, not part of ``timings_s``; read it with
     :func:`~ngdual.studies.sweep.records.estimator`). With ``fields=True`` the arrays hold what the
     figures of Section 3.4 plot (:func:`field_arrays`); with ``samples=True`` the solution
-    as the arrays of :func:`ngdual.verification.reference.solution_samples` (true errors).
+    as the arrays of :func:`ngdual.verification.overkill.solution_samples` (true errors).
     """
     from ...estimator import estimate
     from ...post import result_record
@@ -65,7 +65,7 @@ def solve_task(scene: str, level: int, overrides: list[str] = (), fields: bool =
                            "seconds": indicators.seconds}
     arrays = field_arrays(solution) if fields else {}
     if samples:
-        from ...verification.reference import solution_samples
+        from ...verification.overkill import solution_samples
 
         arrays.update(solution_samples(solution))
     return record, arrays
@@ -100,7 +100,7 @@ def adapt_task(scene: str, marking: str, theta: float, steps: int, level: int,
     meshes of the steps in ``snapshots`` are kept as arrays ``points_<k>``,
     ``triangles_<k>`` and ``marked_<k>``. A ConvergenceError keeps the steps done.
     With ``samples=True`` every step's solution is kept as the arrays of
-    :func:`ngdual.verification.reference.solution_samples`, prefixed ``s<k>_``; the run stops
+    :func:`ngdual.verification.overkill.solution_samples`, prefixed ``s<k>_``; the run stops
     after the first step whose mesh has at least ``max_elements`` triangles.
     """
     from ...afem import adapt
@@ -129,7 +129,7 @@ def adapt_task(scene: str, marking: str, theta: float, steps: int, level: int,
             arrays[f"marked_{k}"] = (np.zeros(mesh.ne, bool) if marked is None
                                      else np.asarray(marked, bool))
         if samples:
-            from ...verification.reference import solution_samples
+            from ...verification.overkill import solution_samples
 
             arrays.update({f"s{k}_{n}": v for n, v in solution_samples(solution).items()})
         history.append(dict(record))

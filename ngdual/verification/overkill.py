@@ -1,7 +1,7 @@
-"""True errors against a reference solution: an overkill solve, or any finer nested one.
+"""True errors against an overkill solve, or any finer nested one.
 
 Where no exact solution is known, the error of a discrete solution is measured against a
-solve several uniform levels finer (the *reference*). Both are reduced to plain arrays,
+solve several uniform levels finer (the overkill solution, the *reference* of the error). Both are reduced to plain arrays,
 so that solves in different processes (a sweep's records) can be compared later:
 
 * :func:`element_samples`: the mesh (vertices, triangles) and fields at the six P2 nodes of

@@ -1,4 +1,4 @@
-"""Reference solvers independent of Algorithms 3.38/3.41: the discrete problem as convex QPs.
+"""The discrete problem as convex QPs: a solver independent of Algorithms 3.38/3.41.
 
 The algebraic problem (3.103), i.e. the discrete variational inequality (3.68)
 without friction, is the KKT system of
@@ -36,7 +36,7 @@ import scipy.sparse.linalg as spla
 
 from ..forms import DiscreteProblem
 from ..friction import build_friction_forms, tresca_bound
-from ..tolerances import CLARABEL_REFERENCE, CLARABEL_TOLERANCES
+from ..tolerances import CLARABEL_TOLERANCES, CLARABEL_WHOLE_PROBLEM
 from .result import ConvergenceError, Solution
 from .settings import Model
 
@@ -94,7 +94,7 @@ def _solve_qp(problem: DiscreteProblem, modulus: float,
     equality, contact = lhs == b_s, C_n.T @ z <= 0
     qp = cp.Problem(cp.Minimize(0.5 * cp.quad_form(z, A_s, assume_PSD=True) - g_s @ z),
                     [equality, contact, *constraints])
-    qp.solve(solver=cp.CLARABEL, **CLARABEL_REFERENCE)
+    qp.solve(solver=cp.CLARABEL, **CLARABEL_WHOLE_PROBLEM)
     if z.value is None:
         raise RuntimeError(f"Clarabel returned no solution (status {qp.status!r})")
     # cvxpy's Lagrangian is f + y^T (B^T z - b) + lambda^T C_n^T z, the sign of (3.103)
@@ -115,7 +115,7 @@ def _solve_qp(problem: DiscreteProblem, modulus: float,
     residuals = {**_residuals(A, B, C_n, g, b_nu, x[i_sigma], x[i_mult], x[i_lam]),
                  "polished": float(polished is not None)}
     converged = polished is not None or qp.status == cp.OPTIMAL
-    return Solution(problem, x, converged, "reference-qp", iterations={"outer": 0, "inner": 0},
+    return Solution(problem, x, converged, "qp", iterations={"outer": 0, "inner": 0},
                     residuals=residuals,
                     timings={"assemble": problem.assemble_seconds, "qp": qp_s,
                              "polish": polish_s, "solve": qp_s + polish_s},
@@ -160,7 +160,7 @@ def solve_qp_friction(problem: DiscreteProblem, model: Model, tol: float = 1e-10
             raise ConvergenceError(f"the fixed point on F did not converge in {max_iter} QPs",
                                    history)
     sol.friction_bound, sol.friction_forms = bound, forms
-    sol.method, sol.history = f"reference-qp-{law}", history
+    sol.method, sol.history = f"qp-{law}", history
     sol.iterations = {"outer": len(history), "inner": 0}
     sol.timings["solve"] = time.perf_counter() - start
     return sol
