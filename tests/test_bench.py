@@ -1,9 +1,12 @@
-"""``ngdual bench`` writes one valid record per (case, level, solver): structure, not speed."""
+"""``ngdual bench``: every benchmark prints its table and writes one valid record per row
+with the package versions (structure, not speed), and its numbers are the pipeline's."""
 
 import json
 
+import pytest
+
 from ngdual.cli import main
-from ngdual.studies.bench import CASES, SOLVERS
+from ngdual.studies.bench.limit_ratio import CASES, SOLVERS
 
 RECORD_KEYS = {"case", "scene", "level", "solver", "method", "ndof", "dofs", "converged",
                "iterations", "seconds_assemble", "seconds_total", "seconds_parts",
@@ -13,7 +16,7 @@ RECORD_KEYS = {"case", "scene", "level", "solver", "method", "ndof", "dofs", "co
 
 def test_bench_levels_1_2_3_writes_valid_json(tmp_path, capsys):
     path = tmp_path / "bench.json"
-    assert main(["bench", "--levels", "1", "2", "3", "--json", str(path)]) == 0
+    assert main(["bench", "limit-ratio", "--levels", "1", "2", "3", "--json", str(path)]) == 0
     run = json.loads(path.read_text())
     records = run["records"]
     assert {(r["case"], r["level"], r["solver"]) for r in records} == {
@@ -37,5 +40,57 @@ def test_bench_levels_1_2_3_writes_valid_json(tmp_path, capsys):
 
 
 def test_bench_rejects_unknown_solver(capsys):
-    assert main(["bench", "--levels", "1", "--solvers", "newton"]) == 2
+    assert main(["bench", "limit-ratio", "--levels", "1", "--solvers", "newton"]) == 2
     assert "newton" in capsys.readouterr().err
+
+
+def run_bench(tmp_path, *argv) -> dict:
+    path = tmp_path / "bench.json"
+    assert main(["bench", *argv, "--json", str(path)]) == 0
+    study = json.loads(path.read_text())
+    assert study["benchmark"] == argv[0]
+    assert study["versions"]["ngsolve"] and study["machine"]["cpu_count"]
+    return study
+
+
+def test_levels_solve_each_level_in_its_own_process_as_ngdual_solve_does(tmp_path, capsys):
+    from ngdual.quantities import norms
+    from ngdual.scene import load_scene
+    from ngdual.solvers import solve_scene
+
+    study = run_bench(tmp_path, "levels", "--levels", "1", "2")
+    assert [r["level"] for r in study["records"]] == [1, 2]
+    solution = solve_scene(load_scene("thesis-3.46-frictionless"), 2)
+    expected = {k: v for k, v in norms(solution).items() if v is not None}
+    assert {k: study["records"][1]["norms"][k] for k in expected} == pytest.approx(expected,
+                                                                                   rel=1e-12)
+    assert study["records"][1]["ndof"] == solution.problem.K.shape[0]
+    assert all(r["peak_rss_mb"] > 0 and r["converged"] for r in study["records"])
+    assert "sigma_X" in capsys.readouterr().out
+
+
+def test_estimator_cost_times_the_estimate_and_one_linear_solve(tmp_path):
+    study = run_bench(tmp_path, "estimator-cost", "--levels", "1", "--repeat", "1")
+    (row,) = study["records"]
+    assert row["estimate_s"] > 0 and row["linear_solve_s"] > 0
+    assert row["ratio"] == pytest.approx(row["estimate_s"] / row["linear_solve_s"])
+    assert row["elements"] == 32
+
+
+def test_infsup_constants_of_the_thesis_example_match_the_readme(tmp_path):
+    study = run_bench(tmp_path, "infsup", "--scenes", "thesis-3.46-frictionless",
+                      "--levels", "1", "2")
+    # the README's table: 0.732 and 0.723 on levels 1 and 2
+    assert [round(r["beta"], 3) for r in study["records"]] == [0.732, 0.723]
+
+
+def test_primal_peer_reports_the_hertz_errors_and_rejects_a_law_without_friction(tmp_path,
+                                                                                  capsys):
+    study = run_bench(tmp_path, "primal-peer", "--levels", "1", "--orders", "1")
+    (row,) = study["records"]
+    assert row["converged"] and row["theta"] == -1.0 and row["gamma0"] == 1.0
+    # P1 on level 1: the contact half-width within 2 % of Hertz's, the force balanced
+    assert row["a_measured"] == pytest.approx(row["a_hertz"], rel=0.02)
+    assert row["reaction"] == pytest.approx(row["force"], rel=0.01)
+    assert main(["bench", "primal-peer", "--law", "tresca"]) == 2
+    assert "--law" in capsys.readouterr().err

@@ -356,11 +356,18 @@ def cli_reference_rst() -> list[str]:
     """``ngdual`` and each subcommand: usage, description and an option table."""
     from ngdual import cli
 
+    def commands(title: str, p: argparse.ArgumentParser, summary: str) -> list[tuple]:
+        """``p`` and its subcommands (``ngdual bench`` has its own), depth first."""
+        sub = next((a for a in p._actions if isinstance(a, argparse._SubParsersAction)), None)
+        if sub is None:
+            return [(title, p, summary)]
+        helps = {choice.dest: choice.help for choice in sub._choices_actions}
+        return [(title, p, summary), *(c for name, q in sub.choices.items()
+                                       for c in commands(f"{title} {name}", q,
+                                                         helps.get(name) or ""))]
+
     top = cli.parser()
-    sub = next(a for a in top._actions if isinstance(a, argparse._SubParsersAction))
-    helps = {choice.dest: choice.help for choice in sub._choices_actions}
-    parsers = [("ngdual", top, top.description or "")]
-    parsers += [(f"ngdual {name}", p, helps.get(name) or "") for name, p in sub.choices.items()]
+    parsers = commands("ngdual", top, top.description or "")
     lines: list[str] = []
     for title, p, summary in parsers:
         lines += [title, "-" * len(title), ""]

@@ -11,8 +11,9 @@ runs the adaptive loop and writes ``DIR/history.json`` plus a mesh (.vol, .png w
 marked triangles shaded) and, with ``--vtk``, a VTK file per step.
 ``ngdual tutorials [--notebooks DIR] [--solutions]`` lists the lecture tutorials or
 writes them as Jupyter notebooks.
-``ngdual bench [--levels ...] [--json FILE]`` times the contact solvers against one
-linear solve of the same matrix (the limit ratio, :mod:`ngdual.studies.bench`).
+``ngdual bench BENCHMARK [--json FILE]`` runs one benchmark of :mod:`ngdual.studies.bench`:
+``limit-ratio`` (the contact solvers against one linear solve of the same matrix),
+``levels``, ``estimator-cost``, ``infsup``, ``primal-peer``.
 ``ngdual verify [--quick] [--json FILE]`` prints the errors against exact solutions with
 observed orders (:mod:`ngdual.verification.report`).
 After the result table ``solve`` prints one ``warning:`` line per failed physics check
@@ -146,25 +147,81 @@ def parser() -> argparse.ArgumentParser:
                     help="also write small copies of a few figures into DIR (docs/gallery "
                          "for the README)")
     fg.set_defaults(func=cmd_figures)
-    be = sub.add_parser("bench", help="contact-solve time / one linear solve, per level and "
-                                      "solver (Example 3.46), JSON with --json",
-                        parents=[sized])
-    be.add_argument("--levels", type=int, nargs="+", default=[1, 2, 3, 4, 5], metavar="LEVEL",
+    be = sub.add_parser("bench", help="benchmarks: the solvers' and the estimator's cost, the "
+                                      "inf-sup constants, the primal peer (a table; JSON with "
+                                      "--json)", parents=[common])
+    bench = be.add_subparsers(dest="benchmark", required=True, metavar="BENCHMARK")
+    json_out = argparse.ArgumentParser(add_help=False)
+    json_out.add_argument("--json", default=None, metavar="FILE",
+                          help="write all records (with package versions and the machine) "
+                               "to FILE, atomically after each one")
+    lr = bench.add_parser("limit-ratio", help="contact-solve time / one linear solve, per "
+                                              "level and solver (Example 3.46)",
+                          parents=[sized, json_out])
+    lr.add_argument("--levels", type=int, nargs="+", default=[1, 2, 3, 4, 5], metavar="LEVEL",
                     help="mesh levels (default: 1 2 3 4 5)")
-    be.add_argument("--cases", nargs="+", default=["thesis-3.46", "thesis-3.46-coulomb"],
+    lr.add_argument("--cases", nargs="+", default=["thesis-3.46", "thesis-3.46-coulomb"],
                     metavar="CASE", help="benchmark cases (default: thesis-3.46 "
                                          "thesis-3.46-coulomb)")
-    be.add_argument("--solvers", nargs="+", default=["uzawa", "uzawa-tuned", "active-set"],
+    lr.add_argument("--solvers", nargs="+", default=["uzawa", "uzawa-tuned", "active-set"],
                     metavar="SOLVER", help="solvers to time (default: uzawa uzawa-tuned "
                                            "active-set)")
-    be.add_argument("--json", default=None, metavar="FILE",
-                    help="write all records (with package versions) to FILE, atomically")
-    be.add_argument("--isolate", choices=["auto", "always", "never"], default="auto",
+    lr.add_argument("--isolate", choices=["auto", "always", "never"], default="auto",
                     help="one process per record for its own peak memory (auto: level >= 4)")
-    be.add_argument("--timeout", type=float, default=None, metavar="S",
+    lr.add_argument("--timeout", type=float, default=None, metavar="S",
                     help="bound on one isolated record (s)")
-    be.add_argument("--blas-threads", type=int, default=1, metavar="N",
+    lr.add_argument("--blas-threads", type=int, default=1, metavar="N",
                     help="BLAS threads for every solver (default 1; 0: the libraries' own)")
+    lv = bench.add_parser("levels", help="one scene per level, each in its own process: "
+                                         "unknowns, iterations, times, peak memory, norms",
+                          parents=[sized, json_out])
+    lv.add_argument("--scene", default="thesis-3.46-frictionless",
+                    help="a TOML scene or a shipped scene (default: thesis-3.46-frictionless)")
+    lv.add_argument("--levels", type=int, nargs="+", default=[1, 2, 3, 4, 5, 6],
+                    metavar="LEVEL", help="mesh levels (default: 1 2 3 4 5 6)")
+    lv.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    dest="overrides", help="override a scene entry, e.g. "
+                                           "--set solver.metric=euclidean")
+    ec = bench.add_parser("estimator-cost", help="the estimator (4.50) against one linear "
+                                                 "solve, per level", parents=[sized, json_out])
+    ec.add_argument("--scene", default="thesis-3.46-frictionless",
+                    help="a TOML scene or a shipped scene (default: thesis-3.46-frictionless)")
+    ec.add_argument("--levels", type=int, nargs="+", default=[1, 2, 3, 4, 5], metavar="LEVEL",
+                    help="mesh levels (default: 1 2 3 4 5)")
+    ec.add_argument("--repeat", type=int, default=3, metavar="N",
+                    help="timed runs per level, the median is kept (default 3)")
+    inf = bench.add_parser("infsup", help="discrete inf-sup constants of the boundary "
+                                          "multipliers phi, lambda_t, lambda_n",
+                           parents=[sized, json_out])
+    inf.add_argument("--scenes", nargs="+", metavar="SCENE",
+                     default=["thesis-3.46-frictionless", "hertz-cylinder", "flat-punch",
+                              "wedge"], help="scenes (default: thesis-3.46-frictionless "
+                                             "hertz-cylinder flat-punch wedge)")
+    inf.add_argument("--levels", type=int, nargs="+", default=[1, 2, 3, 4, 5],
+                     metavar="LEVEL", help="mesh levels (default: 1 2 3 4 5)")
+    inf.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                     dest="overrides", help="override an entry of every scene, e.g. "
+                                            "--set contact.ends=consistent")
+    pp = bench.add_parser("primal-peer", help="the primal Nitsche peer against Hertz or "
+                                              "Cattaneo-Mindlin", parents=[common, json_out])
+    pp.add_argument("--case", default="hertz", choices=["hertz", "cattaneo-mindlin"],
+                    help="Hertz (frictionless) or Cattaneo-Mindlin (default: hertz)")
+    pp.add_argument("--orders", type=int, nargs="+", default=[1, 2], choices=[1, 2],
+                    help="polynomial orders (default: 1 2)")
+    pp.add_argument("--levels", type=int, nargs="+", default=[1, 2, 3, 4, 5], metavar="LEVEL",
+                    help="local refinement levels (default: 1 2 3 4 5)")
+    pp.add_argument("--hc", type=float, default=0.05,
+                    help="contact edge length on level 1 (default 0.05)")
+    pp.add_argument("--thetas", type=float, nargs="+", default=[-1.0], metavar="THETA",
+                    help="Nitsche variants: -1 skew-symmetric, 0 incomplete, 1 symmetric "
+                         "(default: -1)")
+    pp.add_argument("--gammas", type=float, nargs="+", default=[1.0], metavar="GAMMA0",
+                    help="Nitsche penalties gamma0 (default: 1; the gamma study: "
+                         "--thetas -1 0 1 --gammas 0.3 1 3 10 100)")
+    pp.add_argument("--nu", type=float, default=None,
+                    help="Poisson ratio (default: 0.3 for hertz, 0.49 for cattaneo-mindlin)")
+    pp.add_argument("--law", choices=["coulomb", "tresca"], default=None,
+                    help="friction law of cattaneo-mindlin (default: coulomb)")
     be.set_defaults(func=cmd_bench)
     ve = sub.add_parser("verify", help="errors against exact solutions: manufactured contact "
                                        "problems and the Hertz, flat-punch and "

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import re
 import sys
 from pathlib import Path
 
@@ -51,54 +52,128 @@ def cmd_figures(args) -> int:
 
 
 def cmd_bench(args) -> int:
-    """Limit ratios of the contact solvers (ngdual.studies.bench): table on stdout, JSON
-    with --json."""
-    from .. import budget
-    from ..io import check_output_file, write_json
-    from ..scene import Geometry
-    from ..studies.bench import CASES, SOLVERS, bench, summary_rows
+    """One benchmark of :mod:`ngdual.studies.bench`: its table on stdout, row by row, and
+    with --json its records (package versions, machine) in FILE, rewritten after each row."""
+    from importlib import import_module
 
-    for flag, values, known in (("--cases", args.cases, CASES), ("--solvers", args.solvers,
-                                                                  SOLVERS)):
-        for value in values:
-            if value not in known:
-                raise SceneError(flag, f"unknown {flag[2:-1]} {value!r}; use one of "
-                                       + ", ".join(known))
+    from ..io import check_output_file, write_json
+
+    module = import_module(f"..studies.bench.{args.benchmark.replace('-', '_')}", __package__)
+    settings = BENCH_SETTINGS[args.benchmark](args)
+    if args.json:
+        check_output_file(args.json, "--json")
+    columns = (module.COLUMNS[settings["case"]] if isinstance(module.COLUMNS, dict)
+               else module.COLUMNS)
+    print(" ".join(_cell(title, spec) for title, _, spec in columns))
+
+    def on_record(study: dict) -> None:
+        if args.json:
+            write_json(study, args.json)
+        print(_row(columns, study["records"][-1]), flush=True)
+
+    study = module.run(**settings, on_record=on_record)
+    if args.json:
+        write_json(study, args.json)
+        print(f"wrote {args.json}")
+    converged = all(r.get("converged", True) for r in study["records"])
+    return 0 if converged else EXIT_NOT_CONVERGED
+
+
+def _cell(value, spec: str) -> str:
+    """``value`` in the column format ``spec``; a title or a missing value (``-``) in a
+    numeric column is aligned right."""
+    if value is None or isinstance(value, str) and not spec.endswith("s"):
+        width = re.match(r"\d*", spec).group() or "0"
+        return format("-" if value is None else value, f">{width}")
+    return format(value, spec)
+
+
+def _row(columns, record: dict) -> str:
+    """One record as a table row; a failed record says so after the row."""
+    cells = []
+    for _, key, spec in columns:
+        value = record
+        for part in key.split("."):
+            value = value.get(part) if isinstance(value, dict) else None
+        cells.append(_cell(value, spec))
+    line = " ".join(cells)
+    if record.get("converged") is False:
+        line += "  NOT CONVERGED" + (f": {record['error']}" if record.get("error") else "")
+    return line
+
+
+def _known(flag: str, values, known) -> None:
+    for value in values:
+        if value not in known:
+            raise SceneError(flag, f"unknown {flag[2:].rstrip('s')} {value!r}; use one of "
+                                   + ", ".join(known))
+
+
+def _sized_levels(args, scene_names, methods=("auto",)) -> list[int]:
+    """``--levels`` checked as levels and against the memory the machine has, for every
+    scene of ``scene_names`` and solver method of ``methods``."""
+    from .. import budget
+    from ..scene import load_scene
+
     levels = level_flags(args.levels, "--levels")
+    for name in scene_names:
+        geometry = load_scene(name, getattr(args, "overrides", [])).geometry
+        for level in levels:
+            for method in methods:
+                budget.check(geometry, level, "--levels", args.allow_large, method=method)
+    return levels
+
+
+def _limit_ratio_settings(args) -> dict:
+    from ..studies.bench.limit_ratio import CASES, SOLVERS
+
+    _known("--cases", args.cases, CASES)
+    _known("--solvers", args.solvers, SOLVERS)
     if args.timeout is not None:
         number_flag(args.timeout, "--timeout", 1e-3, 1e7)
     number_flag(args.blas_threads, "--blas-threads", 0, 1024, integer=True)
-    if args.json:
-        check_output_file(args.json, "--json")
-    methods = {"active-set" if s == "active-set" else "uzawa" for s in args.solvers}
-    for level in levels:
-        for method in methods:
-            budget.check(Geometry(), level, "--levels", args.allow_large, method=method)
-    header = (f"{'case':20s} {'lvl':>3} {'solver':12s} {'unknowns':>9} {'assemble':>8} "
-              f"{'linear':>8} {'contact':>8} {'ratio':>6} {'r_fast':>6} {'outer':>6} "
-              f"{'inner':>6} {'RSS MB':>7}")
-    print(header)
+    methods = sorted({"active-set" if s == "active-set" else "uzawa" for s in args.solvers})
+    return {"levels": _sized_levels(args, [CASES[c] for c in args.cases], methods),
+            "cases": args.cases, "solvers": args.solvers, "isolate": args.isolate,
+            "timeout": args.timeout, "blas_threads": args.blas_threads or None}
 
-    def on_record(run):
-        if args.json:
-            write_json(run, args.json)
-        row = summary_rows({"records": run["records"][-1:]})[0]
-        if row["total"] is None:
-            print(f"{row['case']:20s} {row['level']:3d} {row['solver']:12s}  {row['error']}")
-            return
-        print(f"{row['case']:20s} {row['level']:3d} {row['solver']:12s} {row['ndof']:9d} "
-              f"{row['assemble']:8.2f} {row['linear']:8.2f} {row['total']:8.2f} "
-              f"{row['ratio']:6.2f} {row['ratio_fastest']:6.2f} {row['outer']!s:>6} "
-              f"{row['inner']!s:>6} {row['rss']:7.0f}"
-              + ("" if row["converged"] else f"  NOT CONVERGED {row['error'] or ''}"),
-              flush=True)
 
-    run = bench(levels, args.cases, args.solvers, args.isolate, args.timeout, on_record,
-                args.blas_threads or None)
-    if args.json:
-        write_json(run, args.json)
-        print(f"wrote {args.json}")
-    return 0 if all(r["converged"] for r in run["records"]) else EXIT_NOT_CONVERGED
+def _levels_settings(args) -> dict:
+    return {"scene": args.scene, "levels": _sized_levels(args, [args.scene]),
+            "overrides": args.overrides}
+
+
+def _estimator_cost_settings(args) -> dict:
+    number_flag(args.repeat, "--repeat", 1, 1000, integer=True)
+    return {"scene": args.scene, "levels": _sized_levels(args, [args.scene]),
+            "repeat": args.repeat}
+
+
+def _infsup_settings(args) -> dict:
+    return {"scenes": args.scenes, "levels": _sized_levels(args, args.scenes),
+            "overrides": args.overrides}
+
+
+def _primal_peer_settings(args) -> dict:
+    from ..studies.bench.primal_peer import CASES
+
+    _known("--case", [args.case], CASES)
+    if args.law is not None and args.case != "cattaneo-mindlin":
+        raise SceneError("--law", "the friction law is a setting of --case cattaneo-mindlin")
+    number_flag(args.hc, "--hc", 1e-6, 1.0)
+    for gamma0 in args.gammas:
+        number_flag(gamma0, "--gammas", 1e-12, 1e12)
+    physics = {k: v for k, v in (("nu", args.nu), ("law", args.law)) if v is not None}
+    if "nu" in physics:
+        number_flag(args.nu, "--nu", 0.0, 0.5 - 1e-12)
+    return {"case": args.case, "orders": args.orders, "levels": level_flags(args.levels,
+                                                                            "--levels"),
+            "hc": args.hc, "thetas": args.thetas, "gammas": args.gammas, **physics}
+
+
+BENCH_SETTINGS = {"limit-ratio": _limit_ratio_settings, "levels": _levels_settings,
+                  "estimator-cost": _estimator_cost_settings, "infsup": _infsup_settings,
+                  "primal-peer": _primal_peer_settings}
 
 
 def cmd_verify(args) -> int:

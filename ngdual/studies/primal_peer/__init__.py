@@ -1,7 +1,7 @@
 """A primal peer for contact: P1/P2 displacements, Nitsche contact, semismooth Newton.
 
 "The method a user would pick instead" of ngdual's dual-dual mixed method, the independent
-solver of the work-precision study (``ngdual figures``) and of ``benchmarks/primal_peer.py``:
+solver of the work-precision study (``ngdual figures``) and of ``ngdual bench primal-peer``:
 :mod:`~.nitsche` (the discretisation and the Newton solver, :func:`solve_primal`),
 :mod:`~.result` (what it returns), :mod:`~.scenes` (an ngdual scene solved by it),
 :mod:`~.cases` (Hertz and Cattaneo-Mindlin against their half-plane solutions).

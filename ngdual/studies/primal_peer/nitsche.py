@@ -35,8 +35,8 @@ theta and gamma0: the defaults are theta = -1 (skew-symmetric) and gamma0 = 1.
   higher for nu = 0.49 (the Cattaneo-Mindlin case) than for nu = 0.3.
 * gamma0 small, because with a curved gap the penalty term is inconsistent at the discrete level by
   beta (I_h g - g) ~ gamma0 E h / (8R) for P1 (u_n can only follow the parabola piecewise
-  linearly), an O(gamma0 h / a) relative pressure error. Measured on Hertz
-  (``benchmarks/primal_peer.py --gamma-study --levels 1 3``): gamma0 = 100 gives P1
+  linearly), an O(gamma0 h / a) relative pressure error. Measured on Hertz (``ngdual bench
+  primal-peer --thetas -1 0 1 --gammas 0.1 0.3 1 3 10 100 --levels 1 3``): gamma0 = 100 gives P1
   pressure errors of 60-110 % (the pressure becomes spikes between the quadrature points,
   whose integral is then 70 % off the Galerkin reaction on level 1), gamma0 = 10 about
   twice the errors of gamma0 = 1, and 0.1 <= gamma0 <= 1 about the same errors with
@@ -63,6 +63,7 @@ from threadpoolctl import threadpool_limits
 
 from ...expr import Expression
 from ...geometry import tangent
+from ...tolerances import BLAS_THREADS
 from .result import ContactEdges, PrimalResult
 
 
@@ -250,7 +251,7 @@ def solve_primal(mesh: ngs.Mesh, *, E: float, nu: float, dirichlet, neumann=(), 
         t1 = time.perf_counter()
         # one BLAS thread: NGSolve's threaded OpenBLAS spin-waits on shared cores (the same
         # UMFPACK factorisation took 0.57 s with one thread and 1.6-3 s without the limit)
-        with threadpool_limits(limits=1):
+        with threadpool_limits(limits=BLAS_THREADS):
             inv = a.mat.Inverse(free, inverse="umfpack")
             du = (inv * res).Evaluate()
         gfu.vec.data -= du

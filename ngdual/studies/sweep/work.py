@@ -206,13 +206,14 @@ def execute(task: Task) -> tuple[dict, dict]:
     from threadpoolctl import threadpool_limits
 
     from ...solvers.result import ConvergenceError
+    from ...tolerances import BLAS_THREADS
 
     started = time.time()
     start = time.perf_counter()
     arrays: dict = {}
     try:
-        # one BLAS thread per task, one task per core: fair timings (see ngdual.studies.bench)
-        with threadpool_limits(limits=1):
+        # one BLAS thread per task, one task per core: fair timings (ngdual.tolerances)
+        with threadpool_limits(limits=BLAS_THREADS):
             record, arrays = TASKS[task.kind](**task.params)
     except ConvergenceError as err:
         record = {"status": "failed", "message": str(err), "history_length": len(err.history)}

@@ -1,4 +1,5 @@
-"""Discrete inf-sup constants of the boundary multiplier spaces (phi on Gamma_N, lambda on Gamma_C).
+"""Discrete inf-sup constants of the boundary multiplier spaces, phi on Gamma_N and lambda on
+Gamma_C (``ngdual bench infsup``).
 
     beta_h = inf_{mu in N_h x C_h x C_h} sup_{tau in X_h} d(mu, tau) / (|mu|_{1/2} ||tau||_{H(div)})
 
@@ -9,14 +10,10 @@ arc-length stiffness against the mass matrix). beta_h^2 is the smallest eigenval
 B^T A^{-1} B against that norm (A the H(div) Gram matrix of X_h, B = K[sigma, multipliers]).
 It must stay bounded away from zero under refinement, with fixed ends (the thesis), with
 free ends next to Gamma_N and at kinks (``contact.ends = "consistent"``).
-
-    python benchmarks/infsup.py --scenes hertz-cylinder flat-punch wedge --levels 1 2 3 4 5
 """
 
 from __future__ import annotations
 
-import argparse
-import json
 import time
 
 import ngsolve as ngs
@@ -25,13 +22,16 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ngdual import peers
-from ngdual.forms import Spaces, assemble
-from ngdual.io import versions
-from ngdual.mesh import build_mesh
-from ngdual.scene import load_scene
+from ... import peers
+from ...forms import Spaces, assemble
+from ...mesh import build_mesh
+from ...scene import load_scene
+from .measure import header
 
 DEFAULT_SCENES = ("thesis-3.46-frictionless", "hertz-cylinder", "flat-punch", "wedge")
+# the table ngdual bench infsup prints: (title, key of a record, format)
+COLUMNS = (("scene", "scene", "28s"), ("ends", "ends", "10s"), ("level", "level", "5d"),
+           ("mult", "multipliers", "6d"), ("X_h", "stresses", "8d"), ("beta_h", "beta", "8.4f"))
 
 
 def hdiv_gram(mesh: ngs.Mesh) -> sp.csr_matrix:
@@ -84,27 +84,14 @@ def infsup(scene, level: int) -> dict:
             "beta": float(np.sqrt(max(beta2, 0.0))), "seconds": time.perf_counter() - start}
 
 
-def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--scenes", nargs="+", default=list(DEFAULT_SCENES))
-    parser.add_argument("--levels", nargs="+", type=int, default=[1, 2, 3, 4, 5])
-    parser.add_argument("--set", action="append", default=[], dest="overrides")
-    parser.add_argument("--json", help="write the table to this file")
-    args = parser.parse_args(argv)
-    rows = []
-    print(f"{'scene':28s} {'ends':10s} {'level':>5s} {'mult':>6s} {'X_h':>8s} {'beta_h':>8s}")
-    for name in args.scenes:
-        scene = load_scene(name, args.overrides)
-        for level in args.levels:
-            row = infsup(scene, level)
-            rows.append(row)
-            print(f"{row['scene']:28s} {row['ends']:10s} {level:5d} {row['multipliers']:6d} "
-                  f"{row['stresses']:8d} {row['beta']:8.4f}", flush=True)
-    if args.json:
-        with open(args.json, "w") as out:
-            json.dump({"rows": rows, "versions": versions()}, out, indent=1)
-    return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())
+def run(scenes=DEFAULT_SCENES, levels=(1, 2, 3, 4, 5), overrides=(), on_record=None) -> dict:
+    """beta_h of every scene of ``scenes`` (with ``overrides``) on every level of ``levels``;
+    ``on_record(study)`` after each record."""
+    study = header("infsup", scenes=list(scenes), overrides=list(overrides))
+    for name in scenes:
+        scene = load_scene(name, list(overrides))
+        for level in levels:
+            study["records"].append(infsup(scene, level))
+            if on_record:
+                on_record(study)
+    return study

@@ -1,4 +1,5 @@
-"""How far each contact solver is from the cost of one linear solve (``ngdual bench``).
+"""How far each contact solver is from the cost of one linear solve (``ngdual bench
+limit-ratio``).
 
 For Example 3.46 without friction (``thesis-3.46``) and with Coulomb friction
 (``thesis-3.46-coulomb``), per level and solver variant, one record with the DOFs, the
@@ -20,32 +21,35 @@ one scale.
 Solver variants: ``uzawa`` (Algorithm 3.38 / nested Uzawa 3.41 with Remark 3.45, the
 scene's default steps rho = rho1 = rho2 = 1), ``uzawa-tuned`` (the steps of ``TUNED``),
 ``active-set`` (:mod:`ngdual.solvers.active_set`), as spelled in
-:data:`ngdual.studies.variants.VARIANTS`. Functions return records; printing and file
-writing are in :mod:`ngdual.cli`.
+:data:`ngdual.studies.variants.VARIANTS`. Every solver runs with ``BLAS_THREADS`` BLAS
+threads (:mod:`ngdual.tolerances`): UMFPACK and CHOLMOD call the first OpenBLAS in the
+process (NGSolve's, threaded), whose spin-waiting threads on cores shared with other
+processes made the same UMFPACK factorisation take 0.8 s or 34 s. Functions return
+records; printing and file writing are in :mod:`ngdual.cli`.
 """
 
 from __future__ import annotations
 
-import json
 import os
-import platform
-import resource
 import subprocess
-import sys
 import time
 
 from threadpoolctl import threadpool_limits
 
-from ..io import versions
-from .variants import TUNED, VARIANTS
+from ...tolerances import BLAS_THREADS
+from ..variants import TUNED, VARIANTS
+from .measure import header, in_fresh_process, peak_rss_mb
 
 CASES = {"thesis-3.46": "thesis-3.46-frictionless", "thesis-3.46-coulomb": "thesis-3.46-coulomb"}
 SOLVERS = ("uzawa", "uzawa-tuned", "active-set")
 ISOLATE_FROM_LEVEL = 4
-# UMFPACK and CHOLMOD call the first OpenBLAS in the process (NGSolve's, threaded); on 2
-# cores shared with other processes its spin-waiting threads made the same UMFPACK
-# factorisation take 0.8 s or 34 s. One thread for every solver keeps the comparison fair.
-BLAS_THREADS = 1
+# the table ngdual bench limit-ratio prints: (title, key of a record, format)
+COLUMNS = (("case", "case", "20s"), ("lvl", "level", "3d"), ("solver", "solver", "12s"),
+           ("unknowns", "ndof", "9d"), ("assemble", "seconds_assemble", "8.2f"),
+           ("linear", "linear_seconds", "8.2f"), ("contact", "seconds_total", "8.2f"),
+           ("ratio", "limit_ratio", "6.2f"), ("r_fast", "limit_ratio_fastest", "6.2f"),
+           ("outer", "iterations.outer", "6d"), ("inner", "iterations.inner", "6d"),
+           ("RSS MB", "peak_rss_mb", "7.0f"))
 _WARM: set = set()
 
 
@@ -62,10 +66,10 @@ def linear_seconds(problem, backend: str) -> dict:
     ``"hybrid-cholesky"`` (hybridisation, static condensation, CHOLMOD, one solve and the
     recovery of sigma and u). Returns the times and, for Cholesky, the factor's nonzeros.
     """
-    from ..solvers.cholesky import SchurCholesky
-    from ..solvers.hybrid import HybridSystem
-    from ..solvers.linear import Factorization
-    from ..solvers.settings import Model
+    from ...solvers.cholesky import SchurCholesky
+    from ...solvers.hybrid import HybridSystem
+    from ...solvers.linear import Factorization
+    from ...solvers.settings import Model
 
     start = time.perf_counter()
     if backend == "umfpack":
@@ -87,17 +91,6 @@ def linear_seconds(problem, backend: str) -> dict:
             "total": end - start, "nnz_factor": nnz}
 
 
-def _peak_rss_mb() -> float:
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
-
-
-def machine() -> dict:
-    """What the timings were measured on (the load average shows other processes)."""
-    return {"processor": platform.processor() or platform.machine(),
-            "cpu_count": os.cpu_count(), "load_average": list(os.getloadavg()),
-            "OPENBLAS_NUM_THREADS": os.environ.get("OPENBLAS_NUM_THREADS")}
-
-
 def run_one(case: str, level: int, solver: str, blas_threads: int | None = BLAS_THREADS,
             warm_up: bool = True) -> dict:
     """Assemble ``case`` on ``level``, time the linear solves and the contact solver.
@@ -106,7 +99,7 @@ def run_one(case: str, level: int, solver: str, blas_threads: int | None = BLAS_
     ``warm_up`` the same record is computed on level 1 first, so that one-time costs
     (imports, code generation) fall on no measurement (once per process).
     """
-    from .. import forms, solvers  # noqa: F401  (loads NGSolve and its BLAS before the limit)
+    from ... import forms, solvers  # noqa: F401  (loads NGSolve and its BLAS before the limit)
 
     with threadpool_limits(limits=blas_threads, user_api="blas"):
         if warm_up and (case, solver) not in _WARM:
@@ -119,12 +112,12 @@ def run_one(case: str, level: int, solver: str, blas_threads: int | None = BLAS_
 
 
 def _measure(case: str, level: int, solver: str) -> dict:
-    from ..forms import assemble
-    from ..mesh import build_mesh
-    from ..quantities import norms
-    from ..scene import load_scene
-    from ..solvers import solve_problem
-    from ..solvers.result import ConvergenceError
+    from ...forms import assemble
+    from ...mesh import build_mesh
+    from ...quantities import norms
+    from ...scene import load_scene
+    from ...solvers import solve_problem
+    from ...solvers.result import ConvergenceError
 
     scene = load_scene(CASES[case], _overrides(solver))
     start = time.perf_counter()
@@ -162,7 +155,7 @@ def _measure(case: str, level: int, solver: str) -> dict:
         "nnz_factor": own["nnz_factor"],
         "residuals": {k: float(v) for k, v in solution.residuals.items()} if solution else {},
         "norms": norms(solution) if solution else None,
-        "peak_rss_mb": _peak_rss_mb(),
+        "peak_rss_mb": peak_rss_mb(),
     }
     return record
 
@@ -170,32 +163,27 @@ def _measure(case: str, level: int, solver: str) -> dict:
 def _run_isolated(case: str, level: int, solver: str, timeout: float | None,
                   blas_threads: int | None) -> dict:
     """:func:`run_one` in a fresh process, so that its peak memory is its own."""
-    cmd = [sys.executable, "-m", "ngdual.studies.bench", case, str(level), solver,
-           str(blas_threads)]
     try:
-        out = subprocess.run(cmd, check=True, capture_output=True, text=True, timeout=timeout)
+        return in_fresh_process("limit_ratio:run_one", timeout, case=case, level=level,
+                                solver=solver, blas_threads=blas_threads)
     except subprocess.TimeoutExpired:
-        return {"case": case, "scene": CASES[case], "level": level, "solver": solver,
-                "converged": False, "error": f"timed out after {timeout} s",
-                "seconds_total": None, "limit_ratio": None, "iterations": None,
-                "peak_rss_mb": None}
+        error = f"timed out after {timeout} s"
     except subprocess.CalledProcessError as err:
-        return {"case": case, "scene": CASES[case], "level": level, "solver": solver,
-                "converged": False, "error": err.stderr.strip().splitlines()[-1:],
-                "seconds_total": None, "limit_ratio": None, "iterations": None,
-                "peak_rss_mb": None}
-    return json.loads(out.stdout.strip().splitlines()[-1])
+        error = err.stderr.strip().splitlines()[-1:]
+    return {"case": case, "scene": CASES[case], "level": level, "solver": solver,
+            "converged": False, "error": error, "seconds_total": None, "limit_ratio": None,
+            "iterations": None, "peak_rss_mb": None}
 
 
-def bench(levels, cases=tuple(CASES), solvers=SOLVERS, isolate: str = "auto",
-          timeout: float | None = None, on_record=None,
-          blas_threads: int | None = BLAS_THREADS) -> dict:
+def run(levels, cases=tuple(CASES), solvers=SOLVERS, isolate: str = "auto",
+        timeout: float | None = None, on_record=None,
+        blas_threads: int | None = BLAS_THREADS) -> dict:
     """All records for ``cases`` x ``levels`` x ``solvers``, with versions and machine.
 
     ``isolate``: ``"always"`` runs every record in its own process (its own peak memory;
     ``peak_rss_scope = "run"``), ``"never"`` runs all in this process (peak memory of the
     process so far, ``"process"``), ``"auto"`` isolates from level ``ISOLATE_FROM_LEVEL``
-    on. ``timeout`` bounds an isolated run. ``on_record(run)`` is called after each record
+    on. ``timeout`` bounds an isolated run. ``on_record(study)`` is called after each record
     with everything so far (for progress and atomic partial output).
     """
     for case in cases:
@@ -203,9 +191,8 @@ def bench(levels, cases=tuple(CASES), solvers=SOLVERS, isolate: str = "auto",
             raise ValueError(f"unknown case {case!r}; use one of {tuple(CASES)}")
     for solver in solvers:
         _overrides(solver)
-    run = {"benchmark": "limit-ratio", "versions": versions(),
-           "machine": {**machine(), "blas_threads": blas_threads}, "tuned": TUNED,
-           "records": []}
+    study = header("limit-ratio", tuned=TUNED)
+    study["machine"]["blas_threads"] = blas_threads
     for case in cases:
         for level in levels:
             for solver in solvers:
@@ -216,30 +203,9 @@ def bench(levels, cases=tuple(CASES), solvers=SOLVERS, isolate: str = "auto",
                 else:
                     record = run_one(case, level, solver, blas_threads)
                 record["peak_rss_scope"] = "run" if isolated else "process"
-                record["versions"] = run["versions"]
-                run["records"].append(record)
+                record["versions"] = study["versions"]
+                study["records"].append(record)
                 if on_record:
-                    on_record(run)
-    run["machine"]["load_average_end"] = list(os.getloadavg())
-    return run
-
-
-def summary_rows(run: dict) -> list[dict]:
-    """One flat row per record for a table."""
-    rows = []
-    for r in run["records"]:
-        its = r.get("iterations") or {}
-        rows.append({"case": r["case"], "level": r["level"], "solver": r["solver"],
-                     "ndof": r.get("ndof"), "assemble": r.get("seconds_assemble"),
-                     "linear": r.get("linear_seconds"), "total": r.get("seconds_total"),
-                     "ratio": r.get("limit_ratio"), "ratio_fastest": r.get("limit_ratio_fastest"),
-                     "outer": its.get("outer"), "inner": its.get("inner"),
-                     "rss": r.get("peak_rss_mb"), "converged": r.get("converged"),
-                     "error": r.get("error")})
-    return rows
-
-
-if __name__ == "__main__":  # child process of _run_isolated
-    case_, level_, solver_, threads_ = sys.argv[1], int(sys.argv[2]), sys.argv[3], sys.argv[4]
-    print(json.dumps(run_one(case_, level_, solver_,
-                             None if threads_ == "None" else int(threads_))))
+                    on_record(study)
+    study["machine"]["load_average_end"] = list(os.getloadavg())
+    return study

@@ -1,1 +1,0 @@
-"""Benchmarks and peer methods (run as scripts or ``python -m benchmarks.NAME``)."""
