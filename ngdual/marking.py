@@ -1,12 +1,12 @@
 """Marking strategies for adaptive refinement: pure functions of the indicators.
 
-Each takes the element indicators eta_T >= 0 (e.g. eta_{tot,T} of (4.50))
-and a parameter theta in [0, 1], and returns a boolean mask of the elements
-to refine. Ties are resolved by value, never by position: two elements with
-the same indicator are either both marked or both not, so the result does not
-depend on the element numbering.
+Each takes the element indicators eta_T >= 0 (e.g. eta_{tot,T} of (4.50),
+``nd.estimate(solution).eta``) and a parameter theta in [0, 1], and returns a
+boolean mask of the elements to refine. Ties are resolved by value, never by
+position: two elements with the same indicator are either both marked or both
+not, so the result does not depend on the element numbering.
 
-* :func:`mark_max` -- the first algorithm of Section 4.2: eta_T >= theta * max eta.
+* :func:`mark_max` -- the first algorithm of Section 4.2: eta_T >= theta max_S eta_S.
 * :func:`mark_fraction` -- the second algorithm of Section 4.2: the theta share
   of the elements with the largest indicators.
 * :func:`mark_dorfler` -- Dörfler's bulk criterion: the smallest set M with
@@ -27,76 +27,93 @@ from .scene import SceneError, SceneTypeError
 STRATEGIES = ("max", "fraction", "dorfler")
 
 
-def _check(eta, theta: float) -> np.ndarray:
-    """``eta`` as an array of floats; a SceneError (SceneTypeError for a wrong type) naming
-    ``eta`` or ``theta`` if they are not indicators and a parameter in [0, 1]."""
+def _check(indicators, theta: float) -> np.ndarray:
+    """``indicators`` as an array of floats; a SceneError (SceneTypeError for a wrong type)
+    naming ``indicators`` or ``theta`` if they are not indicators and a parameter in [0, 1]."""
     wanted = "a 1D array of the element indicators eta_T >= 0 (e.g. nd.estimate(s).eta)"
-    if isinstance(eta, (str, bytes)) or eta is None:
-        raise SceneTypeError("eta", f"must be {wanted}, got {type(eta).__name__}")
+    if isinstance(indicators, (str, bytes)) or indicators is None:
+        raise SceneTypeError("indicators", f"must be {wanted}, got "
+                                           f"{type(indicators).__name__}")
     try:
-        eta = np.asarray(eta, dtype=float)
+        values = np.asarray(indicators, dtype=float)
     except (TypeError, ValueError):
-        raise SceneTypeError("eta", f"must be {wanted}, got {type(eta).__name__}") from None
-    if eta.ndim != 1:
-        raise SceneError("eta", f"must be {wanted}, got shape {eta.shape}")
-    if not np.all(np.isfinite(eta)) or np.any(eta < 0):
-        raise SceneError("eta", f"must be finite and >= 0 ({wanted})")
+        raise SceneTypeError("indicators", f"must be {wanted}, got "
+                                           f"{type(indicators).__name__}") from None
+    if values.ndim != 1:
+        raise SceneError("indicators", f"must be {wanted}, got shape {values.shape}")
+    if not np.all(np.isfinite(values)) or np.any(values < 0):
+        raise SceneError("indicators", f"must be finite and >= 0 ({wanted})")
     if isinstance(theta, bool) or not isinstance(theta, (int, float, np.integer, np.floating)):
         raise SceneTypeError("theta", f"must be a number in [0, 1], got {type(theta).__name__}")
     if not 0 <= theta <= 1:
         raise SceneError("theta", f"must lie in [0, 1], got {theta!r}")
-    return eta
+    return values
 
 
-def mark_max(eta, theta: float) -> np.ndarray:
-    """Mark T where eta_T >= theta * max eta (Section 4.2, first algorithm).
+def mark_max(indicators, theta: float) -> np.ndarray:
+    """Mark T where eta_T >= theta max_S eta_S (Section 4.2, first algorithm).
 
     theta = 0 marks every element, theta = 1 the elements attaining the maximum.
     """
-    eta = _check(eta, theta)
-    if not len(eta):
+    indicators = _check(indicators, theta)
+    if not len(indicators):
         return np.zeros(0, dtype=bool)
-    return eta >= theta * eta.max()
+    return indicators >= theta * indicators.max()
 
 
-def mark_fraction(eta, theta: float) -> np.ndarray:
+def mark_fraction(indicators, theta: float) -> np.ndarray:
     """Mark the ceil(theta * N) elements with the largest indicators (Section 4.2, second).
 
     Elements tied with the smallest marked indicator are marked too, so the
     mask may hold more than ceil(theta * N) elements. theta = 0 marks none,
     theta = 1 all.
     """
-    eta = _check(eta, theta)
-    count = math.ceil(round(theta * len(eta), 9))
+    indicators = _check(indicators, theta)
+    count = math.ceil(round(theta * len(indicators), 9))
     if count == 0:
-        return np.zeros(len(eta), dtype=bool)
-    threshold = np.sort(eta)[::-1][count - 1]
-    return eta >= threshold
+        return np.zeros(len(indicators), dtype=bool)
+    threshold = np.sort(indicators)[::-1][count - 1]
+    return indicators >= threshold
 
 
-def mark_dorfler(eta, theta: float) -> np.ndarray:
+def mark_dorfler(indicators, theta: float) -> np.ndarray:
     """Dörfler marking: a smallest set M with sum_M eta_T^2 >= theta * sum_T eta_T^2.
 
     The elements are taken in decreasing order of eta_T until the bulk is
     reached; elements tied with the last one taken are added as well.
     theta = 0 marks none; theta = 1 marks every element with eta_T > 0.
     """
-    eta = _check(eta, theta)
-    if not len(eta) or theta == 0:
-        return np.zeros(len(eta), dtype=bool)
-    ordered = np.sort(eta)[::-1]
+    indicators = _check(indicators, theta)
+    if not len(indicators) or theta == 0:
+        return np.zeros(len(indicators), dtype=bool)
+    ordered = np.sort(indicators)[::-1]
     bulk = np.cumsum(ordered**2)
     if bulk[-1] == 0:
-        return np.zeros(len(eta), dtype=bool)
+        return np.zeros(len(indicators), dtype=bool)
     # comparing with bulk[-1] (not a separate sum) makes theta = 1 exact in floating point
     count = int(np.searchsorted(bulk, theta * bulk[-1], side="left")) + 1
-    return eta >= ordered[count - 1]
+    return indicators >= ordered[count - 1]
 
 
-def mark(eta, theta: float, strategy: str = "dorfler") -> np.ndarray:
-    """Dispatch to :func:`mark_max`, :func:`mark_fraction` or :func:`mark_dorfler`."""
+def mark(indicators, theta: float, strategy: str = "dorfler") -> np.ndarray:
+    """Mark with one strategy of Section 4.2 (or Dörfler's).
+
+    Parameters
+    ----------
+    indicators : array_like
+        The element indicators eta_T >= 0, e.g. eta_{tot,T} of (4.50).
+    theta : float
+        The strategy's parameter in [0, 1].
+    strategy : {"max", "fraction", "dorfler"}
+        :func:`mark_max`, :func:`mark_fraction` or :func:`mark_dorfler`.
+
+    Returns
+    -------
+    numpy.ndarray of bool
+        The elements to refine.
+    """
     functions = {"max": mark_max, "fraction": mark_fraction, "dorfler": mark_dorfler}
     if not isinstance(strategy, str) or strategy not in functions:
         raise SceneError("strategy", f"unknown marking {strategy!r}; use one of "
                                      + ", ".join(STRATEGIES))
-    return functions[strategy](eta, theta)
+    return functions[strategy](indicators, theta)

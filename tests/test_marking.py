@@ -4,26 +4,29 @@ import numpy as np
 import pytest
 
 from ngdual.marking import mark, mark_dorfler, mark_fraction, mark_max
+from ngdual.scene import SceneError
 
-ETA = np.array([1.0, 3.0, 2.0, 3.0, 0.5, 0.0])
+INDICATORS = np.array([1.0, 3.0, 2.0, 3.0, 0.5, 0.0])
 
 
 def test_max_marks_everything_within_theta_of_the_maximum():
-    np.testing.assert_array_equal(mark_max(ETA, 0.5), [False, True, True, True, False, False])
+    np.testing.assert_array_equal(mark_max(INDICATORS, 0.5),
+                                  [False, True, True, True, False, False])
     # ties with the maximum are all marked, whatever their position
-    np.testing.assert_array_equal(mark_max(ETA, 1.0), [False, True, False, True, False, False])
-    assert mark_max(ETA, 0.0).all()
+    np.testing.assert_array_equal(mark_max(INDICATORS, 1.0),
+                                  [False, True, False, True, False, False])
+    assert mark_max(INDICATORS, 0.0).all()
     assert mark_max(np.zeros(4), 0.7).all()  # all equal: every element attains the maximum
 
 
 def test_fraction_marks_the_theta_share_with_the_largest_indicators():
-    eta = np.array([5.0, 1.0, 4.0, 2.0, 3.0, 0.0, 6.0, 7.0, 8.0, 9.0])
-    marked = mark_fraction(eta, 0.2)
+    indicators = np.array([5.0, 1.0, 4.0, 2.0, 3.0, 0.0, 6.0, 7.0, 8.0, 9.0])
+    marked = mark_fraction(indicators, 0.2)
     np.testing.assert_array_equal(np.flatnonzero(marked), [8, 9])
     # ceil(theta N): 0.25 of 10 elements is 3 elements
-    assert mark_fraction(eta, 0.25).sum() == 3
-    assert not mark_fraction(eta, 0.0).any()
-    assert mark_fraction(eta, 1.0).all()
+    assert mark_fraction(indicators, 0.25).sum() == 3
+    assert not mark_fraction(indicators, 0.0).any()
+    assert mark_fraction(indicators, 1.0).all()
 
 
 def test_fraction_marks_ties_with_the_last_marked_value():
@@ -31,31 +34,31 @@ def test_fraction_marks_ties_with_the_last_marked_value():
     np.testing.assert_array_equal(mark_fraction(np.array([3.0, 1.0, 3.0, 3.0]), 0.25),
                                   [True, False, True, True])
     # ceil(0.2 * 6) = 2: exactly the two elements with 3.0
-    np.testing.assert_array_equal(mark_fraction(ETA, 0.2), [False, True, False, True, False,
+    np.testing.assert_array_equal(mark_fraction(INDICATORS, 0.2), [False, True, False, True, False,
                                                             False])
 
 
 def test_dorfler_takes_the_smallest_set_carrying_theta_of_the_bulk():
-    eta = np.sqrt(np.array([50.0, 30.0, 15.0, 5.0]))  # squares sum to 100
-    np.testing.assert_array_equal(mark_dorfler(eta, 0.5), [True, False, False, False])
-    np.testing.assert_array_equal(mark_dorfler(eta, 0.51), [True, True, False, False])
-    np.testing.assert_array_equal(mark_dorfler(eta, 0.8), [True, True, False, False])
-    np.testing.assert_array_equal(mark_dorfler(eta, 0.9), [True, True, True, False])
+    indicators = np.sqrt(np.array([50.0, 30.0, 15.0, 5.0]))  # squares sum to 100
+    np.testing.assert_array_equal(mark_dorfler(indicators, 0.5), [True, False, False, False])
+    np.testing.assert_array_equal(mark_dorfler(indicators, 0.51), [True, True, False, False])
+    np.testing.assert_array_equal(mark_dorfler(indicators, 0.8), [True, True, False, False])
+    np.testing.assert_array_equal(mark_dorfler(indicators, 0.9), [True, True, True, False])
     # the set is minimal: dropping its smallest element loses the bulk property
     for theta in np.linspace(0.05, 1.0, 20):
-        marked = mark_dorfler(eta, theta)
-        assert np.sum(eta[marked] ** 2) >= theta * np.sum(eta**2) * (1 - 1e-14)
+        marked = mark_dorfler(indicators, theta)
+        assert np.sum(indicators[marked] ** 2) >= theta * np.sum(indicators**2) * (1 - 1e-14)
         smaller = marked.copy()
-        smaller[np.flatnonzero(marked)[np.argmin(eta[marked])]] = False
-        assert np.sum(eta[smaller] ** 2) < theta * np.sum(eta**2)
+        smaller[np.flatnonzero(marked)[np.argmin(indicators[marked])]] = False
+        assert np.sum(indicators[smaller] ** 2) < theta * np.sum(indicators**2)
 
 
 def test_dorfler_limits_and_ties():
-    assert not mark_dorfler(ETA, 0.0).any()
+    assert not mark_dorfler(INDICATORS, 0.0).any()
     # theta = 1 needs every element carrying part of the sum, not the zero one
-    np.testing.assert_array_equal(mark_dorfler(ETA, 1.0), ETA > 0)
+    np.testing.assert_array_equal(mark_dorfler(INDICATORS, 1.0), INDICATORS > 0)
     # 3^2 = 9 of 23.25 already exceeds 0.3 of the bulk; its tie 3.0 comes with it
-    np.testing.assert_array_equal(mark_dorfler(ETA, 0.3), [False, True, False, True, False,
+    np.testing.assert_array_equal(mark_dorfler(INDICATORS, 0.3), [False, True, False, True, False,
                                                            False])
     assert not mark_dorfler(np.zeros(3), 0.5).any()
 
@@ -69,17 +72,23 @@ def test_empty_input_gives_an_empty_mark(strategy):
 @pytest.mark.parametrize("strategy", ["max", "fraction", "dorfler"])
 def test_marks_do_not_depend_on_the_element_numbering(strategy):
     rng = np.random.default_rng(3)
-    eta = rng.choice([0.5, 1.0, 2.0, 4.0], size=40)
+    indicators = rng.choice([0.5, 1.0, 2.0, 4.0], size=40)
     perm = rng.permutation(40)
     for theta in (0.1, 0.3, 0.6, 0.9):
-        np.testing.assert_array_equal(mark(eta, theta, strategy)[perm],
-                                      mark(eta[perm], theta, strategy))
+        np.testing.assert_array_equal(mark(indicators, theta, strategy)[perm],
+                                      mark(indicators[perm], theta, strategy))
 
 
-def test_invalid_input_is_rejected():
+def test_invalid_input_is_rejected_naming_the_argument():
     with pytest.raises(ValueError, match="theta"):
-        mark_max(ETA, 1.5)
-    with pytest.raises(ValueError, match=">= 0"):
-        mark_dorfler(-ETA, 0.5)
+        mark_max(INDICATORS, 1.5)
+    with pytest.raises(SceneError, match=">= 0") as found:
+        mark_dorfler(-INDICATORS, 0.5)
+    assert found.value.field == "indicators"
     with pytest.raises(ValueError, match="unknown marking"):
-        mark(ETA, 0.5, "bulk")
+        mark(INDICATORS, 0.5, "bulk")
+
+
+def test_the_indicators_are_passed_by_their_name():
+    np.testing.assert_array_equal(mark(indicators=INDICATORS, theta=1.0, strategy="max"),
+                                  INDICATORS == INDICATORS.max())
