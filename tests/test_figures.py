@@ -30,8 +30,10 @@ from pathlib import Path
 
 import pytest
 
+from ngdual.afem import adapt
 from ngdual.cli import main
 from ngdual.rates import extrapolated_norms, observed_rates
+from ngdual.scene import load_scene
 from ngdual.studies.figures import Plan, best, errors, markdown_table
 from ngdual.studies.sweep import Task, estimator, execute, load_record, run_task
 
@@ -293,13 +295,13 @@ def test_error_helpers():
     assert "| 1 | - |" in markdown_table([{"a": 1}], {"a": "A", "b": "B"})
 
 
-def test_records_of_the_last_release_still_give_their_estimator():
-    """The estimator is ``estimator`` in this release's records; ``eta`` (the rotation's
-    name) in older ones, which stay readable."""
-    new_solve = {"estimator": {"total": 2.0, "sum": 5.0, "seconds": 0.1}}
-    old_solve = {"estimator": {"eta": 2.0, "eta_sum": 5.0, "seconds": 0.1}}
-    new_step = {"estimator": 2.0, "estimator_sum": 5.0, "norms": {"eta": 7.0}}
-    old_step = {"eta": 2.0, "eta_sum": 5.0, "norms": {"eta": 7.0}}
-    for record in (new_solve, old_solve, new_step, old_step):
-        assert (estimator(record), estimator(record, "sum")) == (2.0, 5.0), record
+def test_a_solve_record_and_an_adaptive_step_hold_the_estimate_under_the_same_keys():
+    """``estimator`` is (sum_T eta_T^2)^(1/2) and ``estimator_sum`` sum_T eta_T in every
+    record; ``eta`` is the rotation's norm."""
+    solve, _ = execute(Task("solve", {"scene": "thesis-3.46-coulomb", "level": 1}))
+    steps = adapt(load_scene("thesis-3.46-coulomb"), steps=1, level=1)
+    for record in (solve, steps[0]):
+        assert isinstance(record["estimator"], float), record
+        assert 0 < estimator(record) <= estimator(record, "sum"), record
+    assert estimator(solve) == estimator(steps[0]) and "eta" in solve["norms"]
     assert estimator({"status": "ok", "ndof": 3}) is None  # the primal peer has none

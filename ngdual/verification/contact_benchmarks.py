@@ -203,7 +203,7 @@ def adaptive_study(name: str, steps: int = 4, level: int = 1, theta: float = 0.5
     ``level`` is the step and ``h`` = N^(-1/2), N the number of unknowns."""
     rows = []
 
-    def on_step(record, solution, indicators, marked):
+    def on_step(record, solution, estimated, marked):
         row = ROWS[name](solution)
         # graded meshes: orders against N^(-1/2), the mesh size of a uniform mesh with N dofs
         rows.append({"benchmark": name, "level": record["step"], **row,

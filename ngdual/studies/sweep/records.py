@@ -12,11 +12,10 @@ tolerance, e.g. at ``solver.max_iter``); ``"failed"`` (it raised a
 three are final. ``"error"`` (any other exception, with its traceback) is kept
 for inspection but counts as unfinished, so the next run tries again.
 
-Record keys: the a posteriori estimator (4.50) is ``estimator`` (``eta`` is the rotation,
-as in the norms); ``warnings`` (in a solve record and in every adaptive or manufactured
-step) lists the physics checks the solution fails (:mod:`ngdual.checks`). Records written
-before this release named the estimator ``eta`` (adaptive steps)
-or ``estimator.eta`` (solves); :func:`estimator` reads both, for one release.
+Record keys: the a posteriori estimate (4.50) is ``estimator`` (sum_T eta_T^2)^(1/2) and
+``estimator_sum`` sum_T eta_T, in a solve record and in an adaptive step alike (``eta`` is
+the rotation, as in the norms); ``warnings`` (in a solve record and in every adaptive or
+manufactured step) lists the physics checks the solution fails (:mod:`ngdual.checks`).
 """
 
 from __future__ import annotations
@@ -32,7 +31,7 @@ from ...io import write_json, write_npz
 
 FINISHED = ("ok", "not-converged", "failed")
 # part of every task id: raise it when what a task writes changes, so old records are not reused
-RECORD_FORMAT = 3
+RECORD_FORMAT = 4
 
 
 @dataclass(frozen=True)
@@ -62,19 +61,14 @@ class Task:
         return "-".join(p for p in parts if p) + "-" + digest
 
 
-_OLD_KEYS = {"total": "eta", "sum": "eta_sum"}
+ESTIMATOR_KEYS = {"total": "estimator", "sum": "estimator_sum"}
 
 
 def estimator(record: dict, key: str = "total") -> float | None:
-    """The estimator (4.50) of a solve record or of an adaptive step: ``key`` ``"total"``
-    is eta = (sum_T eta_T^2)^(1/2), ``"sum"`` is sum_T eta_T. Reads this release's
-    ``estimator`` keys and the ``eta`` / ``eta_sum`` of records written before it."""
-    value = record.get("estimator")
-    if isinstance(value, dict):  # a solve record: {"total", "sum", "seconds"}
-        return value.get(key, value.get(_OLD_KEYS[key]))
-    if "estimator" in record:  # an adaptive step
-        return value if key == "total" else record.get("estimator_sum")
-    return record.get(_OLD_KEYS[key])
+    """The estimate (4.50) of a solve record or of an adaptive step: ``key`` ``"total"``
+    is (sum_T eta_T^2)^(1/2), ``"sum"`` is sum_T eta_T; None for a record without one
+    (the primal peer's)."""
+    return record.get(ESTIMATOR_KEYS[key])
 
 
 def record_path(folder: str | Path, task: Task) -> Path:

@@ -42,12 +42,13 @@ def solve_task(scene: str, level: int, overrides: list[str] = (), fields: bool =
 
     The record keeps the failed physics checks under ``warnings``, as ``result.json`` does.
 
-    The record also holds the a posteriori estimator (4.50) of the solution
-    (``estimator``: ``total`` = (sum_T eta_T^2)^(1/2), ``sum`` = sum_T eta_T and its
-    ``seconds``, not part of ``timings_s``; read it with
-    :func:`~ngdual.studies.sweep.records.estimator`). With ``fields=True`` the arrays hold what the
-    figures of Section 3.4 plot (:func:`field_arrays`); with ``samples=True`` the solution
-    as the arrays of :func:`ngdual.verification.overkill.solution_samples` (true errors).
+    The record also holds the a posteriori estimate (4.50) of the solution under the keys of
+    an adaptive step (:func:`ngdual.afem.step_record`): ``estimator`` = (sum_T eta_T^2)^(1/2),
+    ``estimator_sum`` = sum_T eta_T, and ``estimator_seconds``, the time it took (not part
+    of ``timings_s``, which times the solve as in ``result.json``). With ``fields=True`` the
+    arrays hold what the figures of Section 3.4 plot (:func:`field_arrays`); with
+    ``samples=True`` the solution as the arrays of
+    :func:`ngdual.verification.overkill.solution_samples` (true errors).
     """
     from ...estimator import estimate
     from ...post import result_record
@@ -61,8 +62,8 @@ def solve_task(scene: str, level: int, overrides: list[str] = (), fields: bool =
     record["status"] = _status_of(solution)
     record["ndof"] = int(sum(record["dofs"].values()))
     indicators = estimate(solution)
-    record["estimator"] = {"total": indicators.total, "sum": indicators.total_sum,
-                           "seconds": indicators.seconds}
+    record.update(estimator=indicators.total, estimator_sum=indicators.total_sum,
+                  estimator_seconds=indicators.seconds)
     arrays = field_arrays(solution) if fields else {}
     if samples:
         from ...verification.overkill import solution_samples
