@@ -155,11 +155,19 @@ def parser() -> argparse.ArgumentParser:
     json_out.add_argument("--json", default=None, metavar="FILE",
                           help="write all records (with package versions and the machine) "
                                "to FILE, atomically after each one")
+    one_scene = argparse.ArgumentParser(add_help=False)
+    one_scene.add_argument("--scene", default="thesis-3.46-frictionless",
+                           help="a TOML scene or a shipped scene (default: "
+                                "thesis-3.46-frictionless)")
+
+    def levels_flag(p: argparse.ArgumentParser, last: int = 5) -> None:
+        p.add_argument("--levels", type=int, nargs="+", default=list(range(1, last + 1)),
+                       metavar="LEVEL", help=f"mesh levels (default: 1 ... {last})")
+
     lr = bench.add_parser("limit-ratio", help="contact-solve time / one linear solve, per "
                                               "level and solver (Example 3.46)",
                           parents=[sized, json_out])
-    lr.add_argument("--levels", type=int, nargs="+", default=[1, 2, 3, 4, 5], metavar="LEVEL",
-                    help="mesh levels (default: 1 2 3 4 5)")
+    levels_flag(lr)
     lr.add_argument("--cases", nargs="+", default=["thesis-3.46", "thesis-3.46-coulomb"],
                     metavar="CASE", help="benchmark cases (default: thesis-3.46 "
                                          "thesis-3.46-coulomb)")
@@ -174,20 +182,15 @@ def parser() -> argparse.ArgumentParser:
                     help="BLAS threads for every solver (default 1; 0: the libraries' own)")
     lv = bench.add_parser("levels", help="one scene per level, each in its own process: "
                                          "unknowns, iterations, times, peak memory, norms",
-                          parents=[sized, json_out])
-    lv.add_argument("--scene", default="thesis-3.46-frictionless",
-                    help="a TOML scene or a shipped scene (default: thesis-3.46-frictionless)")
-    lv.add_argument("--levels", type=int, nargs="+", default=[1, 2, 3, 4, 5, 6],
-                    metavar="LEVEL", help="mesh levels (default: 1 2 3 4 5 6)")
+                          parents=[sized, json_out, one_scene])
+    levels_flag(lv, 6)
     lv.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                     dest="overrides", help="override a scene entry, e.g. "
                                            "--set solver.metric=euclidean")
     ec = bench.add_parser("estimator-cost", help="the estimator (4.50) against one linear "
-                                                 "solve, per level", parents=[sized, json_out])
-    ec.add_argument("--scene", default="thesis-3.46-frictionless",
-                    help="a TOML scene or a shipped scene (default: thesis-3.46-frictionless)")
-    ec.add_argument("--levels", type=int, nargs="+", default=[1, 2, 3, 4, 5], metavar="LEVEL",
-                    help="mesh levels (default: 1 2 3 4 5)")
+                                                 "solve, per level",
+                          parents=[sized, json_out, one_scene])
+    levels_flag(ec)
     ec.add_argument("--repeat", type=int, default=3, metavar="N",
                     help="timed runs per level, the median is kept (default 3)")
     inf = bench.add_parser("infsup", help="discrete inf-sup constants of the boundary "
@@ -197,8 +200,7 @@ def parser() -> argparse.ArgumentParser:
                      default=["thesis-3.46-frictionless", "hertz-cylinder", "flat-punch",
                               "wedge"], help="scenes (default: thesis-3.46-frictionless "
                                              "hertz-cylinder flat-punch wedge)")
-    inf.add_argument("--levels", type=int, nargs="+", default=[1, 2, 3, 4, 5],
-                     metavar="LEVEL", help="mesh levels (default: 1 2 3 4 5)")
+    levels_flag(inf)
     inf.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                      dest="overrides", help="override an entry of every scene, e.g. "
                                             "--set contact.ends=consistent")
@@ -208,8 +210,7 @@ def parser() -> argparse.ArgumentParser:
                     help="Hertz (frictionless) or Cattaneo-Mindlin (default: hertz)")
     pp.add_argument("--orders", type=int, nargs="+", default=[1, 2], choices=[1, 2],
                     help="polynomial orders (default: 1 2)")
-    pp.add_argument("--levels", type=int, nargs="+", default=[1, 2, 3, 4, 5], metavar="LEVEL",
-                    help="local refinement levels (default: 1 2 3 4 5)")
+    levels_flag(pp)
     pp.add_argument("--hc", type=float, default=0.05,
                     help="contact edge length on level 1 (default 0.05)")
     pp.add_argument("--thetas", type=float, nargs="+", default=[-1.0], metavar="THETA",

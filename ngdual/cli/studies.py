@@ -14,10 +14,13 @@ from .output import EXIT_BAD_INPUT, EXIT_NOT_CONVERGED, level_flags, number_flag
 def cmd_figures(args) -> int:
     """Regenerate the figures and tables of Sections 3.4 and 4.2 into DIR (see figures/)."""
     from .. import budget
+    from ..extras import require
     from ..io import check_output_dir
     from ..scene import Geometry
     from ..studies.figures import DEFAULT_MAX_LEVEL, THESIS_MAX_LEVEL, run_figures
     from ..studies.figures.run import select_scripts
+
+    require("dask.distributed", "studies")  # the sweep's; refused before anything is written
 
     max_level = DEFAULT_MAX_LEVEL if args.max_level is None else args.max_level
     number_flag(max_level, "--max-level", 2, THESIS_MAX_LEVEL, integer=True)
