@@ -57,6 +57,7 @@ import numpy as np
 
 from . import peers
 from .friction import FrictionForms, build_friction_forms
+from .geometry import round_off
 from .scene import Contact, contact_junctions
 from .solvers.result import CheckWarning, Solution
 
@@ -311,8 +312,7 @@ def _clamped_ends(solution: Solution) -> list[tuple[np.ndarray, int]]:
     pb = solution.problem
     contact, scene = pb.spaces.contact, pb.scene
     dirichlet = [p for p, kind, _ in contact_junctions(scene) if kind == "dirichlet"]
-    size = max(float(np.ptp(np.vstack([ch.points for ch in contact.chains]), axis=0).max()),
-               1e-300)
+    tolerance = round_off(scene.geometry.curves())
     out, offset = [], 0
     for c, chain in enumerate(contact.chains):
         dofs = len(contact.dof_positions(c))
@@ -320,7 +320,7 @@ def _clamped_ends(solution: Solution) -> list[tuple[np.ndarray, int]]:
             for end, free, neighbour in ((0, contact.free[c][0], offset),
                                          (-1, contact.free[c][1], offset + dofs - 1)):
                 point = chain.points[contact.nodes[c][end]]
-                if not free and any(np.linalg.norm(point - q) <= 1e-9 * size
+                if not free and any(np.linalg.norm(point - q) <= tolerance
                                     for q in dirichlet):
                     out.append((point, neighbour))
         offset += dofs

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import ngsolve as ngs
 import numpy as np
 
+from ..geometry import round_off
 from ..scene import contact_junctions
 
 
@@ -126,15 +127,17 @@ class EndRule:
     """Where the chains of a boundary part break and which of their ends are free.
 
     ``breaks``: fine vertex numbers where a chain is cut; ``free_points``: coordinates
-    of the chain ends that carry a dof (all other ends of open chains are fixed).
+    of the chain ends that carry a dof (all other ends of open chains are fixed);
+    ``tolerance``: the distance below which two points are the same (the scene's
+    :func:`ngdual.geometry.round_off`).
     """
 
     breaks: frozenset = frozenset()
     free_points: tuple = ()
+    tolerance: float = 0.0
 
     def is_free(self, point: np.ndarray) -> bool:
-        return any(np.linalg.norm(point - q) <= 1e-9 * (1 + np.linalg.norm(q))
-                   for q in self.free_points)
+        return any(np.linalg.norm(point - q) <= self.tolerance for q in self.free_points)
 
     def free_ends(self, chains) -> tuple[tuple[bool, bool], ...]:
         return tuple((False, False) if ch.closed
@@ -151,6 +154,7 @@ def end_rule(scene, mesh: ngs.Mesh, role: str) -> EndRule:
     meets Gamma_D, and all ends for ``"thesis"``) is fixed (see :class:`ngdual.scene.Contact`).
     """
     junctions = contact_junctions(scene) if scene.has_contact else []
+    tolerance = round_off(scene.geometry.curves())
     kinks = [p for p, kind, _ in junctions if kind == "kink"]
     touching = [p for p, kind, _ in junctions if kind == "neumann"]
     consistent = scene.contact.ends == "consistent"
@@ -160,8 +164,8 @@ def end_rule(scene, mesh: ngs.Mesh, role: str) -> EndRule:
         candidates = {v.nr: np.array(mesh[v].point) for el in mesh.Elements(ngs.BND)
                       if el.mat in labels for v in el.vertices} if kinks else {}
         breaks = frozenset(nr for nr, xy in candidates.items()
-                           if any(np.linalg.norm(xy - k) <= 1e-9 * (1 + np.linalg.norm(k))
-                                  for k in kinks))
-        return EndRule(breaks, tuple(kinks) + (tuple(touching) if consistent else ()))
-    return EndRule(frozenset(), tuple(touching) if consistent else ())
+                           if any(np.linalg.norm(xy - k) <= tolerance for k in kinks))
+        return EndRule(breaks, tuple(kinks) + (tuple(touching) if consistent else ()),
+                       tolerance)
+    return EndRule(frozenset(), tuple(touching) if consistent else (), tolerance)
 
