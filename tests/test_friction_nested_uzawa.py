@@ -1,6 +1,7 @@
 """Nested Uzawa (Algorithm 3.41, Remark 3.45): Tresca and Coulomb on coarse levels, and
 the variants (loop order, metrics, step, condensed iteration) reach the same solution."""
 
+import dataclasses
 import functools
 
 import numpy as np
@@ -10,7 +11,7 @@ from ngdual import post
 from ngdual.forms import assemble
 from ngdual.friction import build_friction_forms
 from ngdual.mesh import build_mesh
-from ngdual.scene import load_scene
+from ngdual.scene import SceneError, SceneTypeError, load_scene
 from ngdual.solvers import solve_scene
 from ngdual.solvers.nested import box_projection, box_projection_qp, nested_uzawa
 from ngdual.solvers.projections import NonnegativeProjection, metric_matrix
@@ -80,10 +81,10 @@ def _coulomb_problem(level=2):
         "thesis-3.46-coulomb").geometry, level))
 
 
-def _nested(condensed=True, **options):
+def _nested(**options):
     pb = _coulomb_problem()
     settings = NestedUzawaSettings.from_scene(pb.scene, eps1=1e-11, eps2=1e-10, **options)
-    return nested_uzawa(pb, settings, condensed=condensed)
+    return nested_uzawa(pb, settings)
 
 
 @pytest.mark.parametrize("variant", [{"loop_order": "contact-outer"},
@@ -97,7 +98,7 @@ def test_loop_orders_metrics_and_steps_reach_the_same_solution(variant):
 
 def test_condensed_iteration_repeats_the_sparse_solves_exactly():
     """Same iterates, so the same iteration counts and the same solution."""
-    condensed, full = _nested(), _nested(condensed=False)
+    condensed, full = _nested(condensed=True), _nested(condensed=False)
     assert condensed.iterations == full.iterations
     assert np.linalg.norm(condensed.x - full.x) <= 1e-10 * np.linalg.norm(full.x)
 
@@ -106,7 +107,8 @@ def test_frictionless_uzawa_condensed_equals_sparse():
     problem = assemble(load_scene("thesis-3.46-frictionless"),
                        build_mesh(load_scene("thesis-3.46-frictionless").geometry, 3))
     settings = UzawaSettings.from_scene(problem.scene, eps=1e-10)
-    a, b = uzawa(problem, settings), uzawa(problem, settings, condensed=True)
+    a = uzawa(problem, settings)
+    b = uzawa(problem, dataclasses.replace(settings, condensed=True))
     assert a.iterations == b.iterations and a.history == pytest.approx(b.history, rel=1e-6)
     assert np.linalg.norm(a.x - b.x) <= 1e-10 * np.linalg.norm(a.x)
 
@@ -136,3 +138,23 @@ def test_stick_slip_diagnostics_are_consistent(solved):
     assert np.all(diag.lam_n[separated] > 0) and np.all(diag.lam_n[~separated] >= 0)
     summary = post.contact_summary(sol)
     assert summary["stick_nodes"] + summary["slip_nodes"] == summary["nodes_in_contact"] > 0
+
+
+def test_condensed_has_one_default_resolved_per_algorithm_and_is_validated():
+    """``solver.condensed = "auto"`` (the scene's default) is the Gamma_C response for nested
+    Uzawa and sparse solves for Algorithm 3.38 (solvers.settings.CONDENSED_AUTO); a given
+    value applies to both; anything else is refused naming the field."""
+    coulomb = load_scene("thesis-3.46-coulomb")
+    assert coulomb.solver.condensed == "auto"
+    assert NestedUzawaSettings.from_scene(coulomb).condensed is True
+    assert UzawaSettings.from_scene(coulomb).condensed is False
+    forced = load_scene("thesis-3.46-coulomb", ["solver.method='uzawa'", "solver.condensed=false"])
+    assert NestedUzawaSettings.from_scene(forced).condensed is False
+    with pytest.raises(SceneError) as bad:
+        load_scene("thesis-3.46-coulomb", ["solver.method='uzawa'", "solver.condensed='yes'"])
+    assert bad.value.field == "solver.condensed"
+    with pytest.raises(SceneTypeError) as bad:
+        UzawaSettings.from_scene(coulomb, condensed=1)
+    assert bad.value.field == "solver.condensed"
+    with pytest.raises(SceneError, match="does nothing"):
+        load_scene("hertz-cylinder", ["solver.condensed=true"])

@@ -378,7 +378,7 @@ KNOWN = {
     "contact": ["gap", "foundation", "htilde_factor", "hhat_factor", "ends"],
     "friction": ["law", "mu", "bound", "normal_stress"],
     "solver": ["method", "metric", "rho", "eps", "max_iter", "rho1", "rho2", "eps1", "eps2",
-               "loop_order", "friction_metric"],
+               "loop_order", "friction_metric", "condensed"],
     "boundary": ["dirichlet", "neumann", "contact"],
 }
 TOKENS = ["x", "y", "pi", "e", "1", "0", "2.5", "1e308", "10", "-", "+", "*", "/", "**", "(",

@@ -184,6 +184,10 @@ MEANINGS = {
     "solver.friction_metric": "Diagonal metric of the projection P^Lambda: `mass` (Remark "
                               "3.44) or `jacobi` (mass weighted by the diagonal of the nu "
                               "operator).",
+    "solver.condensed": "Iterate Uzawa on the Gamma_C response computed once (`true`) or "
+                        "solve the sparse system every step (`false`); the same iterates. "
+                        "`auto`: the response for nested Uzawa, sparse solves for "
+                        "Algorithm 3.38.",
     "units.length": "Unit of every length of the scene (coordinates, gap, displacements); "
                     "only the labels of plots read it. Not given: no unit is shown.",
     "units.stress": "Unit of E, tractions and stresses; only the labels of plots read it. "

@@ -22,7 +22,7 @@ The schema (all tables optional except ``geometry``, whose ``kind`` must be give
     [friction]   law = "none" | "tresca" | "coulomb", mu, bound (Tresca F),
                  normal_stress = "hat-projection" | "fine-edges" (the |sigma_n| of F)
     [solver]     method, metric, rho, eps, max_iter, rho1, rho2, eps1, eps2, loop_order,
-                 friction_metric
+                 friction_metric, condensed
     [units]      length = "m" | "mm" | ..., stress = "Pa" | "MPa" | ...  (labels of plots)
     [benchmark]  kind = "none" | "hertz" | "flat-punch" | "cattaneo-mindlin" | "wedge",
                  radius, half_width, slope, center  (the analytic solution of the pictures)

@@ -243,7 +243,13 @@ class Solver:
     iteration and must lie in (0, 2). ``friction_metric`` is the diagonal metric
     of the nu projection P^Lambda: ``"mass"`` (Remark 3.44) or ``"jacobi"`` (the
     mass matrix weighted by the diagonal of the nu operator, so that h^ edges
-    with a small friction bound F converge as fast as the others).
+    with a small friction bound F converge as fast as the others). ``condensed``:
+    ``true`` iterates on the Gamma_C response computed once from 2 N_C + 1 solves
+    (:mod:`ngdual.solvers.condensed`), ``false`` solves the sparse saddle-point system
+    in every step; both give the same iterates to round-off. ``"auto"`` takes the
+    response for nested Uzawa, whose thousands of inner steps it makes cheap, and the
+    sparse solves for Algorithm 3.38, whose tens of steps cost less than the response
+    (:data:`ngdual.solvers.settings.CONDENSED_AUTO`).
     """
 
     method: str = "auto"
@@ -257,6 +263,7 @@ class Solver:
     eps2: float = 1e-6
     loop_order: str = "friction-outer"
     friction_metric: str = "jacobi"
+    condensed: bool | str = "auto"
 
 
 @dataclass

@@ -184,6 +184,9 @@ def _validate_solver(sol: Solver, problems: Problems) -> None:
                                         "iteration converges (it is relative to the stability "
                                         "bound)")
     problems.run(positive, sol.max_iter, "solver.max_iter", integer=True)
+    if not (isinstance(sol.condensed, bool) or sol.condensed == "auto"):
+        problems.add("solver.condensed", f"must be true, false or \"auto\", got "
+                                         f"{show(sol.condensed)}")
 
 
 def _validate_units(units: Units, problems: Problems) -> None:

@@ -61,11 +61,16 @@ def pair(values, field_name: str) -> list[Expression]:
 # What each setting must be; the formulas (loads, contact.gap, friction.bound) are checked
 # by parsing them, the tables of geometry (points, labels, arcs, side_maxh) entry by entry.
 _TYPES = {"str": (str,), "int": (int,), "float": (int, float), "list": (list, tuple),
-          "dict": (dict,)}
+          "dict": (dict,), "bool": (bool,)}
 
 
 _TYPE_NAMES = {"str": "a string", "int": "an integer", "float": "a number",
-               "list": "a list", "dict": "a table"}
+               "list": "a list", "dict": "a table", "bool": "true or false"}
+
+
+def _is_kind(value, kind: str) -> bool:
+    """``value`` is of the table type ``kind``; true and false are of kind bool only."""
+    return isinstance(value, _TYPES[kind]) and (kind == "bool") == isinstance(value, bool)
 
 
 FORMULAS = {"contact.gap", "friction.bound", "loads.body_force", "loads.traction",
@@ -80,8 +85,10 @@ def field_type_problems(section: str, obj) -> list[tuple[str, str]]:
         kinds = [k.strip() for k in str(f.type).split("|")]
         if key in FORMULAS or (value is None and "None" in kinds):
             continue
-        if isinstance(value, bool) or not isinstance(value, _TYPES[kinds[0]]):
-            found.append((key, f"must be {_TYPE_NAMES[kinds[0]]}, got {show(value)}"))
+        kinds = [k for k in kinds if k != "None"]
+        if not any(_is_kind(value, k) for k in kinds):
+            found.append((key, f"must be {', or '.join(_TYPE_NAMES[k] for k in kinds)}, got "
+                               f"{show(value)}"))
     return found
 
 

@@ -23,9 +23,10 @@ operator of the nu iteration (:class:`FrictionStep`), computed from the
 tangential block of the Gamma_C response, so 0 < rho_2 < 2 converges for any E,
 load scale and level. The number of outer steps still grows like 1/h^: the
 mass-matrix metric of Remark 3.44 is not H^{-1/2}-equivalent, so the condition
-number of H grows like |Gamma_C| / h^. By default the loops run on the
-condensed Gamma_C response (:mod:`ngdual.solvers.condensed`), so that an outer
-step costs small dense products instead of sparse solves.
+number of H grows like |Gamma_C| / h^. With ``solver.condensed`` (the default for
+nested Uzawa) the loops run on the condensed Gamma_C response
+(:mod:`ngdual.solvers.condensed`), so that an outer step costs small dense products
+instead of sparse solves.
 """
 
 from __future__ import annotations
@@ -165,7 +166,6 @@ def _stagnation_message(model: Model, outer: int, what: str) -> str:
 
 
 def nested_uzawa(problem: DiscreteProblem, settings: NestedUzawaSettings,
-                 condensed: bool = True,
                  progress: Callable[[int, float], None] | None = None) -> Solution:
     """Solve (3.62) with Tresca (Algorithm 3.41) or Coulomb (Remark 3.45) friction.
 
@@ -180,11 +180,10 @@ def nested_uzawa(problem: DiscreteProblem, settings: NestedUzawaSettings,
         lambda_n); ``max_iter``, the bound on the outer iterations (and on the inner
         ones per outer step); ``loop_order``, "friction-outer" (Algorithm 3.41: nu
         outside, lambda_n inside) or "contact-outer" (Remark 3.43); ``friction_metric``,
-        "jacobi" or "mass", the diagonal metric of P^Lambda (:class:`FrictionStep`).
-    condensed : bool
-        Iterate on the Gamma_C response from one factorisation
-        (:mod:`ngdual.solvers.condensed`) instead of one sparse solve per step;
-        same iterates.
+        "jacobi" or "mass", the diagonal metric of P^Lambda (:class:`FrictionStep`);
+        ``condensed``, iterate on the Gamma_C response from one factorisation
+        (:mod:`ngdual.solvers.condensed`) instead of one sparse solve per step (the same
+        iterates to round-off).
 
     Stopping is honest: the iteration ends only when the inner loop converged
     (complementarity of lambda_n to eps1), the relative increments of nu, F
@@ -208,7 +207,7 @@ def nested_uzawa(problem: DiscreteProblem, settings: NestedUzawaSettings,
         raise ValueError(f"unknown loop_order {s.loop_order!r}")
     start_all = time.perf_counter()
     forms = build_friction_forms(problem)
-    loop = ContactLoop(problem, s.metric, model.plane_strain_modulus, condensed,
+    loop = ContactLoop(problem, s.metric, model.plane_strain_modulus, s.condensed,
                        extra_outputs=forms.T_n[:, problem.saddle])
     n_c = loop.n_c
     if loop.response is not None:

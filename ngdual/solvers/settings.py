@@ -11,8 +11,8 @@ none, so a solver never silently runs with a value nobody chose.
 >>> type(settings).__name__, settings.model.law, settings.model.mu_f
 ('ActiveSetSettings', 'coulomb', 0.5)
 >>> uzawa_settings = NestedUzawaSettings.from_scene(load_scene("thesis-3.46-coulomb"), eps2=1e-8)
->>> uzawa_settings.eps2, uzawa_settings.rho2
-(1e-08, 1.0)
+>>> uzawa_settings.eps2, uzawa_settings.rho2, uzawa_settings.condensed
+(1e-08, 1.0, True)
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ import dataclasses
 from dataclasses import dataclass
 from typing import ClassVar
 
-from ..scene import Scene
+from ..scene import Scene, SceneTypeError
 
 
 @dataclass(frozen=True)
@@ -87,14 +87,34 @@ class _FromScene:
 
         ``changes`` replace single fields, of the settings (e.g. a tighter ``eps2`` for a
         comparison) or of the model (e.g. another ``mu_f`` on the same assembled problem).
+        ``solver.condensed = "auto"`` becomes the choice :data:`CONDENSED_AUTO` makes for
+        ``cls``.
         """
         model_fields = {f.name for f in dataclasses.fields(Model)}
         model = dataclasses.replace(Model.of(scene), **{k: v for k, v in changes.items()
                                                         if k in model_fields})
         values = {f.name: getattr(scene.solver, f.name) for f in dataclasses.fields(cls)
                   if f.name != "model"}
+        if values.get("condensed") == "auto":
+            values["condensed"] = CONDENSED_AUTO[cls.method]
         return dataclasses.replace(cls(model=model, **values),
                                    **{k: v for k, v in changes.items() if k not in model_fields})
+
+
+# solver.condensed = "auto" (the scene's default): the Gamma_C response costs 2 N_C + 1
+# solves once and pays off after about as many steps. Nested Uzawa takes thousands of
+# inner steps; Algorithm 3.38 in the H^{1/2} metric takes tens, independent of h, so the
+# response costs more than it saves from level 5 of Example 3.46 on (N_C = 63, 17 steps:
+# 25 s against 7.5 s for the sparse solves).
+CONDENSED_AUTO = {"uzawa": False, "nested-uzawa": True}
+
+
+def _check_condensed(settings) -> None:
+    """A settings object's ``condensed`` is True or False (a scene's "auto" is resolved by
+    :meth:`_FromScene.from_scene`)."""
+    if not isinstance(settings.condensed, bool):
+        raise SceneTypeError("solver.condensed", f"must be True or False, got "
+                                                 f"{settings.condensed!r}")
 
 
 @dataclass(frozen=True)
@@ -107,11 +127,13 @@ class LinearSettings(_FromScene):
 
 @dataclass(frozen=True)
 class UzawaSettings(_FromScene):
-    """Algorithm 3.38 (frictionless contact): ``solver.rho``, ``eps``, ``max_iter``, ``metric``.
+    """Algorithm 3.38 (frictionless contact): ``solver.rho``, ``eps``, ``max_iter``, ``metric``,
+    ``condensed``.
 
     ``rho`` is the dimensionless step (the metric carries E*), ``eps`` the tolerance on the
     relative increment of step 5, ``metric`` that of the projection P^+ ("h12" or
-    "euclidean", :mod:`ngdual.solvers.projections`).
+    "euclidean", :mod:`ngdual.solvers.projections`), ``condensed`` whether the steps run on
+    the Gamma_C response (:class:`~ngdual.solvers.uzawa.ContactLoop`).
     """
 
     method: ClassVar[str] = "uzawa"
@@ -120,6 +142,10 @@ class UzawaSettings(_FromScene):
     eps: float
     max_iter: int
     metric: str
+    condensed: bool
+
+    def __post_init__(self):
+        _check_condensed(self)
 
 
 @dataclass(frozen=True)
@@ -129,7 +155,8 @@ class NestedUzawaSettings(_FromScene):
     ``rho1``, ``eps1``: step and tolerance of the contact loop (lambda_n); ``rho2`` in
     (0, 2): step of the nu update relative to its stability bound; ``eps2``: tolerance of
     the outer increments; ``loop_order``: "friction-outer" (Algorithm 3.41) or
-    "contact-outer" (Remark 3.43); ``friction_metric``: "jacobi" or "mass" (Remark 3.44).
+    "contact-outer" (Remark 3.43); ``friction_metric``: "jacobi" or "mass" (Remark 3.44);
+    ``condensed``: whether the loops run on the Gamma_C response.
     """
 
     method: ClassVar[str] = "nested-uzawa"
@@ -142,6 +169,10 @@ class NestedUzawaSettings(_FromScene):
     metric: str
     loop_order: str
     friction_metric: str
+    condensed: bool
+
+    def __post_init__(self):
+        _check_condensed(self)
 
 
 @dataclass(frozen=True)

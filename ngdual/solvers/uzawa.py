@@ -218,7 +218,7 @@ class ContactLoop:
                                  np.max(np.abs(self.b0), initial=0.0))
 
 
-def uzawa(problem: DiscreteProblem, settings: UzawaSettings, condensed: bool = False,
+def uzawa(problem: DiscreteProblem, settings: UzawaSettings,
           progress: Callable[[int, float], None] | None = None) -> Solution:
     """Algorithm 3.38 for the frictionless contact problem (3.68).
 
@@ -227,10 +227,9 @@ def uzawa(problem: DiscreteProblem, settings: UzawaSettings, condensed: bool = F
     settings : UzawaSettings
         ``rho`` (dimensionless step: the metric carries the elastic modulus), ``eps``
         (tolerance on the relative increment of step 5), ``max_iter``, ``metric`` (of the
-        projection P^+, :mod:`ngdual.solvers.projections`), and the model (E*).
-    condensed : bool
-        Iterate on the Gamma_C response (:class:`ContactLoop`); pays off when the
-        number of steps exceeds about 2 N_C solves' worth.
+        projection P^+, :mod:`ngdual.solvers.projections`), ``condensed`` (iterate on the
+        Gamma_C response, :class:`ContactLoop`: pays off when the number of steps exceeds
+        about 2 N_C solves' worth), and the model (E*).
     progress : callable, optional
         Called as ``progress(iteration, increment)`` after every step.
 
@@ -240,7 +239,7 @@ def uzawa(problem: DiscreteProblem, settings: UzawaSettings, condensed: bool = F
         If the increments grow by ``DIVERGENCE_FACTOR`` (rho too large) or become NaN.
     """
     s = settings
-    loop = ContactLoop(problem, s.metric, s.model.plane_strain_modulus, condensed)
+    loop = ContactLoop(problem, s.metric, s.model.plane_strain_modulus, s.condensed)
     start = time.perf_counter()
     state, its, history, converged = loop.run(np.zeros(len(problem.lam_n)), s.rho, s.eps,
                                               s.max_iter, progress=progress)
