@@ -180,12 +180,14 @@ def force_balance(solution: Solution) -> ForceBalance:
 
 
 def result_record(solution: Solution) -> dict:
-    """The result record of SPEC section 6 (plain JSON-serialisable data); ``warnings``
-    lists the failed physics checks (code, message, value, tolerance;
-    :mod:`ngdual.checks`)."""
+    """The result record of ``ngdual solve`` (``result.json``, plain JSON-serialisable data):
+    scene, level, method, DOFs, the norms of Tables 3.2/3.3, the contact summary, iterations,
+    residuals, timings and versions; ``warnings`` lists the failed physics checks (code,
+    message, value, tolerance; :mod:`ngdual.checks`)."""
     pb = solution.problem
     t = solution.timings
-    # SPEC's four phases: the Gamma_C condensation counts as part of the contact solve
+    # four phases, assemble, factorize, solve and total: the Gamma_C condensation is part of
+    # the contact solve
     timings = {"assemble": float(t.get("assemble", 0.0)),
                "factorize": float(t.get("factorize", 0.0)),
                "solve": float(t.get("solve", 0.0) + t.get("condense", 0.0)),

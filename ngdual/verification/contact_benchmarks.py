@@ -44,8 +44,9 @@ tangential displacement and the stick zone moves (Spence's problem); with nu = 0
 coupling is 1400 times weaker. Below the h^ resolution the centroid of the slip reserve
 mu_f p_h - |q_h| (``stick_centroid_a``) sits at -0.045a and -0.054a on levels 3 and 4;
 it is polluted by the shear error in the slip zones (q_max 22-31 %, at the edges of the
-contact zone, where the Coulomb bound inherits the pressure spike of issue 14, item 6) and
-is not evidence of a shift.
+contact zone, where the Coulomb bound inherits the spike p_h carries where the edge of the
+contact zone lies inside an h~ edge, :func:`ngdual.friction.hat_projection`) and is not
+evidence of a shift.
 """
 
 from __future__ import annotations

@@ -1,8 +1,9 @@
 """True errors against an overkill solve, or any finer nested one.
 
 Where no exact solution is known, the error of a discrete solution is measured against a
-solve several uniform levels finer (the overkill solution, the *reference* of the error). Both are reduced to plain arrays,
-so that solves in different processes (a sweep's records) can be compared later:
+solve several uniform levels finer (the overkill solution, the *reference* of the error).
+Both are reduced to plain arrays, so that solves in different processes (a sweep's records)
+can be compared later:
 
 * :func:`element_samples`: the mesh (vertices, triangles) and fields at the six P2 nodes of
   every triangle. PEERS stresses (RT_0 + Curl of cubic bubbles), the P0 displacement and
