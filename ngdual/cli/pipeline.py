@@ -155,11 +155,11 @@ def _adapt(args) -> int:
         except ConvergenceError as err:
             return not_converged(err)
 
-    def on_step(record, solution, estimate, marked):
+    def on_step(record, solution, estimated, marked):
         effectivity = record.get("effectivity")
         line = (f"step {record['step']:3d}  dofs {record['dofs']['total']:8d}  "
                 f"estimator {record['estimator']:.4e}"
-                + (f"  e_tot {record['e_tot']:.4e}  eta/e_tot {effectivity:.3f}"
+                + (f"  e_tot {record['e_tot']:.4e}  effectivity {effectivity:.3f}"
                    if effectivity else "") + f"  marked {record['marked']}")
         if args.strict and record["warnings"]:
             print(line + "\n" + warning_lines(record["warnings"], "    "))
