@@ -34,6 +34,7 @@ import argparse
 import sys
 
 from ..extras import MissingExtraError
+from ..marking import STRATEGIES
 from ..scene import SceneError
 from .output import EXIT_BAD_INPUT, EXIT_INTERNAL, EXIT_NOT_CONVERGED, EXIT_WARNINGS
 from .pipeline import cmd_adapt, cmd_dofs, cmd_scenes, cmd_solve
@@ -90,7 +91,7 @@ def parser() -> argparse.ArgumentParser:
     ad = sub.add_parser("adapt", help="adaptive refinement (Chapter 4), writes DIR/history.json",
                         parents=[sized])
     ad.add_argument("scene", help="path to a TOML scene or the name of a shipped scene")
-    ad.add_argument("--marking", choices=["max", "fraction", "dorfler"], default="dorfler",
+    ad.add_argument("--marking", choices=STRATEGIES, default="dorfler",
                     help="marking strategy (Section 4.2): max (eta_T >= theta max eta_T), "
                          "fraction (the theta share of the triangles with the largest "
                          "eta_T) or dorfler (the fewest triangles carrying theta of the "
