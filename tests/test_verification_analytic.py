@@ -1,4 +1,4 @@
-"""The computed contact tractions converge to the half-plane solutions (issue 14, acceptance).
+"""The computed contact tractions converge to the half-plane solutions.
 
 Hertz: the h~-projected pressure's L2 error falls on every level 1-4 and is below 3 % on
 level 4. Flat punch: the force on |x| < a/2 is P/3 and the contact zone is the punch face,
