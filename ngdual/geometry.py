@@ -18,7 +18,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import ngsolve as ngs
 import numpy as np
 
 MAX_ARC_PIECE = np.pi / 4  # netgen gets an arc as rational quadratic splines of <= 45 degrees
@@ -44,6 +43,8 @@ def tangent(normal):
     """
     if isinstance(normal, np.ndarray):
         return np.stack([normal[..., 1], -normal[..., 0]], axis=-1)
+    import ngsolve as ngs  # here only: scenes are read and checked without NGSolve
+
     return ngs.CF((normal[1], -normal[0]))
 
 

@@ -151,7 +151,8 @@ def parser() -> argparse.ArgumentParser:
     be = sub.add_parser("bench", help="benchmarks: the solvers' and the estimator's cost, the "
                                       "inf-sup constants, the primal peer (a table; JSON with "
                                       "--json)", parents=[common])
-    bench = be.add_subparsers(dest="benchmark", required=True, metavar="BENCHMARK")
+    bench = be.add_subparsers(dest="benchmark", required=True, metavar="BENCHMARK",
+                              help="which benchmark (each has its own --help)")
     json_out = argparse.ArgumentParser(add_help=False)
     json_out.add_argument("--json", default=None, metavar="FILE",
                           help="write all records (with package versions and the machine) "
