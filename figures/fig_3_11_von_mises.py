@@ -10,7 +10,7 @@ import numpy as np
 
 from ngdual import plot
 from ngdual.studies.figures import script_main
-from ngdual.studies.figures.kit import UNITS, element_rows, field_summary, stress
+from ngdual.studies.figures.kit import centroids, element_field, field_summary, stress
 
 THESIS = "Fig. 3.11"
 STUDIES = ("uniform-frictionless", "uniform-coulomb")
@@ -21,25 +21,20 @@ def run(ctx):
     # COMPUTE: the solves of both problems on the field level (shared with Tables 3.2/3.3)
     fields = ctx.both_fields()
     a0, a1 = (fields[p][1] for p in ("frictionless", "coulomb"))
-    centroids = a0["points"][a0["triangles"]].mean(axis=1)
-    away = np.abs(centroids[:, 0]) <= AWAY
-    # WRITE
-    data = ctx.write_csv("fig_3_11_von_mises.csv", element_rows(fields, "von_mises"),
-                         "plane-strain von Mises stress per element (centroid), both problems")
-    # PLOT
-    fig = plot.plot_field_pair(a0["points"], a0["triangles"],
-                               [a0["von_mises"], a1["von_mises"]], ctx.titles(),
-                               stress(r"von Mises stress $\sigma_0$"),
-                               "Fig. 3.11: von Mises equivalent stress (plane strain)",
-                               clip=plot.CORNER_CLIP, units=UNITS)
-    figs = plot.save_figure(fig, ctx.figure_stem("fig_3_11_von_mises"))
+    away = np.abs(centroids(a0["points"], a0["triangles"])[:, 0]) <= AWAY
     numbers = {}
     for name, a in (("mu_f = 0", a0), ("mu_f = 0.5", a1)):
         s = field_summary(a["von_mises"][away], a["points"], a["triangles"][away])
         numbers[f"max sigma_0 for |x_1| <= {AWAY}, {name}"] = s["max"]
         numbers[f"  at (x_1, x_2), {name}"] = s["argmax"]
         numbers[f"max sigma_0 overall (corners), {name}"] = float(a["von_mises"].max())
-    ctx.entry(THESIS, "Von Mises equivalent stress in Omega", [*figs, data], numbers,
+    # WRITE, PLOT: the CSV and both problems side by side
+    files = element_field(ctx, fields, "von_mises", stress(r"von Mises stress $\sigma_0$"),
+                          "Fig. 3.11: von Mises equivalent stress (plane strain)",
+                          "fig_3_11_von_mises",
+                          "plane-strain von Mises stress per element (centroid), both problems",
+                          clip=plot.CORNER_CLIP)
+    ctx.entry(THESIS, "Von Mises equivalent stress in Omega", files, numbers,
               thesis_says="singularities in the corners; with friction the maximal value is "
                           "smaller and its zone moves to where the body slides.")
 

@@ -7,9 +7,8 @@ body starts to slide; the extrema lie on the boundary.
 
 import numpy as np
 
-from ngdual import plot
 from ngdual.studies.figures import script_main
-from ngdual.studies.figures.kit import UNITS, element_rows
+from ngdual.studies.figures.kit import centroids, element_field
 
 THESIS = "Fig. 3.14"
 STUDIES = ("uniform-frictionless", "uniform-coulomb")
@@ -19,19 +18,15 @@ def run(ctx):
     # COMPUTE: the solves of both problems on the field level (shared with Tables 3.2/3.3)
     fields = ctx.both_fields()
     a0, a1 = (fields[p][1] for p in ("frictionless", "coulomb"))
-    centroids = a0["points"][a0["triangles"]].mean(axis=1)
+    centre = centroids(a0["points"], a0["triangles"])
     h = float(np.ptp(a0["points"][a0["triangles"][0]][:, 0]))
     # the bottom row of triangles under the central part of the contact zone
-    contact_row = (centroids[:, 1] < -1 + h) & (np.abs(centroids[:, 0]) < 1.0)
-    # WRITE
-    data = ctx.write_csv("fig_3_14_rotation.csv", element_rows(fields, "eta"),
-                         "rotation eta^h at the element centroids, both problems")
-    # PLOT
-    fig = plot.plot_field_pair(a0["points"], a0["triangles"], [a0["eta"], a1["eta"]],
-                               ctx.titles(), r"$\eta^h$ [rad]",
-                               r"Fig. 3.14: rotation $\eta^h$", units=UNITS)
-    figs = plot.save_figure(fig, ctx.figure_stem("fig_3_14_rotation"))
-    ctx.entry(THESIS, "Rotation eta in Omega", [*figs, data],
+    contact_row = (centre[:, 1] < -1 + h) & (np.abs(centre[:, 0]) < 1.0)
+    # WRITE, PLOT: the CSV and both problems side by side
+    files = element_field(ctx, fields, "eta", r"$\eta^h$ [rad]", r"Fig. 3.14: rotation $\eta^h$",
+                          "fig_3_14_rotation",
+                          "rotation eta^h at the element centroids, both problems")
+    ctx.entry(THESIS, "Rotation eta in Omega", files,
               {"max |eta| on the bottom row, |x_1| < 1, mu_f = 0":
                    float(np.abs(a0["eta"][contact_row]).max()),
                "max |eta| on the bottom row, |x_1| < 1, mu_f = 0.5":

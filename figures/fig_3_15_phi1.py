@@ -1,8 +1,5 @@
-"""Fig. 3.15: phi_1^h on Gamma_N (coarse h~ P1 multiplier, phi = -u on Gamma_N), both problems.
-
-The thesis: no difference between the two cases (same traction t_0); by Theorem 3.10 the
-sign of phi is opposite to that of u on Gamma_N.
-"""
+"""Fig. 3.15: phi_1^h on Gamma_N, the horizontal component of the coarse h~ P1 multiplier
+(phi = -u on Gamma_N), both problems."""
 
 from ngdual.studies.figures import script_main
 from ngdual.studies.figures.kit import neumann_multiplier

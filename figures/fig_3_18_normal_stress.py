@@ -17,11 +17,11 @@ def run(ctx):
     # COMPUTE: the solves of both problems on the field level (shared with Tables 3.2/3.3)
     fields = ctx.both_fields()
     # WRITE, PLOT: the CSV and one panel per problem
-    figs, data, numbers = gamma_c_stress(ctx, fields, THESIS, "sigma_n", r"\sigma_n",
-                                         "normal stress", "fig_3_18_normal_stress")
+    files, numbers = gamma_c_stress(ctx, fields, THESIS, "sigma_n", r"\sigma_n", "normal stress",
+                                    "fig_3_18_normal_stress")
     for p, (record, _) in fields.items():
         numbers[f"F_abs, {PROBLEM_TITLES[p]}"] = record["contact"]["F_abs"]
-    ctx.entry(THESIS, "Normal stress sigma_n on Gamma_C", [*figs, data], numbers,
+    ctx.entry(THESIS, "Normal stress sigma_n on Gamma_C", files, numbers,
               thesis_says="max |sigma_n| larger without friction; F_abs larger with friction "
                           "(the values are withheld in our copy of the thesis).")
 

@@ -12,12 +12,10 @@ STUDIES = ("uniform-frictionless", "uniform-coulomb")
 
 
 def run(ctx):
-    # COMPUTE: the solves of both problems on the field level (shared with Tables 3.2/3.3)
-    fields = ctx.both_fields()
-    # WRITE, PLOT: the CSV and one panel per problem
-    figs, data, numbers = gamma_c_stress(ctx, fields, THESIS, "sigma_t", r"\sigma_t",
-                                         "tangential stress", "fig_3_20_tangential_stress")
-    ctx.entry(THESIS, "Tangential stress sigma_t on Gamma_C", [*figs, data], numbers,
+    # COMPUTE, WRITE, PLOT: both problems on the field level (shared with Tables 3.2/3.3)
+    files, numbers = gamma_c_stress(ctx, ctx.both_fields(), THESIS, "sigma_t", r"\sigma_t",
+                                    "tangential stress", "fig_3_20_tangential_stress")
+    ctx.entry(THESIS, "Tangential stress sigma_t on Gamma_C", files, numbers,
               thesis_says="sigma_t = 0 without friction; friction forces with friction.")
 
 

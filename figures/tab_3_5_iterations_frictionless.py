@@ -7,32 +7,21 @@ assembly and factorisation. Sweep tasks run two at a time, so times carry that n
 Last columns: the default active-set solver (semismooth Newton steps, no parameter).
 """
 
-from ngdual.studies.figures import best, markdown_table, rho_tasks, script_main, solve
+from ngdual.studies.figures import markdown_table, script_main
+from ngdual.studies.figures.kit import rho_search, solver_columns
 
 THESIS = "Table 3.5"
 STUDIES = ("rho-frictionless", "uniform-frictionless")
 
 
 def run(ctx):
-    # COMPUTE: the rho grid on every level
-    tasks = rho_tasks(ctx.plan)["frictionless"]
-    records = dict(zip(tasks, ctx.compute(list(tasks.values()))))
+    # COMPUTE: the rho grid on every level, against rho = 1 and the active-set solver
     rows = []
-    for level in ctx.plan.levels:
-        at = {rho: records[(lv, rho)] for lv, rho in tasks if lv == level}
-        default, opt = at.get(1.0), best(at)
-        row = {"level": level}
-        if default and default["status"] == "ok":
-            row.update(it=default["iterations"]["outer"], time=default["timings_s"]["solve"],
-                       total=default["timings_s"]["total"])
+    for level, (at, opt, active_set) in rho_search(ctx, "frictionless").items():
+        row = {"level": level, **solver_columns(at.get(1.0), {"it": "outer"})}
         if opt is not None:
-            r = at[opt]
-            row.update(rho_opt=opt, it_opt=r["iterations"]["outer"],
-                       time_opt=r["timings_s"]["solve"], total_opt=r["timings_s"]["total"])
-        fast = ctx.record(solve(ctx.plan, "frictionless", level))
-        if fast and fast["status"] == "ok":
-            row.update(newton=fast["iterations"]["inner"], time_fast=fast["timings_s"]["solve"],
-                       total_fast=fast["timings_s"]["total"])
+            row.update(rho_opt=opt, **solver_columns(at[opt], {"it_opt": "outer"}, "_opt"))
+        row.update(solver_columns(active_set, {"newton": "inner"}, "_fast"))
         row["grid"] = {str(rho): (r["iterations"]["outer"] if r and r["status"] == "ok"
                                   else (r or {}).get("status", "missing"))
                        for rho, r in at.items()}

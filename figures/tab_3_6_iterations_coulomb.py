@@ -8,35 +8,25 @@ is the condensation onto Gamma_C plus the iteration; sweep tasks run two at a ti
 Last columns: the default active-set solver (Coulomb fixed-point / Newton steps).
 """
 
-from ngdual.studies.figures import best, markdown_table, rho_tasks, script_main, solve
+from ngdual.studies.figures import markdown_table, script_main
+from ngdual.studies.figures.kit import rho_search, solver_columns
 
 THESIS = "Table 3.6"
 STUDIES = ("rho-coulomb", "uniform-coulomb")
 
 
 def run(ctx):
-    # COMPUTE: the (rho_1, rho_2) search on every level
-    tasks = rho_tasks(ctx.plan)["coulomb"]
-    records = dict(zip(tasks, ctx.compute(list(tasks.values()))))
+    # COMPUTE: the (rho_1, rho_2) search on every level, against (1, 1) and the active-set solver
     rows = []
-    for level in ctx.plan.levels:
-        at = {(r1, r2): records[(lv, r1, r2)] for lv, r1, r2 in tasks if lv == level}
-        default, opt = at.get((1.0, 1.0)), best(at)
+    for level, (at, opt, active_set) in rho_search(ctx, "coulomb").items():
         row = {"level": level, "tried": len(at),
-               "failed": sum(1 for r in at.values() if not r or r["status"] != "ok")}
-        if default and default["status"] == "ok":
-            row.update(out=default["iterations"]["outer"], inn=default["iterations"]["inner"],
-                       time=default["timings_s"]["solve"], total=default["timings_s"]["total"])
+               "failed": sum(1 for r in at.values() if not r or r["status"] != "ok"),
+               **solver_columns(at.get((1.0, 1.0)), {"out": "outer", "inn": "inner"})}
         if opt is not None:
-            r = at[opt]
-            row.update(rho1_opt=opt[0], rho2_opt=opt[1], out_opt=r["iterations"]["outer"],
-                       inn_opt=r["iterations"]["inner"], time_opt=r["timings_s"]["solve"],
-                       total_opt=r["timings_s"]["total"])
-        fast = ctx.record(solve(ctx.plan, "coulomb", level))
-        if fast and fast["status"] == "ok":
-            row.update(fixed_point=fast["iterations"]["outer"],
-                       newton=fast["iterations"]["inner"], time_fast=fast["timings_s"]["solve"],
-                       total_fast=fast["timings_s"]["total"])
+            row.update(rho1_opt=opt[0], rho2_opt=opt[1],
+                       **solver_columns(at[opt], {"out_opt": "outer", "inn_opt": "inner"}, "_opt"))
+        row.update(solver_columns(active_set, {"fixed_point": "outer", "newton": "inner"},
+                                  "_fast"))
         rows.append(row)
     # WRITE
     data = ctx.write_csv("tab_3_6_iterations_coulomb.csv", rows,

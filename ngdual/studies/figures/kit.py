@@ -1,6 +1,7 @@
 """What several figure scripts share: axis labels in the thesis scenes' units, the norms of
-Tables 3.2/3.3, the h^ cases of Figs. 3.26-3.28, CSV rows of fields and traces, and the
-panels of Figs. 3.15-3.20.
+Tables 3.2/3.3, the rho searches of Tables 3.5/3.6, the element fields of Figs. 3.11-3.14,
+the Gamma_N and Gamma_C panels of Figs. 3.15-3.20, the h^ cases of Figs. 3.26-3.28, the
+adaptive meshes of Figs. 4.1-4.13, and CSV rows of fields and traces.
 
 The figure scripts (``figures/*.py``) import it as ``ngdual.studies.figures.kit``; no other
 module does, so that loading the thesis scene for :data:`UNITS` costs nothing elsewhere.
@@ -8,6 +9,7 @@ module does, so that loading the thesis scene for :data:`UNITS` costs nothing el
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -15,10 +17,10 @@ import numpy as np
 from ... import plot
 from ...scene import load_scene
 from .index import markdown_table
-from .numbers import outcome
+from .numbers import best, outcome, require
 from .output import Context
 from .plan import PROBLEM_TITLES, SCENES
-from .tasks import gap_tasks
+from .tasks import adaptive_task, gap_tasks, rho_tasks, solve
 
 # the units the thesis scenes declare ([units]; none: labels name the quantity alone)
 UNITS = load_scene(SCENES["frictionless"]).units
@@ -40,6 +42,7 @@ NORM_LABELS = {"sigma_X": "||sigma||_X", "u": "||u||_L2", "eta": "||eta||_L2",
                "lam_n": "||lam_n||_L2(G_C)", "nu": "||nu||_L2(A_C)"}
 
 HHAT_CASES = {"abs": ("(a) $g = |x_1|$", "g = |x_1|"), "3125": ("(b) $g$ of (3.125)", "g (3.125)")}
+HHAT_NAMES = {1: "h^ = h~", 2: "h^ = 2h~"}
 HHAT_STYLE = {1: {"color": "tab:red", "ls": "--", "label": r"$\hat h = \tilde h$"},
               2: {"color": "tab:green", "label": r"$\hat h = 2\tilde h$"}}
 
@@ -67,19 +70,75 @@ def hhat_numbers(ctx: Context) -> dict:
         solver = "nested Uzawa" if uzawa else "default solver"
         for case, by_factor in hhat_solutions(ctx, uzawa).items():
             for factor, (record, _) in by_factor.items():
-                key = (f"{HHAT_CASES[case][1]}, h^ = {'2' if factor == 2 else ''}h~, {solver}, "
-                       f"level {level}")
+                key = f"{HHAT_CASES[case][1]}, {HHAT_NAMES[factor]}, {solver}, level {level}"
                 numbers[key] = outcome(record)
     return numbers
+
+
+def hhat_panels(solutions: dict, ylabel: str,
+                trace: Callable[[str, int, dict], tuple[list[dict], dict]],
+                **panel) -> tuple[list[dict], list[dict]]:
+    """Figs. 3.26-3.28: one panel per gap case of :func:`hhat_solutions`, with a curve for
+    every h^ that solved and a note naming those that did not.
+
+    ``trace(case, hhat_factor, arrays)`` returns a solution's CSV rows and its curve;
+    ``panel``: further keys of every panel (such as ``ylim``). Returns the CSV rows of all
+    solutions and the panels.
+    """
+    rows, panels = [], []
+    for case, by_factor in solutions.items():
+        curves, notes = [], []
+        for factor, (record, arrays) in by_factor.items():
+            if not arrays:
+                notes.append(f"{HHAT_NAMES[factor]}: {(record or {}).get('status', 'missing')}")
+                continue
+            case_rows, curve = trace(case, factor, arrays)
+            rows += case_rows
+            curves.append(curve)
+        panels.append({"title": HHAT_CASES[case][0], "xlabel": length(r"$x_1$ on $\Gamma_C$"),
+                       "ylabel": ylabel, "curves": curves, "note": "; ".join(notes), **panel})
+    return rows, panels
+
+
+def hhat_figure(ctx: Context, thesis: str, stem: str, rows: list[dict], panels: list[dict], *,
+                title: str, description: str, entry: str, numbers: dict | None = None,
+                thesis_says: str) -> None:
+    """Figs. 3.26-3.28: the CSV of ``rows`` (``description``), the ``panels`` under
+    ``title`` with mu_f and the gap level, and the index entry ``entry`` with ``numbers`` and
+    how every h^ case ended (:func:`hhat_numbers`)."""
+    data = ctx.write_csv(f"{stem}.csv", rows, description)
+    fig = plot.plot_curves(panels, rf"{thesis}: {title}, $\mu_f = 0.5$, level {ctx.plan.gap_level}")
+    ctx.entry(thesis, f"{entry} for h^ = h~ and h^ = 2h~",
+              [*plot.save_figure(fig, ctx.figure_stem(stem)), data],
+              {**(numbers or {}), **hhat_numbers(ctx)}, thesis_says=thesis_says)
+
+
+def centroids(points: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+    """The centroid of every triangle, where the element fields are plotted and tabulated."""
+    return points[triangles].mean(axis=1)
 
 
 def element_rows(fields: dict[str, tuple[dict, dict]], key: str) -> list[dict]:
     """CSV rows of an element field of both problems: element, centroid, one value each."""
     first = next(iter(fields.values()))[1]
-    centroids = first["points"][first["triangles"]].mean(axis=1)
     columns = {f"{key}_{p}": arrays[key] for p, (_, arrays) in fields.items()}
     return [{"element": k, "x1": c[0], "x2": c[1], **{n: v[k] for n, v in columns.items()}}
-            for k, c in enumerate(centroids)]
+            for k, c in enumerate(centroids(first["points"], first["triangles"]))]
+
+
+def element_field(ctx: Context, fields: dict[str, tuple[dict, dict]], key: str, label: str,
+                  title: str, stem: str, description: str, clip: float | None = None
+                  ) -> list[Path]:
+    """Figs. 3.11-3.14: the element field ``key`` of both problems (``fields`` =
+    :meth:`Context.both_fields`) side by side on one colour scale (``label`` on its bar,
+    ``clip`` a percentile where it ends), and its CSV (``description``), one row per element.
+    Returns the files written."""
+    data = ctx.write_csv(f"{stem}.csv", element_rows(fields, key), description)
+    arrays = [a for _, a in fields.values()]
+    fig = plot.plot_field_pair(arrays[0]["points"], arrays[0]["triangles"],
+                               [a[key] for a in arrays], ctx.titles(), label, title, clip=clip,
+                               units=UNITS)
+    return [*plot.save_figure(fig, ctx.figure_stem(stem)), data]
 
 
 def curve_rows(fields: dict[str, tuple[dict, dict]], x_key: str, keys: list[str],
@@ -122,21 +181,20 @@ def norms_table(ctx: Context, thesis: str, problem: str, name: str, keys) -> Non
 
 def field_summary(values: np.ndarray, points: np.ndarray, triangles: np.ndarray) -> dict:
     """min / max of an element field and where the maximum sits (for the index)."""
-    centroids = points[triangles].mean(axis=1)
     k = int(np.argmax(values))
     return {"min": float(values.min()), "max": float(values.max()),
-            "argmax": [round(float(c), 3) for c in centroids[k]]}
+            "argmax": [round(float(c), 3) for c in centroids(points, triangles)[k]]}
 
 
 def gamma_c_stress(ctx: Context, fields: dict, thesis: str, key: str, tex: str, what: str,
-                   stem: str, away: float = 3.0) -> tuple[list, Path, dict]:
+                   stem: str, away: float = 3.0) -> tuple[list[Path], dict]:
     """Figs. 3.18 / 3.20: ``key`` (sigma_n or sigma_t, constant per fine Gamma_C edge) for
     both problems (``fields`` = :meth:`Context.both_fields`): the CSV, one panel per
     problem, and the maxima for the index.
 
     The y-range comes from the values with |x_1| <= ``away``, leaving the corner
     singularities at x_1 = +-4 off scale (their size is a note on the panel and in the CSV).
-    Returns the figure files, the CSV and the numbers, for the script's index entry.
+    Returns the files written and the numbers, for the script's index entry.
     """
     data = ctx.write_csv(f"{stem}.csv", curve_rows(fields, "edge_x", [key, "edge_active"]),
                          f"{key}^h at the midpoints of the fine Gamma_C edges")
@@ -158,15 +216,18 @@ def gamma_c_stress(ctx: Context, fields: dict, thesis: str, key: str, tex: str, 
         numbers[f"max |{key}| overall (corners), {PROBLEM_TITLES[p]}"] = float(
             np.abs(a[key]).max())
     fig = plot.plot_curves(panels, rf"{thesis}: {what} ${tex}^h$ on $\Gamma_C$")
-    figs = plot.save_figure(fig, ctx.figure_stem(stem))
-    return figs, data, numbers
+    return [*plot.save_figure(fig, ctx.figure_stem(stem)), data], numbers
 
 
 NEUMANN_STYLE = {"frictionless": {"color": "tab:blue"}, "coulomb": {"color": "tab:red", "ls": "--"}}
 
 
 def neumann_multiplier(ctx: Context, thesis: str, component: int, stem: str) -> None:
-    """Figs. 3.15 / 3.16: phi_i^h on Gamma_N for both problems (CSV, plot, index entry)."""
+    """Figs. 3.15 / 3.16: phi_i^h on Gamma_N for both problems (CSV, plot, index entry).
+
+    The thesis sees no difference between the two problems (the same traction t_0) and, by
+    Theorem 3.10 (phi = -u on Gamma_N), the sign of phi opposite to that of u there.
+    """
     key, tex = f"phi{component}", rf"\varphi_{component}"
     fields = ctx.both_fields()
     a0, a1 = (fields[p][1] for p in ("frictionless", "coulomb"))
@@ -186,3 +247,60 @@ def neumann_multiplier(ctx: Context, thesis: str, component: int, stem: str) -> 
                f"range {name}, mu_f = 0.5": [float(a1[key].min()), float(a1[key].max())],
                f"max |{name}(0.5) - {name}(0)|": float(np.abs(a1[key] - a0[key]).max())},
               thesis_says="no difference between the frictionless and the frictional case.")
+
+
+def adaptive_meshes(ctx: Context, strategy: str, first: int) -> tuple[list[Path], dict[int, dict]]:
+    """Figs. 4.1-4.13: the meshes of the adaptive run with ``strategy`` marking (mu_f = 0.5)
+    at the steps the plan shows, one figure each from Fig. 4.``first`` on, shaded where the
+    next step refines (marked by the indicators of (4.50)), and the CSV of their sizes.
+
+    Returns the files written (the CSV first) and the run's history by step.
+    """
+    task = adaptive_task(ctx.plan, "coulomb", strategy)
+    record = require(ctx.record(task), task.label)
+    arrays = ctx.arrays(task)
+    steps = {r["step"]: r for r in record["history"]}
+    shown = list(zip(range(first, first + len(task.params["snapshots"])),
+                     task.params["snapshots"]))
+    figures = f"Figs. 4.{first}-4.{shown[-1][0]}"
+    marking = f"{task.params['marking']} marking $\\theta = {task.params['theta']}$"
+    files = [ctx.write_csv(f"fig_4_{first:02d}_to_4_{shown[-1][0]:02d}_{strategy}_marking.csv",
+                           [{"figure": f"4.{n}", "step": k, "elements": steps[k]["elements"],
+                             "dofs": steps[k]["dofs"]["total"], "marked": steps[k]["marked"],
+                             "h_min": steps[k]["h_min"]} for n, k in shown],
+                           f"the meshes shown in {figures}: step, triangles, DOFs, marked")]
+    for n, k in shown:
+        when = "initial mesh" if k == 0 else f"after {k} step{'s' if k > 1 else ''}"
+        fig = plot.plot_mesh(arrays[f"points_{k}"], arrays[f"triangles_{k}"],
+                             f"Fig. 4.{n}: {marking}, {when} ({steps[k]['dofs']['total']} DOFs)",
+                             arrays[f"marked_{k}"], units=UNITS)
+        files += plot.save_figure(fig, ctx.figure_stem(f"fig_4_{n:02d}_{strategy}_marking_"
+                                                       f"step{k:02d}"))
+    return files, steps
+
+
+def rho_search(ctx: Context, problem: str) -> dict[int, tuple[dict, object, dict | None]]:
+    """Tables 3.5 / 3.6: on every uniform level, the records of the rho search keyed by rho
+    (Algorithm 3.38, no friction) or by (rho_1, rho_2) (Algorithm 3.41, Coulomb), the key of
+    the best (:func:`~.numbers.best`; None if none converged) and the record of the default
+    active-set solver on that level, what the search is measured against."""
+    tasks = rho_tasks(ctx.plan)[problem]
+    records = dict(zip(tasks, ctx.compute(list(tasks.values()))))
+    out = {}
+    for level in ctx.plan.levels:
+        at = {key[1] if len(key) == 2 else key[1:]: record
+              for key, record in records.items() if key[0] == level}
+        out[level] = (at, best(at), ctx.record(solve(ctx.plan, problem, level)))
+    return out
+
+
+def solver_columns(record: dict | None, counts: dict[str, str], suffix: str = "") -> dict:
+    """Tables 3.5 / 3.6: the columns of a converged solve, its iteration counts (``counts``:
+    column name -> "outer" or "inner") and its times ``time`` (the iteration) and ``total``
+    (with meshing, assembly and factorisation), ``suffix`` on the names of the two times;
+    none if it did not converge."""
+    if not record or record["status"] != "ok":
+        return {}
+    return {**{name: record["iterations"][kind] for name, kind in counts.items()},
+            f"time{suffix}": record["timings_s"]["solve"],
+            f"total{suffix}": record["timings_s"]["total"]}
