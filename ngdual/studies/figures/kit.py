@@ -78,12 +78,26 @@ def hhat_numbers(ctx: Context) -> dict:
 def hhat_panels(solutions: dict, ylabel: str,
                 trace: Callable[[str, int, dict], tuple[list[dict], dict]],
                 **panel) -> tuple[list[dict], list[dict]]:
-    """Figs. 3.26-3.28: one panel per gap case of :func:`hhat_solutions`, with a curve for
-    every h^ that solved and a note naming those that did not.
+    """Figs. 3.26-3.28: one panel per gap case, with a curve for every h^ that solved and a
+    note naming those that did not.
 
-    ``trace(case, hhat_factor, arrays)`` returns a solution's CSV rows and its curve;
-    ``panel``: further keys of every panel (such as ``ylim``). Returns the CSV rows of all
-    solutions and the panels.
+    Parameters
+    ----------
+    solutions : dict
+        :func:`hhat_solutions`.
+    ylabel : str
+        The panels' y-axis label (x is x_1 on Gamma_C).
+    trace : callable
+        ``trace(case, hhat_factor, arrays)``: the CSV rows and the curve of one solution.
+    **panel
+        Further keys of every panel of :func:`ngdual.plot.plot_curves` (such as ``ylim``).
+
+    Returns
+    -------
+    rows : list of dict
+        The CSV rows of every solution, case by case.
+    panels : list of dict
+        One panel per gap case of :data:`HHAT_CASES`.
     """
     rows, panels = [], []
     for case, by_factor in solutions.items():
@@ -103,9 +117,26 @@ def hhat_panels(solutions: dict, ylabel: str,
 def hhat_figure(ctx: Context, thesis: str, stem: str, rows: list[dict], panels: list[dict], *,
                 title: str, description: str, entry: str, numbers: dict | None = None,
                 thesis_says: str) -> None:
-    """Figs. 3.26-3.28: the CSV of ``rows`` (``description``), the ``panels`` under
-    ``title`` with mu_f and the gap level, and the index entry ``entry`` with ``numbers`` and
-    how every h^ case ended (:func:`hhat_numbers`)."""
+    """Figs. 3.26-3.28: write the CSV and the figure of one h^ comparison and its index entry.
+
+    Parameters
+    ----------
+    thesis, stem : str
+        The figure's thesis number (``"Fig. 3.26"``) and the name of its files.
+    rows, panels : list of dict
+        :func:`hhat_panels`, perhaps with panels added.
+    title : str
+        What the figure shows; the suptitle adds the thesis number, mu_f and the gap level.
+    description : str
+        What the CSV holds.
+    entry : str
+        The index entry's title, before "for h^ = h~ and h^ = 2h~".
+    numbers : dict, optional
+        The figure's own numbers; the entry adds how every h^ case ended
+        (:func:`hhat_numbers`).
+    thesis_says : str
+        What the thesis states about the figure.
+    """
     data = ctx.write_csv(f"{stem}.csv", rows, description)
     fig = plot.plot_curves(panels, rf"{thesis}: {title}, $\mu_f = 0.5$, level {ctx.plan.gap_level}")
     ctx.entry(thesis, f"{entry} for h^ = h~ and h^ = 2h~",
@@ -129,10 +160,27 @@ def element_rows(fields: dict[str, tuple[dict, dict]], key: str) -> list[dict]:
 def element_field(ctx: Context, fields: dict[str, tuple[dict, dict]], key: str, label: str,
                   title: str, stem: str, description: str, clip: float | None = None
                   ) -> list[Path]:
-    """Figs. 3.11-3.14: the element field ``key`` of both problems (``fields`` =
-    :meth:`Context.both_fields`) side by side on one colour scale (``label`` on its bar,
-    ``clip`` a percentile where it ends), and its CSV (``description``), one row per element.
-    Returns the files written."""
+    """Figs. 3.11-3.14: write the CSV of an element field of both problems, one row per
+    element, and the figure of both side by side on one colour scale.
+
+    Parameters
+    ----------
+    fields : dict
+        :meth:`Context.both_fields`.
+    key : str
+        The field among the arrays (``"u1"``, ``"eta"``, ...).
+    label, title : str
+        The colour bar's label and the figure's suptitle.
+    stem, description : str
+        The name of the files and what the CSV holds.
+    clip : float, optional
+        The percentile where the colour scale ends (:data:`ngdual.plot.CORNER_CLIP`).
+
+    Returns
+    -------
+    list of pathlib.Path
+        The files written, the figure's first.
+    """
     data = ctx.write_csv(f"{stem}.csv", element_rows(fields, key), description)
     arrays = [a for _, a in fields.values()]
     fig = plot.plot_field_pair(arrays[0]["points"], arrays[0]["triangles"],
@@ -250,11 +298,23 @@ def neumann_multiplier(ctx: Context, thesis: str, component: int, stem: str) -> 
 
 
 def adaptive_meshes(ctx: Context, strategy: str, first: int) -> tuple[list[Path], dict[int, dict]]:
-    """Figs. 4.1-4.13: the meshes of the adaptive run with ``strategy`` marking (mu_f = 0.5)
-    at the steps the plan shows, one figure each from Fig. 4.``first`` on, shaded where the
-    next step refines (marked by the indicators of (4.50)), and the CSV of their sizes.
+    """Figs. 4.1-4.13: write the meshes of an adaptive run (mu_f = 0.5) at the steps the plan
+    shows, one figure each, shaded where the next step refines (marked by the indicators
+    eta_{tot,T} of (4.50)), and the CSV of their sizes.
 
-    Returns the files written (the CSV first) and the run's history by step.
+    Parameters
+    ----------
+    strategy : {"max", "fraction"}
+        The run of :data:`~.plan.ADAPTIVE_RUNS`; its marking and theta name the figures.
+    first : int
+        The thesis number of the first figure (Fig. 4.``first``).
+
+    Returns
+    -------
+    files : list of pathlib.Path
+        The files written, the CSV first.
+    steps : dict
+        The run's history, by step.
     """
     task = adaptive_task(ctx.plan, "coulomb", strategy)
     record = require(ctx.record(task), task.label)
@@ -280,10 +340,20 @@ def adaptive_meshes(ctx: Context, strategy: str, first: int) -> tuple[list[Path]
 
 
 def rho_search(ctx: Context, problem: str) -> dict[int, tuple[dict, object, dict | None]]:
-    """Tables 3.5 / 3.6: on every uniform level, the records of the rho search keyed by rho
-    (Algorithm 3.38, no friction) or by (rho_1, rho_2) (Algorithm 3.41, Coulomb), the key of
-    the best (:func:`~.numbers.best`; None if none converged) and the record of the default
-    active-set solver on that level, what the search is measured against."""
+    """Tables 3.5 / 3.6: the rho search on every uniform level.
+
+    Parameters
+    ----------
+    problem : {"frictionless", "coulomb"}
+        The search over rho of Algorithm 3.38 or over (rho_1, rho_2) of Algorithm 3.41.
+
+    Returns
+    -------
+    dict
+        ``level -> (records, best, active_set)``: the records keyed by rho or (rho_1, rho_2),
+        the key of the best (:func:`~.numbers.best`; None if none converged) and the record
+        of the default active-set solver on that level, what the search is measured against.
+    """
     tasks = rho_tasks(ctx.plan)[problem]
     records = dict(zip(tasks, ctx.compute(list(tasks.values()))))
     out = {}
@@ -295,10 +365,23 @@ def rho_search(ctx: Context, problem: str) -> dict[int, tuple[dict, object, dict
 
 
 def solver_columns(record: dict | None, counts: dict[str, str], suffix: str = "") -> dict:
-    """Tables 3.5 / 3.6: the columns of a converged solve, its iteration counts (``counts``:
-    column name -> "outer" or "inner") and its times ``time`` (the iteration) and ``total``
-    (with meshing, assembly and factorisation), ``suffix`` on the names of the two times;
-    none if it did not converge."""
+    """Tables 3.5 / 3.6: the columns of one solve.
+
+    Parameters
+    ----------
+    record : dict or None
+        A solve's record; one that is missing or did not converge gives no columns.
+    counts : dict
+        Column name -> ``"outer"`` or ``"inner"``: the iteration counts to show.
+    suffix : str
+        Appended to the names of the two times, ``time`` (the iteration) and ``total``
+        (with meshing, assembly and factorisation).
+
+    Returns
+    -------
+    dict
+        The columns, counts first.
+    """
     if not record or record["status"] != "ok":
         return {}
     return {**{name: record["iterations"][kind] for name, kind in counts.items()},
