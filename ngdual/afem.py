@@ -126,7 +126,7 @@ def adapt(scene: Scene, marking: str = "dorfler", theta: float = 0.5, steps: int
         marked = None
         if not last:
             with _timed(record, "mark"):
-                marked = mark(estimated.eta, theta, marking)
+                marked = mark(estimated.indicators, theta, marking)
             record["marked"] = int(marked.sum())
         if on_step is not None:
             on_step(record, solution, estimated, marked)
@@ -216,7 +216,7 @@ def step_record(step: int, solution: Solution, estimated: Estimate,
         "iterations": {k: int(v) for k, v in solution.iterations.items()},
         "estimator": estimated.total,
         "estimator_sum": estimated.total_sum,
-        "estimator_max": float(estimated.eta.max()),
+        "estimator_max": float(estimated.indicators.max()),
         "estimator_terms": {k: float(np.sqrt(v)) for k, v in estimated.summed().items()},
         "asymmetry_norm": estimated.asymmetry,
         "norms": norms(solution),

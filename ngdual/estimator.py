@@ -99,19 +99,19 @@ class Estimate:
         return np.sqrt(sum(self.terms[k] for k in U_TERMS))
 
     @property
-    def eta(self) -> np.ndarray:
+    def indicators(self) -> np.ndarray:
         """eta_{tot,T} of (4.50): the indicator that marking uses."""
         return np.sqrt(sum(self.terms[k] for k in TERMS))
 
     @property
     def total(self) -> float:
         """(sum_T eta_{tot,T}^2)^{1/2}, the global estimator compared with the error."""
-        return float(np.sqrt(np.sum(self.eta**2)))
+        return float(np.sqrt(np.sum(self.indicators**2)))
 
     @property
     def total_sum(self) -> float:
         """sum_T eta_{tot,T}, the eta_tot of Table 4.4 (Theorem 4.8 bounds the error by it)."""
-        return float(np.sum(self.eta))
+        return float(np.sum(self.indicators))
 
     def summed(self) -> dict[str, float]:
         """sum_T of every squared term (their sum is ``total**2``)."""

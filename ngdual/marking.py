@@ -1,7 +1,7 @@
 """Marking strategies for adaptive refinement: pure functions of the indicators.
 
 Each takes the element indicators eta_T >= 0 (e.g. eta_{tot,T} of (4.50),
-``nd.estimate(solution).eta``) and a parameter theta in [0, 1], and returns a
+``nd.estimate(solution).indicators``) and a parameter theta in [0, 1], and returns a
 boolean mask of the elements to refine. Ties are resolved by value, never by
 position: two elements with the same indicator are either both marked or both
 not, so the result does not depend on the element numbering.
@@ -30,7 +30,7 @@ STRATEGIES = ("max", "fraction", "dorfler")
 def _check(indicators, theta: float) -> np.ndarray:
     """``indicators`` as an array of floats; a SceneError (SceneTypeError for a wrong type)
     naming ``indicators`` or ``theta`` if they are not indicators and a parameter in [0, 1]."""
-    wanted = "a 1D array of the element indicators eta_T >= 0 (e.g. nd.estimate(s).eta)"
+    wanted = "a 1D array of the element indicators eta_T >= 0 (e.g. nd.estimate(s).indicators)"
     if isinstance(indicators, (str, bytes)) or indicators is None:
         raise SceneTypeError("indicators", f"must be {wanted}, got "
                                            f"{type(indicators).__name__}")

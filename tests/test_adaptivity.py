@@ -205,7 +205,7 @@ def run_thesis_strategy(marking, theta, level, steps):
     captured = []
 
     def on_step(record, solution, estimated, marked):
-        captured.append((estimated.eta.copy(), None if marked is None else marked.copy(),
+        captured.append((estimated.indicators.copy(), None if marked is None else marked.copy(),
                          coarse_node_points(solution.problem.spaces.contact),
                          coarse_node_points(solution.problem.spaces.friction)))
 

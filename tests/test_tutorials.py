@@ -230,7 +230,7 @@ def check_solutions(number: int, r: dict) -> None:
         d = r["dorfler"]
         assert d["0.5"]["rate"] > d["0.8"]["rate"] and d["0.5"]["rate"] > 0.9, d
         assert d["0.2"]["steps"] > d["0.5"]["steps"] > d["0.8"]["steps"], d
-        eta, sigma = r["by_indicator"]["eta"], r["by_indicator"]["eta_sigma"]
+        eta, sigma = r["by_indicator"]["indicators"], r["by_indicator"]["eta_sigma"]
         assert eta["top_edges"] > sigma["top_edges"], (eta, sigma)
         incompatible, compatible = r["corners"]["0.01"], r["corners"]["0"]
         assert incompatible["uniform_as_max"][-1] > 0.8 * incompatible["uniform_as_max"][0]

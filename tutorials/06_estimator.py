@@ -137,7 +137,7 @@ def plot_terms(mesh, terms: dict, title: str, columns: int = 2):
     return fig
 
 
-lesson.save(plot_terms(mesh, {"eta_tot^2": est.eta**2, **est.terms}, "Squared indicators of "
+lesson.save(plot_terms(mesh, {"eta_tot^2": est.indicators**2, **est.terms}, "Squared indicators of "
                        f"(4.50), Example 3.46, mu_f = 0.5, level {THESIS_LEVEL}"),
             "terms_thesis_coulomb")
 
@@ -271,7 +271,8 @@ lesson.results({
     "levels": LEVELS,
     "thesis": {"level": THESIS_LEVEL, "eta": est.total, "summed": summed,
                "elements": mesh.ne,
-               "sum_of_terms_is_eta2": bool(np.allclose(est.eta**2, sum(est.terms.values()))),
+               "sum_of_terms_is_eta2": bool(np.allclose(est.indicators**2,
+                                                        sum(est.terms.values()))),
                "friction_elements": int(np.count_nonzero(est.terms["friction"])),
                "neumann_elements": int(np.count_nonzero(est.terms["neumann"]))},
     "smooth": rows, "effectivity": effectivity, "hdiv_effectivity": hdiv_ratio,

@@ -90,14 +90,15 @@ lesson.save(nd.plot_von_mises(mesh, nd.fields(solution).sigma, l_shape.material.
 # %% [markdown]
 # ## ESTIMATE
 #
-# `nd.estimate` returns the indicators of (4.50); `eta` holds $\eta_{tot,T}$ per element.
+# `nd.estimate` returns the indicators of (4.50); `indicators` holds $\eta_{tot,T}$ per element.
 
 # %%
 estimate = nd.estimate(solution)
-eta = estimate.eta
+indicators = estimate.indicators
 points, triangles = mesh_arrays(mesh)
-lesson.save(nd.plot_element_field(points, triangles, eta, r"ESTIMATE: $\eta_{tot,T}$ of (4.50)",
-                                  r"$\eta_{tot,T}$"), "estimate")
+lesson.save(nd.plot_element_field(points, triangles, indicators,
+                                  r"ESTIMATE: $\eta_{tot,T}$ of (4.50)", r"$\eta_{tot,T}$"),
+            "estimate")
 
 # %% [markdown]
 # ## MARK
@@ -112,10 +113,11 @@ lesson.save(nd.plot_element_field(points, triangles, eta, r"ESTIMATE: $\eta_{tot
 # Only Dörfler controls how much of $\eta^2$ is refined; optimal rates are proven for it.
 
 # %%
-marked = {strategy: nd.mark(eta, theta, strategy) for strategy, theta in THETAS.items()}
+marked = {strategy: nd.mark(indicators, theta, strategy) for strategy, theta in THETAS.items()}
 for strategy, chosen in marked.items():
-    print(f"{strategy:8s} theta = {THETAS[strategy]}: {chosen.sum():3d} of {len(eta)} elements, "
-          f"{100 * np.sum(eta[chosen] ** 2) / np.sum(eta**2):5.1f} % of eta^2")
+    share = np.sum(indicators[chosen] ** 2) / np.sum(indicators**2)
+    print(f"{strategy:8s} theta = {THETAS[strategy]}: {chosen.sum():3d} of {len(indicators)} "
+          f"elements, {100 * share:5.1f} % of eta^2")
 lesson.save(nd.plot_mesh(points, triangles, "MARK: Dörfler, theta = 0.5",
                          marked=marked["dorfler"]), "mark")
 
@@ -200,7 +202,8 @@ lesson.save(nd.plot_mesh(points, triangles, f"Dörfler, last step: {len(triangle
 lesson.results({
     "alpha": alpha, "elements": int(mesh.ne),
     "marking_example": {s: int(m.sum()) for s, m in marked.items()},
-    "marking_share": {s: float(np.sum(eta[m] ** 2) / np.sum(eta**2)) for s, m in marked.items()},
+    "marking_share": {s: float(np.sum(indicators[m] ** 2) / np.sum(indicators**2))
+                      for s, m in marked.items()},
     "refined_elements": int(refined.ne),
     "l_shape": {name: {k: kept[k] for k in ("ndofs", "errors", "etas", "rates", "effectivity")}
                 for name, kept in runs.items()},

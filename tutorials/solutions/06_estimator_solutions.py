@@ -145,10 +145,10 @@ frictionless = load_scene("thesis-3.46-frictionless")
 ratios = {"square": [], "thesis": []}
 for level in LEVELS:
     for name, scene in (("square", square), ("thesis", frictionless)):
-        indicators = estimate(solve_scene(scene, level))
-        ratios[name].append({"level": level, "elements": len(indicators.eta),
-                             "ratio": indicators.total_sum / indicators.total,
-                             "eta": indicators.total})
+        estimated = estimate(solve_scene(scene, level))
+        ratios[name].append({"level": level, "elements": len(estimated.indicators),
+                             "ratio": estimated.total_sum / estimated.total,
+                             "eta": estimated.total})
     square_row, thesis_row = ratios["square"][-1], ratios["thesis"][-1]
     print(f"level {level}: sum / sqrt(sum of squares) = {square_row['ratio']:7.2f} "
           f"(square, sqrt(N_T) = {math.sqrt(square_row['elements']):6.2f}), "

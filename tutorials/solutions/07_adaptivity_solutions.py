@@ -30,11 +30,11 @@ CORNER_STEPS = 4 if QUICK else 9            # Exercise 3
 UNIFORM_LEVELS = [1, 2, 3] if QUICK else [1, 2, 3, 4]
 
 
-def adapt_until(scene, marking, theta, max_dofs, level=1, indicator="eta", error=None,
+def adapt_until(scene, marking, theta, max_dofs, level=1, indicator="indicators", error=None,
                 max_steps=40):
     """SOLVE-ESTIMATE-MARK-REFINE until N >= max_dofs, marking with any indicator array.
 
-    ``indicator`` names an `Estimate` attribute ("eta", "eta_sigma", "eta_u").
+    ``indicator`` names an `Estimate` attribute ("indicators", "eta_sigma", "eta_u").
     Returns one row (ndof, eta, error or None) per step and the last mesh.
     """
     mesh = build_mesh(scene.geometry, level)
@@ -42,13 +42,13 @@ def adapt_until(scene, marking, theta, max_dofs, level=1, indicator="eta", error
     rows = []
     for _ in range(max_steps):
         solution = solve_problem(assemble(scene, mesh, coarse))              # SOLVE
-        indicators = estimate(solution)                                      # ESTIMATE
+        estimated = estimate(solution)                                       # ESTIMATE
         ndof = int(sum(solution.problem.spaces.dofs().values()))
-        rows.append({"ndof": ndof, "eta": indicators.total,
+        rows.append({"ndof": ndof, "eta": estimated.total,
                      "error": error(solution) if error else None})
         if ndof >= max_dofs:
             break
-        marked = mark(getattr(indicators, indicator), theta, marking)        # MARK
+        marked = mark(getattr(estimated, indicator), theta, marking)         # MARK
         mesh = refine(mesh, marked)                                          # REFINE
         coarse = coarse.follow(scene, mesh)
     return rows, mesh
@@ -117,7 +117,7 @@ def edges_on(mesh: ngs.Mesh, label: str) -> int:
 
 thesis = load_scene("thesis-3.46-coulomb")
 by_indicator, meshes = {}, {}
-for indicator in ("eta", "eta_sigma"):
+for indicator in ("indicators", "eta_sigma"):
     rows, mesh = adapt_until(thesis, "fraction", 0.2, 10**9, level=2, indicator=indicator,
                              max_steps=THESIS_STEPS)
     meshes[indicator] = mesh
@@ -131,7 +131,7 @@ for indicator in ("eta", "eta_sigma"):
 
 # %%
 fig, axes = plt.subplots(2, 1, figsize=(9, 5.5), sharex=True)
-for ax, (indicator, label) in zip(axes, (("eta", r"$\eta_{tot,T}$ (4.50)"),
+for ax, (indicator, label) in zip(axes, (("indicators", r"$\eta_{tot,T}$ (4.50)"),
                                          ("eta_sigma", r"$\eta_{\sigma,T}$ (4.15) only"))):
     points, triangles = mesh_arrays(meshes[indicator])
     ax.triplot(points[:, 0], points[:, 1], triangles, color="0.3", lw=0.3)
