@@ -426,7 +426,7 @@ def plot_von_mises(mesh, sigma, nu: float, title: str, clip: float | None = CORN
 
     points, triangles, values = element_values(mesh, von_mises(sigma, nu))
     return plot_element_field(points, triangles, values, title,
-                              unit_label("von Mises stress", _stress(units)), clip=clip,
+                              unit_label(r"von Mises stress $\sigma_0$", _stress(units)), clip=clip,
                               units=units, vmax=vmax)
 
 

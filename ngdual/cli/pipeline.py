@@ -72,12 +72,10 @@ def solution_figures(solution, out) -> list:
     from ..verification.benchmark import benchmark_traces
 
     scene, level = solution.problem.scene, solution.problem.level
-    pts, tris, vm = post.element_values(solution.problem.fes.mesh,
-                                        post.von_mises(fields(solution).sigma, scene.material.nu))
-    fig = plot.plot_element_field(
-        pts, tris, vm, f"Plane-strain von Mises stress, {scene.name}, level {level}",
-        plot.unit_label(r"von Mises stress $\sigma_0$", scene.units.stress),
-        clip=plot.CORNER_CLIP, units=scene.units)
+    fig = plot.plot_von_mises(solution.problem.fes.mesh, fields(solution).sigma,
+                              scene.material.nu,
+                              f"Plane-strain von Mises stress, {scene.name}, level {level}",
+                              units=scene.units)
     written = plot.save_figure(fig, out / "von_mises.png")
     if solution.problem.spaces.contact is not None:
         fig = plot.plot_contact_traces(post.contact_traces(solution),
