@@ -48,6 +48,16 @@ def tangent(normal):
     return ngs.CF((normal[1], -normal[0]))
 
 
+def right_normal(direction: np.ndarray) -> np.ndarray:
+    """The unit normal (d_2, -d_1) / |d| to the right of the direction d (..., 2): the
+    outward normal of an edge traversed counter-clockwise around the domain.
+
+    >>> right_normal(np.array([[2.0, 0.0]]))
+    array([[ 0., -1.]])
+    """
+    return tangent(direction) / np.linalg.norm(direction, axis=-1)[..., None]
+
+
 @dataclass(frozen=True)
 class Side:
     """One side of the boundary: a segment, or a circular arc around ``center``."""

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import ngsolve as ngs
 import numpy as np
 
-from ..geometry import round_off
+from ..geometry import right_normal, round_off
 from ..scene import contact_junctions
 
 
@@ -118,7 +118,7 @@ def _chains(mesh: ngs.Mesh, labels: list[str]) -> list[Chain]:
 def edge_normals(chain: Chain) -> np.ndarray:
     """Outward unit normals of the fine edges of ``chain``, in chain order."""
     d = np.diff(chain.path_points, axis=0)
-    n = np.column_stack([d[:, 1], -d[:, 0]]) / np.linalg.norm(d, axis=1)[:, None]
+    n = right_normal(d)
     return n if chain.ccw else -n
 
 

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 import ngsolve as ngs
 import numpy as np
 
-from ...geometry import tangent
+from ...geometry import right_normal, tangent
 
 
 @dataclass
@@ -39,7 +39,7 @@ class ContactEdges:
         p0, p1, cen = np.array(p0), np.array(p1), np.array(cen)
         d = p1 - p0
         length = np.linalg.norm(d, axis=1)
-        n = np.column_stack([d[:, 1], -d[:, 0]]) / length[:, None]
+        n = right_normal(d)
         flip = np.einsum("ij,ij->i", n, 0.5 * (p0 + p1) - cen) < 0
         n[flip] *= -1
         return cls(p0, p1, length, n, tangent(n))
