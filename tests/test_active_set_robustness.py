@@ -79,7 +79,8 @@ def tight_uzawa(pb):
     return sol
 
 
-@pytest.mark.parametrize("level", [1, 2, 3, 4, 5])
+@pytest.mark.parametrize("level", [1, 2, *(pytest.param(lv, marks=pytest.mark.slow)
+                                           for lv in (3, 4, 5))])
 def test_cattaneo_mindlin_converges_to_round_off_on_every_level(level):
     sol = solve_problem(problem("cattaneo-mindlin", level))
     assert sol.method == "active-set-coulomb"
@@ -93,7 +94,7 @@ def test_cattaneo_mindlin_converges_to_round_off_on_every_level(level):
         assert r["linear"] >= 0.1 * r["roundoff_level"]
 
 
-@pytest.mark.parametrize("level", [1, 2, 3])
+@pytest.mark.parametrize("level", [1, *(pytest.param(lv, marks=pytest.mark.slow) for lv in (2, 3))])
 def test_cattaneo_mindlin_agrees_with_nested_uzawa(level):
     pb = problem("cattaneo-mindlin", level)
     assert_same_as_uzawa(solve_problem(pb), tight_uzawa(pb))
@@ -106,6 +107,7 @@ def test_clamped_block_with_tangential_load_agrees_with_nested_uzawa():
     assert_same_as_uzawa(sol, tight_uzawa(pb))
 
 
+@pytest.mark.slow
 def test_adaptive_refinement_beyond_the_former_fixed_tolerance():
     """Dorfler marking from level 2: the 8th step has 2011 triangles, h_min = 4e-3 and a
     linear residual of 2e-9 at a measured round-off level of 3e-9; it agrees with Uzawa."""

@@ -170,6 +170,7 @@ def l_shape_runs():
     return runs
 
 
+@pytest.mark.slow
 def test_dorfler_marking_restores_the_optimal_rate_on_the_l_shape():
     runs = l_shape_runs()
     alpha = corner_exponent()
@@ -187,6 +188,7 @@ def test_dorfler_marking_restores_the_optimal_rate_on_the_l_shape():
     assert np.interp(np.log(n_uniform), np.log(n_adaptive), e_adaptive) < 0.6 * e_uniform
 
 
+@pytest.mark.slow
 def test_estimator_tracks_the_error_on_the_adaptive_l_shape_meshes():
     effectivity = [estimate / err for _, err, estimate in l_shape_runs()["dorfler"]]
     print(f"effectivity band (Dörfler, L-shape): [{min(effectivity):.2f}, {max(effectivity):.2f}]")
@@ -223,6 +225,7 @@ def run_thesis_strategy(marking, theta, level, steps):
     return history, captured
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("marking, theta, level", [("max", 0.5, 1), ("fraction", 0.2, 2)])
 def test_thesis_strategies_run_on_example_3_46_coulomb(marking, theta, level):
     history, captured = run_thesis_strategy(marking, theta, level, steps=3)

@@ -178,6 +178,7 @@ def test_the_budget_sees_the_address_space_limit():
     assert 0 < float(run.stdout) < limit
 
 
+@pytest.mark.slow
 @needs_prlimit
 def test_adapt_under_an_address_space_limit_stops_by_the_budget(tmp_path):
     """``ngdual adapt hertz-cylinder --steps 10000 --theta 0.9`` under ``prlimit --as``:

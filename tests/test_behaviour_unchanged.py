@@ -66,6 +66,8 @@ from ngdual.solvers import (
 from ngdual.solvers.semismooth import SAFETY
 from ngdual.tolerances import COULOMB_FIXED_POINT_TOL
 
+pytestmark = pytest.mark.slow  # every shipped scene up to level 4 with its own solver
+
 STORED = json.loads((Path(__file__).parent / "data" / "behaviour_norms.json").read_text())
 CASES = sorted(STORED["norms"])
 STABILITY = 10.0  # 2 q/(1-q) L of an iteration stopped on its relative change (above)

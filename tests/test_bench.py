@@ -14,6 +14,7 @@ RECORD_KEYS = {"case", "scene", "level", "solver", "method", "ndof", "dofs", "co
                "residuals", "norms", "peak_rss_mb", "peak_rss_scope", "versions"}
 
 
+@pytest.mark.slow
 def test_bench_levels_1_2_3_writes_valid_json(tmp_path, capsys):
     path = tmp_path / "bench.json"
     assert main(["bench", "limit-ratio", "--levels", "1", "2", "3", "--json", str(path)]) == 0
@@ -53,6 +54,7 @@ def run_bench(tmp_path, *argv) -> dict:
     return study
 
 
+@pytest.mark.slow
 def test_levels_solve_each_level_in_its_own_process_as_ngdual_solve_does(tmp_path, capsys):
     from ngdual.quantities import norms
     from ngdual.scene import load_scene

@@ -57,6 +57,7 @@ def orders(errors, key):
     return [np.log2(a[key] / b[key]) for a, b in zip(errors, errors[1:])]
 
 
+@pytest.mark.slow
 def test_the_edge_of_the_contact_zone_lies_inside_an_htilde_edge_on_every_level():
     case, sols = solutions()
     for sol in sols:
@@ -65,6 +66,7 @@ def test_the_edge_of_the_contact_zone_lies_inside_an_htilde_edge_on_every_level(
         assert all(0.2 < s["uncovered"] < 0.8 for s in spikes)
 
 
+@pytest.mark.slow
 def test_pressure_error_converges_at_first_order_or_better_on_every_level():
     """p_h against the exact sigma_n: L2 order >= 1 and maximum-norm order >= 0.9 on
     every refinement from level 2 to 5, although theta alternates."""
@@ -76,6 +78,7 @@ def test_pressure_error_converges_at_first_order_or_better_on_every_level():
     assert min(orders(errors, "pressure_max")) >= MIN_ORDER_MAX, orders(errors, "pressure_max")
 
 
+@pytest.mark.slow
 def test_with_the_gap_itself_the_largest_nodal_pressure_error_is_at_the_last_node_in_contact():
     """Against the same projection of the exact sigma_n, p_h is worst at a last contact node
     when g itself enters g(tau) (``contact.discrete_gap = "thesis"``). The nodal gap g_h
@@ -88,6 +91,7 @@ def test_with_the_gap_itself_the_largest_nodal_pressure_error_is_at_the_last_nod
         assert worst in {s["x"] for s in edge_spikes(case, sol)}
 
 
+@pytest.mark.slow
 def test_the_spike_is_bounded_by_the_half_plane_response_to_the_kink_of_lambda_n():
     """Where p_h is too compressive at a last contact node, the excess is at most
     E* kink / pi (E* = E / (1 - nu^2)), and it is first order: excess / h~ does not grow."""

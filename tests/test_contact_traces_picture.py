@@ -80,6 +80,7 @@ def test_p_h_is_the_hertz_pressure_of_the_force_it_carries(hertz):
     assert np.all(traces.coarse_status[traces.coarse_in_contact] == "contact")
 
 
+@pytest.mark.slow
 def test_q_h_points_the_way_of_the_cattaneo_mindlin_shear_and_sticks_inside_the_zone():
     solution = nd.solve(load_scene("cattaneo-mindlin"))
     traces = nd.contact_traces(solution)
@@ -104,6 +105,7 @@ def test_the_y_range_holds_every_p_h_and_the_exact_curve_is_drawn(hertz):
     plot.plt.close(fig)
 
 
+@pytest.mark.slow
 def test_the_tension_at_clamped_ends_with_the_thesis_end_values_is_on_scale_and_named():
     solution = nd.solve(load_scene("thesis-3.46-frictionless", ["geometry.level=2"]))
     traces = nd.contact_traces(solution)
@@ -117,6 +119,7 @@ def test_the_tension_at_clamped_ends_with_the_thesis_end_values_is_on_scale_and_
     plot.plt.close(fig)
 
 
+@pytest.mark.slow
 def test_the_cli_picture_of_a_scene_with_a_benchmark_is_written(tmp_path):
     solution = nd.solve(load_scene("hertz-cylinder", ["geometry.level=1"]))
     written = solution_figures(solution, tmp_path)

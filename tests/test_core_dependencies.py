@@ -1,9 +1,10 @@
 """``import ngdual``, ``nd.solve``, ``nd.adapt`` and ``ngdual solve`` need only the core.
 
 The packages of the extras (``setup.cfg``), with every package they pull in that the core
-does not, are blocked in a subprocess by an import hook, as if they were not installed;
-the subprocess then solves a scene with contact and Coulomb friction on level 1, adapts
-it one step and runs the README's first command. A command that needs an extra names it
+does not, are blocked in a subprocess by an import hook, as if they were not installed.
+There ngdual and every module of its pipeline import (fast tier) and, in the slow tier, a
+scene with contact and Coulomb friction is solved on level 1, adapted one step and solved
+by the README's first command, while ``ngdual figures`` names the extra it needs
 (:func:`ngdual.extras.require`).
 """
 
@@ -80,7 +81,8 @@ def blocked_modules() -> list[str]:
     return sorted(names)
 
 
-CORE_ONLY = r"""
+# a subprocess in which the packages named in argv[1] cannot be imported
+UNINSTALL = r"""
 import importlib.abc, json, sys
 
 BLOCKED = set(json.loads(sys.argv[1]))
@@ -91,7 +93,15 @@ class Uninstalled(importlib.abc.MetaPathFinder):
             raise ModuleNotFoundError(f"No module named {name!r} (blocked)", name=name)
 
 sys.meta_path.insert(0, Uninstalled())
+"""
 
+IMPORTS = UNINSTALL + r"""
+import ngdual as nd
+import ngdual.afem, ngdual.cli, ngdual.plot, ngdual.post, ngdual.solvers, ngdual.studies
+print(json.dumps(sorted({m.partition(".")[0] for m in sys.modules} & BLOCKED)))
+"""
+
+RUNS = UNINSTALL + r"""
 import warnings
 import ngdual as nd
 from ngdual.cli import main
@@ -108,6 +118,13 @@ print(json.dumps({"converged": bool(solution.converged), "steps": len(history),
                   "elements": [r["elements"] for r in history], "cli": status,
                   "figures": figures, "loaded": loaded}))
 """
+
+
+def run_without(blocked: list[str], script: str, cwd: Path) -> subprocess.CompletedProcess:
+    """``script`` in a fresh interpreter with the ``blocked`` packages uninstalled."""
+    return subprocess.run([sys.executable, "-c", script, json.dumps(blocked), str(cwd / "out")],
+                          capture_output=True, text=True, cwd=cwd, timeout=600,
+                          env={**os.environ, "MPLBACKEND": "Agg"})
 
 
 @pytest.fixture(scope="module")
@@ -127,11 +144,15 @@ def test_the_extras_packages_are_not_in_install_requires(blocked):
             "matplotlib"} <= core_names
 
 
+def test_ngdual_and_its_pipeline_import_with_the_extras_uninstalled(blocked, tmp_path):
+    run = run_without(blocked, IMPORTS, tmp_path)
+    assert run.returncode == 0, run.stderr[-3000:]
+    assert json.loads(run.stdout.strip().splitlines()[-1]) == []
+
+
+@pytest.mark.slow
 def test_solve_adapt_and_the_cli_solve_run_with_the_extras_uninstalled(blocked, tmp_path):
-    env = {**os.environ, "MPLBACKEND": "Agg"}
-    run = subprocess.run([sys.executable, "-c", CORE_ONLY, json.dumps(blocked),
-                          str(tmp_path / "out")], capture_output=True, text=True, env=env,
-                         cwd=tmp_path, timeout=600)
+    run = run_without(blocked, RUNS, tmp_path)
     assert run.returncode == 0, run.stderr[-3000:]
     result = json.loads(run.stdout.strip().splitlines()[-1])
     assert result["converged"] and result["steps"] == 2 and result["cli"] == 0, result

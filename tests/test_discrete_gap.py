@@ -38,10 +38,10 @@ def loaded_and_unloaded(name, level, extra=()):
 
 
 @pytest.mark.parametrize("name,extra", [
-    ("hertz-cylinder", ()), ("punch-on-foundation", ()), ("flat-punch", ()),
-    ("wedge", ()), ("cattaneo-mindlin", ()),
-    ("thesis-3.46-coulomb-gap-3125", CONSISTENT), ("thesis-3.46-coulomb-gap-abs", CONSISTENT),
-    ("thesis-3.46-frictionless", CONSISTENT)])
+    ("hertz-cylinder", ()), ("thesis-3.46-coulomb-gap-3125", CONSISTENT),
+    *(pytest.param(name, extra, marks=pytest.mark.slow) for name, extra in (
+        ("punch-on-foundation", ()), ("flat-punch", ()), ("wedge", ()), ("cattaneo-mindlin", ()),
+        ("thesis-3.46-coulomb-gap-abs", CONSISTENT), ("thesis-3.46-frictionless", CONSISTENT)))])
 def test_without_load_every_gap_leaves_the_body_stress_free(name, extra):
     level = 2
     loaded, unloaded = loaded_and_unloaded(name, level, extra)
@@ -51,6 +51,7 @@ def test_without_load_every_gap_leaves_the_body_stress_free(name, extra):
 
 
 @pytest.mark.parametrize("name", ["hertz-cylinder", "punch-on-foundation"])
+@pytest.mark.slow
 @pytest.mark.parametrize("finer", [0, 1])
 def test_acceptance_levels_unloaded_stress_and_force_below_1e_6_of_the_loaded(name, finer):
     level = load_scene(name).geometry.level + finer
@@ -59,6 +60,7 @@ def test_acceptance_levels_unloaded_stress_and_force_below_1e_6_of_the_loaded(na
     assert contact_force(unloaded) <= 1e-6 * contact_force(loaded)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("finer", [0, 1])
 def test_a_foundation_out_of_reach_leaves_the_pushed_block_stress_free(finer):
     """hertz-cylinder is driven by a displacement of its top and has free sides: without the
@@ -86,6 +88,7 @@ def test_a_gap_out_of_reach_gives_the_solution_with_a_free_contact_side():
     assert norms(far)["u"] == pytest.approx(norms(free)["u"], rel=1e-8)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["hertz-cylinder", "punch-on-foundation"])
 def test_force_balance_on_gamma_c_within_2_percent_and_decreasing(name):
     """The resultant of sigma n on the contact sides against the force the multipliers see."""
@@ -98,8 +101,9 @@ def test_force_balance_on_gamma_c_within_2_percent_and_decreasing(name):
     assert mismatch[3] <= mismatch[2] <= mismatch[1] or max(mismatch) < 1e-12
 
 
-@pytest.mark.parametrize("name", ["thesis-3.46-coulomb", "thesis-3.46-coulomb-gap-abs",
-                                  "thesis-3.46-coulomb-gap0"])
+@pytest.mark.parametrize("name", ["thesis-3.46-coulomb", *(
+    pytest.param(name, marks=pytest.mark.slow)
+    for name in ("thesis-3.46-coulomb-gap-abs", "thesis-3.46-coulomb-gap0"))])
 def test_the_nodal_gap_is_the_thesis_gap_where_g_is_affine_on_every_htilde_edge(name):
     level = 2
     thesis = solve_scene(load_scene(name), level)

@@ -93,6 +93,7 @@ def smooth_table():
     return rows
 
 
+@pytest.mark.slow
 def test_estimator_converges_at_the_rate_of_the_error():
     rows = smooth_table()
     for prev, row in zip(rows, rows[1:]):

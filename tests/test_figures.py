@@ -65,6 +65,7 @@ def read_csv(path: Path) -> list[dict]:
     return list(csv.DictReader(lines))
 
 
+@pytest.mark.slow
 def test_every_figure_and_table_has_its_files(coarse_run):
     run = json.loads((coarse_run / "run.json").read_text())
     assert all(s["status"] == "ok" for s in run["scripts"].values()), run["scripts"]
@@ -85,6 +86,7 @@ def test_every_figure_and_table_has_its_files(coarse_run):
     assert len(list((coarse_run / "figures").glob("fig_4_*.png"))) == 13
 
 
+@pytest.mark.slow
 def test_tabulated_numbers_are_finite_and_carry_versions(coarse_run):
     data = sorted((coarse_run / "data").iterdir())
     assert len(data) >= 30
@@ -109,6 +111,7 @@ def test_tabulated_numbers_are_finite_and_carry_versions(coarse_run):
 
 @pytest.mark.parametrize("problem, table", [("frictionless", "tab_3_3_norms_frictionless"),
                                             ("coulomb", "tab_3_2_norms_coulomb")])
+@pytest.mark.slow
 def test_tables_agree_with_ngdual_solve(coarse_run, tmp_path, problem, table, capsys):
     level = int(SMOKE)
     assert main(["solve", f"thesis-3.46-{problem}", "--level", str(level), "--out",
@@ -127,11 +130,13 @@ def test_tables_agree_with_ngdual_solve(coarse_run, tmp_path, problem, table, ca
     assert all(int(dofs[k]) == v for k, v in solved["dofs"].items() if v)
 
 
+@pytest.mark.slow
 def test_table_3_1_matches_the_thesis(coarse_run):
     rows = read_csv(coarse_run / "data" / "tab_3_1_dofs.csv")
     assert len(rows) == int(SMOKE) and all(r["matches_thesis"] == "True" for r in rows)
 
 
+@pytest.mark.slow
 def test_figures_are_readable_without_the_thesis(coarse_run):
     sidecars = sorted((coarse_run / "figures").glob("*.json"))
     assert len(sidecars) >= 30
@@ -156,6 +161,7 @@ def test_figures_are_readable_without_the_thesis(coarse_run):
             assert any("percentile" in bar["label"] for bar in colorbars), path.name
 
 
+@pytest.mark.slow
 def test_a_rerun_computes_nothing(coarse_run, capsys):
     assert main(["figures", "--max-level", SMOKE, "--threads", "--out", str(coarse_run),
                  "--only", "tab_3_1", "tab_3_3"]) == 0
@@ -164,6 +170,7 @@ def test_a_rerun_computes_nothing(coarse_run, capsys):
     assert "0 computed" in capsys.readouterr().out
 
 
+@pytest.mark.slow
 def test_work_precision_plots_only_true_errors_and_the_peer(coarse_run):
     """Every plotted point carries a finite true error against the overkill (no norm
     differences), the primal peer P1 and P2 curves exist for both friction laws, and on
@@ -191,6 +198,7 @@ def test_work_precision_plots_only_true_errors_and_the_peer(coarse_run):
     assert {r["target"] for r in ratios} == {0.05, 0.02, 0.01}
 
 
+@pytest.mark.slow
 def test_the_estimator_tracks_the_exact_error_of_the_manufactured_cases(coarse_run):
     """eta / e on the manufactured cases (exact errors) stays within a factor 2 over the
     uniform levels: the estimator is efficient and reliable there."""
@@ -203,6 +211,7 @@ def test_the_estimator_tracks_the_exact_error_of_the_manufactured_cases(coarse_r
 
 # --- killing a sweep --------------------------------------------------------------------------
 
+@pytest.mark.slow
 def test_a_killed_sweep_resumes_without_recomputing(tmp_path):
     """tab_3_6 at level 2: the (rho_1, rho_2) grid on levels 1 and 2 (20 nested Uzawa solves)."""
     out = tmp_path / "out"

@@ -21,8 +21,8 @@ from ngdual.solvers.qp import solve_qp_friction
 from ngdual.solvers.settings import Model
 
 RTOL = 1e-5
-CASES = [(name, level) for name in ("thesis-3.46-coulomb", "thesis-3.46-coulomb-gap0")
-         for level in (1, 2, 3, 4)]
+CASES = [(name, level) if level <= 2 else pytest.param(name, level, marks=pytest.mark.slow)
+         for name in ("thesis-3.46-coulomb", "thesis-3.46-coulomb-gap0") for level in (1, 2, 3, 4)]
 
 
 @cache

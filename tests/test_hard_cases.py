@@ -17,6 +17,8 @@ from ngdual.solvers.qp import solve_qp_friction
 from ngdual.solvers.result import ConvergenceError
 from ngdual.solvers.settings import Model
 
+pytestmark = pytest.mark.slow  # levels 2-4 under Uzawa at tight tolerances
+
 UZAWA = "solver.method=uzawa"  # these cases test the thesis' algorithms (Alg. 3.41, Rem. 3.45)
 TIGHT = [UZAWA, "solver.eps1=1e-11", "solver.eps2=1e-10"]
 

@@ -22,6 +22,8 @@ from ngdual.post import friction_diagnostics
 from ngdual.scene import load_scene
 from ngdual.solvers import solve_scene
 
+pytestmark = pytest.mark.slow  # Figs. 3.26-3.28: nested Uzawa on levels 3 and 4
+
 SCENES = ["thesis-3.46-coulomb-gap-abs", "thesis-3.46-coulomb-gap-3125"]
 LEVELS = (3, 4)
 

@@ -72,6 +72,7 @@ def test_consistent_ends_balance_the_forces_of_example_3_46():
         assert balance.mismatch < FORCE_BALANCE_TOL / 5 and balance.tension < 1e-9
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["hertz-cylinder", "flat-punch", "cattaneo-mindlin", "wedge",
                                   "punch-on-foundation"])
 def test_the_shipped_contact_scenes_warn_of_nothing_on_their_default_level(name):

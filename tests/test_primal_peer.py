@@ -16,6 +16,8 @@ from ngdual.studies.primal_peer import (
     solve_primal,
 )
 
+pytestmark = pytest.mark.slow  # a study: the primal Nitsche peer on graded meshes to level 5
+
 # Hertz on levels 1, 3, 5 of the block graded towards the contact, contact edges of length
 # HC / 2^(level-1): two refinements (h / 4) between tested levels. The pressure has
 # square-root edges at +-a, so its L2 error is O(h / a) for P1 and P2 alike, with a constant

@@ -272,6 +272,7 @@ def test_tutorial_opens_with_header_and_ends_with_exercises(tutorial):
     assert "input(" not in text
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("tutorial", TUTORIALS, ids=lambda t: t.name)
 def test_tutorial_runs_headless_in_quick_mode(tutorial, tmp_path):
     results = run_script(tutorial, tmp_path)
@@ -282,6 +283,7 @@ def test_tutorial_runs_headless_in_quick_mode(tutorial, tmp_path):
     assert (tmp_path / "out" / tutorial.name / "geometry.png").is_file()   # Γ_D, Γ_N, Γ_C, mesh
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("solution", SOLUTIONS, ids=lambda t: t.name)
 def test_solutions_run_in_quick_mode_and_show_their_answers(solution, tmp_path):
     check_solutions(solution.number, run_script(solution, tmp_path))
@@ -289,6 +291,7 @@ def test_solutions_run_in_quick_mode_and_show_their_answers(solution, tmp_path):
     assert pictures and all(p.stat().st_size > 10_000 for p in pictures), pictures
 
 
+@pytest.mark.slow
 def test_notebooks_execute_cleanly_with_nbconvert(tmp_path):
     """`ngdual tutorials --notebooks DIR`, then `jupyter nbconvert --execute` on every notebook."""
     import nbformat

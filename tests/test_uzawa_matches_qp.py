@@ -20,7 +20,7 @@ from ngdual.solvers.qp import solve_qp
 from ngdual.solvers.settings import Model, UzawaSettings
 from ngdual.solvers.uzawa import uzawa
 
-LEVELS = [1, 2, 3, 4]
+LEVELS = [1, 2, 3, pytest.param(4, marks=pytest.mark.slow)]
 RTOL = 1e-6
 NORMS = ("sigma_X", "u", "eta", "phi", "lam_t", "lam_n")
 

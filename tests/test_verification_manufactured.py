@@ -146,7 +146,8 @@ def test_exact_stress_is_the_elastic_stress_of_a_c1_displacement(name):
 
 # --- convergence ---------------------------------------------------------------------------------
 
-@pytest.mark.parametrize("name", CASES)
+@pytest.mark.parametrize("name", [CASES[0], *(pytest.param(c, marks=pytest.mark.slow)
+                                              for c in CASES[1:])])
 def test_sigma_u_eta_converge_at_first_order_and_the_multipliers_converge(name):
     """Orders on the last two refinements: sigma (L2), u, eta >= 0.9; sigma in H(div)
     >= 0.9 where the set end points are mesh lines, >= 0.4 (theory 1/2) otherwise;
@@ -164,7 +165,8 @@ def test_sigma_u_eta_converge_at_first_order_and_the_multipliers_converge(name):
         assert overall >= 1.0, (key, overall)
 
 
-@pytest.mark.parametrize("name", CASES)
+@pytest.mark.parametrize("name", [CASES[0], *(pytest.param(c, marks=pytest.mark.slow)
+                                              for c in CASES[1:])])
 def test_contact_and_stick_sets_are_recovered_within_one_edge_per_end_point(name):
     """From level 3 on (h~ <= 1/2, below the set sizes): the set errors exceed what the grid
     forces by at most one h~ (contact) or h^ (stick) edge per end point; the contact set of
@@ -220,6 +222,7 @@ def test_uzawa_reaches_the_same_discrete_solution_as_the_active_set_solver(name)
     assert discrete_sets(uzawa) == discrete_sets(fast)
 
 
+@pytest.mark.slow
 def test_both_end_treatments_pose_the_same_problem():
     """The exact lambda_n, lambda_t vanish at the clamped ends of Gamma_C, so the data's end
     values (contact.ends = "consistent") and the thesis' zeros give the same solution."""
