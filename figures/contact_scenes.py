@@ -14,6 +14,8 @@ Cattaneo-Mindlin, whose tangential traction is shown too, with the computed stic
 shaded; the blunt wedge, p = (E* s / pi) arccosh(a / |x|)).
 """
 
+import matplotlib.pyplot as plt
+import matplotlib.tri as mtri
 import numpy as np
 
 from ngdual import plot
@@ -79,14 +81,13 @@ def run(ctx):
             row["exact_half_width"] = half_width(exact)
         rows.append(row)
         # PLOT
-        fig, (ax_f, ax_c) = plot.plt.subplots(1, 2, figsize=(12.5, 3.6),
-                                              constrained_layout=True)
+        fig, (ax_f, ax_c) = plt.subplots(1, 2, figsize=(12.5, 3.6), constrained_layout=True)
         pts, tri = arrays["points"], arrays["triangles"]
         centroids = pts[tri].mean(axis=1)
         inside = ((centroids[:, 0] >= box[0]) & (centroids[:, 0] <= box[1])
                   & (centroids[:, 1] <= box[3]))
         vmax = float(np.percentile(arrays["von_mises"][inside], CLIP))
-        art = ax_f.tripcolor(plot.mtri.Triangulation(pts[:, 0], pts[:, 1], tri),
+        art = ax_f.tripcolor(mtri.Triangulation(pts[:, 0], pts[:, 1], tri),
                              facecolors=arrays["von_mises"], cmap="viridis", vmin=0, vmax=vmax,
                              edgecolors="none", rasterized=True)
         fig.colorbar(art, ax=ax_f, extend="max",

@@ -11,6 +11,7 @@
 * The ``[benchmark]`` table is optional and validated like every table.
 """
 
+import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 
@@ -102,7 +103,7 @@ def test_the_y_range_holds_every_p_h_and_the_exact_curve_is_drawn(hertz):
     assert low <= traces.pressure.min() and traces.pressure.max() <= high
     legend = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
     assert any(text.startswith("Hertz, P = ") for text in legend)
-    plot.plt.close(fig)
+    plt.close(fig)
 
 
 @pytest.mark.slow
@@ -116,7 +117,7 @@ def test_the_tension_at_clamped_ends_with_the_thesis_end_values_is_on_scale_and_
     values = np.concatenate([traces.pressure, traces.end_pressure])
     assert low <= values.min() and values.max() <= high
     assert any("tension at a fixed end" in t.get_text() for t in fig.axes[0].texts)
-    plot.plt.close(fig)
+    plt.close(fig)
 
 
 @pytest.mark.slow

@@ -5,6 +5,7 @@ labels) in its legend and draws the mesh; the von Mises picture is an element fi
 colour bar names the quantity and, for a corner singularity, the clipping.
 """
 
+import matplotlib.pyplot as plt
 import ngsolve as ngs
 from matplotlib.figure import Figure
 
@@ -23,7 +24,7 @@ def test_the_geometry_picture_names_every_boundary_part_and_draws_the_mesh():
     assert f"{mesh.ne} triangles" in ax.get_title()
     notes = {text.get_text() for text in ax.texts}
     assert {r"$\Gamma_D$ (left)", r"$\Gamma_C$ (bottom)"} <= notes
-    nd.plot.plt.close(fig)
+    plt.close(fig)
 
 
 def test_a_scene_without_contact_draws_only_its_parts():
@@ -35,7 +36,7 @@ def test_a_scene_without_contact_draws_only_its_parts():
     assert [t.get_text() for t in ax.get_legend().get_texts()] == [
         r"$\Gamma_D$: left, right, bottom, top"]
     assert ax.get_title() == "clamped"
-    nd.plot.plt.close(fig)
+    plt.close(fig)
 
 
 def test_the_von_mises_picture_of_a_singular_field_says_it_is_clipped():
@@ -46,4 +47,4 @@ def test_the_von_mises_picture_of_a_singular_field_says_it_is_clipped():
     colorbar = fig.axes[-1]
     label = colorbar.get_xlabel() + colorbar.get_ylabel()
     assert label.startswith("von Mises stress") and "99th percentile" in label, label
-    nd.plot.plt.close(fig)
+    plt.close(fig)

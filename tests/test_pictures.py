@@ -15,6 +15,7 @@ import os
 import subprocess
 import sys
 
+import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 from matplotlib.figure import Figure
@@ -55,7 +56,7 @@ def every_figure(units=None) -> dict[str, Figure]:
     return {
         "contact_traces": plot.plot_contact_traces(traces(), "traces", units=units),
         "element_field": plot.plot_element_field(POINTS, TRIANGLES, values, "field",
-                                                 plot.unit_label("stress", plot._stress(units)),
+                                                 plot.unit_label("stress", units and units.stress),
                                                  units=units),
         "mesh": plot.plot_mesh(POINTS, TRIANGLES, "mesh", values > 0.5, units=units),
         "field_pair": plot.plot_field_pair(POINTS, TRIANGLES, [values, values], ["a", "b"],
@@ -84,7 +85,7 @@ def test_plot_functions_return_figures_and_write_nothing(tmp_path, monkeypatch):
     assert all(isinstance(fig, Figure) for fig in figures.values()), figures
     assert not list(tmp_path.iterdir())
     for fig in figures.values():
-        plot.plt.close(fig)
+        plt.close(fig)
 
 
 def test_save_figure_writes_one_file_or_a_stem_with_its_sidecar_and_closes_the_figure(
@@ -92,7 +93,7 @@ def test_save_figure_writes_one_file_or_a_stem_with_its_sidecar_and_closes_the_f
     fig = plot.plot_mesh(POINTS, TRIANGLES, "one file")
     assert plot.save_figure(fig, tmp_path / "out" / "mesh.png") == [tmp_path / "out" / "mesh.png"]
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["mesh.png"]
-    assert not plot.plt.fignum_exists(fig.number)
+    assert not plt.fignum_exists(fig.number)
     fig = plot.plot_mesh(POINTS, TRIANGLES, "a stem")
     written = plot.save_figure(fig, tmp_path / "stem" / "fig_4_01")
     assert [p.name for p in written] == ["fig_4_01.png", "fig_4_01.pdf"]
@@ -119,7 +120,7 @@ def test_labels_carry_the_declared_units():
         assert any("[mm]" in t for t in texts), (name, texts)
         if name in ("contact_traces", "element_field"):
             assert any("[MPa]" in t for t in texts), (name, texts)
-        plot.plt.close(fig)
+        plt.close(fig)
 
 
 def test_without_declared_units_labels_name_the_quantity_and_no_made_up_unit():
@@ -127,10 +128,10 @@ def test_without_declared_units_labels_name_the_quantity_and_no_made_up_unit():
         for text in labels(fig):
             assert "units" not in text and "[length]" not in text, (name, text)
             assert "[mm]" not in text and "[MPa]" not in text, (name, text)
-        plot.plt.close(fig)
+        plt.close(fig)
     fig = plot.plot_contact_traces(traces())
     assert r"pressure $p_h = -\sigma_n$" in labels(fig)
-    plot.plt.close(fig)
+    plt.close(fig)
 
 
 def test_a_corner_singularity_is_clipped_and_the_colour_bar_says_so():
@@ -142,12 +143,12 @@ def test_a_corner_singularity_is_clipped_and_the_colour_bar_says_so():
     assert art.get_clim()[1] < 2 < values.max()
     bar = [a for a in plot.figure_texts(fig)["axes"] if a["colorbar"]][0]["label"]
     assert "90th percentile" in bar and "1e+04" in bar
-    plot.plt.close(fig)
+    plt.close(fig)
     fig = plot.plot_element_field(POINTS, TRIANGLES, np.ones_like(values), "flat", "stress",
                                   clip=90)
     bar = [a for a in plot.figure_texts(fig)["axes"] if a["colorbar"]][0]["label"]
     assert bar == "stress"                              # nothing clipped, nothing said
-    plot.plt.close(fig)
+    plt.close(fig)
 
 
 def test_a_signed_field_is_clipped_symmetrically():
@@ -164,7 +165,7 @@ def test_the_pressure_panel_holds_p_h_and_leaves_only_a_fine_edge_spike_off_scal
     assert low > -500                                    # the corner spike of -sigma_n is not
     notes = " ".join(t.get_text() for t in ax.texts)
     assert "fine-edge values: 1 value off scale (up to -500)" in notes
-    plot.plt.close(fig)
+    plt.close(fig)
 
 
 def test_an_adaptive_mesh_shades_and_counts_the_marked_triangles():
@@ -178,7 +179,7 @@ def test_an_adaptive_mesh_shades_and_counts_the_marked_triangles():
                        np.sort(POINTS[TRIANGLES[marked]].mean(axis=1), axis=0))
     legend = [t.get_text() for t in ax.get_legend().get_texts()]
     assert "3 marked for refinement" in legend and "16 triangles" in legend
-    plot.plt.close(fig)
+    plt.close(fig)
 
 
 @pytest.mark.parametrize("bad", [0, 100, None])

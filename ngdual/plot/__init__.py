@@ -1,0 +1,38 @@
+"""Matplotlib figures (no computation here: inputs are arrays from :mod:`ngdual.post`, or a
+scene with its mesh for the two pictures every lecture starts from, :func:`plot_geometry`
+and :func:`plot_von_mises`).
+
+Every ``plot_*`` function returns a :class:`matplotlib.figure.Figure`; saving it is the
+caller's choice, :func:`save_figure`. Importing this package leaves matplotlib's backend
+alone: a notebook keeps its inline backend, a headless run gets Agg by matplotlib's own
+fallback.
+
+One module per kind of picture: :mod:`.fields` (element fields, von Mises), :mod:`.meshes`
+(the triangulation, the boundary parts, the domain of Example 3.46), :mod:`.traces` (the
+traces on Gamma_C), :mod:`.curves` (line plots and iteration-count grids), :mod:`.scales`
+(axis labels in the scene's units, clipped colour scales) and :mod:`.save` (files and the
+JSON sidecar).
+
+Axis labels carry the units the scene declares in its ``[units]`` table
+(:class:`ngdual.scene.Units`, passed as ``units``); where it declares none a label names
+the quantity only ("$x_1$", "von Mises stress"), never a made-up unit. Fields with
+corner singularities take ``clip``: the colour scale ends at that percentile and the
+colour bar says so.
+
+>>> import numpy as np
+>>> fig = plot_mesh(np.array([[0., 0.], [1., 0.], [0., 1.]]), np.array([[0, 1, 2]]))
+>>> type(fig).__name__
+'Figure'
+"""
+
+from .curves import plot_curves, plot_heatmaps
+from .fields import plot_element_field, plot_field_pair, plot_von_mises
+from .meshes import plot_domain, plot_geometry, plot_mesh
+from .save import figure_texts, save_figure
+from .scales import CORNER_CLIP, clipped_scale, unit_label
+from .traces import TRACE_CLIP, corner_note, plot_contact_traces, trace_range
+
+__all__ = ["CORNER_CLIP", "TRACE_CLIP", "clipped_scale", "corner_note", "figure_texts",
+           "plot_contact_traces", "plot_curves", "plot_domain", "plot_element_field",
+           "plot_field_pair", "plot_geometry", "plot_heatmaps", "plot_mesh", "plot_von_mises",
+           "save_figure", "trace_range", "unit_label"]

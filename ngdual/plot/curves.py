@@ -1,0 +1,87 @@
+"""Line plots and iteration-count grids of the figures of Sections 3.4 and 4.2: panels of
+curves (:func:`plot_curves`) and heat maps over a parameter grid (:func:`plot_heatmaps`,
+Fig. 3.23)."""
+
+from __future__ import annotations
+
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.figure import Figure
+
+
+def plot_curves(panels: list[dict], suptitle: str, ncols: int = 2,
+                panel_size: tuple[float, float] = (5.6, 3.4),
+                figure_legend: bool = False) -> Figure:
+    """Line plots, one panel per dict: ``title``, ``xlabel``, ``ylabel``, ``curves`` (dicts of
+    ``x``, ``y``, ``label`` and matplotlib style keywords), optional ``loglog``, ``hlines``
+    (``(y, label, style)``), ``note`` (text in the corner), ``xlim``, ``ylim``.
+
+    ``figure_legend``: one legend below all panels (the labels of all panels, once each)
+    instead of one per panel."""
+    n = len(panels)
+    ncols = min(ncols, n)
+    nrows = int(np.ceil(n / ncols))
+    fig, axes = plt.subplots(nrows, ncols, figsize=(panel_size[0] * ncols,
+                                                    panel_size[1] * nrows),
+                             constrained_layout=True, squeeze=False)
+    for ax, panel in zip(axes.ravel(), panels):
+        for curve in panel.get("curves", []):
+            curve = dict(curve)
+            x, y = np.asarray(curve.pop("x"), float), np.asarray(curve.pop("y"), float)
+            ax.plot(x, y, **curve)
+        for y, label, style in panel.get("hlines", []):
+            ax.axhline(y, label=label, **style)
+        if panel.get("loglog"):
+            ax.set_xscale("log")
+            ax.set_yscale("log")
+        if panel.get("xlim"):
+            ax.set_xlim(*panel["xlim"])
+        if panel.get("ylim"):
+            ax.set_ylim(*panel["ylim"])
+        if panel.get("note"):
+            ax.text(0.02, 0.03, panel["note"], transform=ax.transAxes, fontsize=8,
+                    va="bottom", ha="left", bbox={"fc": "white", "alpha": 0.8, "lw": 0})
+        ax.set_title(panel["title"])
+        ax.set_xlabel(panel["xlabel"])
+        ax.set_ylabel(panel["ylabel"])
+        ax.grid(alpha=0.3, which="both" if panel.get("loglog") else "major")
+        labelled = any(not line.get_label().startswith("_") for line in ax.get_lines())
+        if labelled and not figure_legend:
+            ax.legend(loc=panel.get("legend_loc", "best"), fontsize=8)
+    for ax in axes.ravel()[n:]:
+        ax.remove()
+    if figure_legend:
+        handles = {}
+        for ax in axes.ravel()[:n]:
+            for handle, label in zip(*ax.get_legend_handles_labels()):
+                handles.setdefault(label, handle)
+        fig.legend(handles.values(), handles.keys(), loc="outside lower center",
+                   ncol=min(3, len(handles)), fontsize=8)
+    fig.suptitle(suptitle)
+    return fig
+
+
+def plot_heatmaps(x: np.ndarray, y: np.ndarray, grids: list[np.ndarray], titles: list[str],
+                  xlabel: str, ylabel: str, cbar_labels: list[str], suptitle: str) -> Figure:
+    """Iteration counts over a parameter grid (Fig. 3.23): blue few, red many, numbers in the
+    cells, NaN cells (did not converge) hatched and marked with a cross."""
+    fig, axes = plt.subplots(1, len(grids), figsize=(5.4 * len(grids), 4.2),
+                             constrained_layout=True)
+    for ax, grid, title, clabel in zip(np.atleast_1d(axes), grids, titles, cbar_labels):
+        data = np.ma.masked_invalid(np.asarray(grid, float))
+        art = ax.pcolormesh(np.arange(len(x) + 1), np.arange(len(y) + 1), data.T,
+                            cmap="coolwarm", shading="flat")
+        ax.set_facecolor("0.85")
+        for i in range(len(x)):
+            for j in range(len(y)):
+                v = grid[i][j]
+                ax.text(i + 0.5, j + 0.5, "x" if not np.isfinite(v) else f"{v:.0f}",
+                        ha="center", va="center", fontsize=7)
+        ax.set_xticks(np.arange(len(x)) + 0.5, [f"{v:g}" for v in x])
+        ax.set_yticks(np.arange(len(y)) + 0.5, [f"{v:g}" for v in y])
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel(ylabel)
+        ax.set_title(title)
+        fig.colorbar(art, ax=ax, label=clabel)
+    fig.suptitle(suptitle)
+    return fig
