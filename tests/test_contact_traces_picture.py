@@ -16,7 +16,6 @@ import numpy as np
 import pytest
 
 import ngdual as nd
-from ngdual import plot
 from ngdual.cli.pipeline import solution_figures
 from ngdual.scene import SceneError, load_scene, read_toml, scene_from_dict
 from ngdual.verification.benchmark import (
