@@ -27,7 +27,7 @@ from .boundary import CoarseMesh, edge_normals
 from .expr import Expression
 from .geometry import tangent
 from .scene import Scene, gap_at
-from .scene.domain import foundation_gap
+from .scene.contact import foundation_gap
 
 
 def trace_space(mesh: ngs.Mesh, labels: list[str]) -> ngs.FESpace:

@@ -21,7 +21,7 @@ from ngdual.forms import assemble
 from ngdual.mesh import build_mesh, moved_mesh
 from ngdual.quantities import fields
 from ngdual.scene import DISCRETE_GAPS, SceneError, read_toml, scene_from_dict
-from ngdual.scene.domain import round_off
+from ngdual.scene.contact import round_off
 from ngdual.solvers import solve_problem
 
 

@@ -31,15 +31,17 @@ Loads, gap and bound are formulas in ``x`` and ``y`` (see :mod:`ngdual.expr`).
 
 The package: :mod:`.tables` (the tables, their defaults, SceneError), :mod:`.load` (TOML,
 shipped scenes, overrides), :mod:`.values` (single values), :mod:`.domain` (the polygon,
-boundary parts, foundation and contact sides; the contact data of a scene) and
-:mod:`.validate` (the whole scene).
+its boundary parts and the formulas on them), :mod:`.contact` (Gamma_C: junctions, foundation
+line, gap, round-off, and its checks) and :mod:`.validate` (the whole scene).
 """
 
-from .domain import (
+from .contact import (
     contact_junctions,
     contact_samples,
     foundation_line,
     gap_at,
+)
+from .domain import (
     role_of,
     validate_geometry,
 )

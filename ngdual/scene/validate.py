@@ -6,13 +6,8 @@ import dataclasses
 
 import numpy as np
 
-from .domain import (
-    validate_boundary,
-    validate_contact,
-    validate_formulas_on_sides,
-    validate_gap_and_bound,
-    validate_geometry,
-)
+from .contact import validate_contact, validate_gap_and_bound
+from .domain import validate_boundary, validate_formulas_on_sides, validate_geometry
 from .tables import (
     BENCHMARK_KINDS,
     CONTACT_ENDS,

@@ -13,10 +13,10 @@ from .result import ContactEdges, PrimalResult
 
 def _scene_gap(contact, mesh: ngs.Mesh, labels: list[str]) -> ngs.CoefficientFunction:
     """The scene's gap as a CF (a formula, or the distance to the foundation line along the
-    outward normal of Gamma_C, :func:`ngdual.scene.domain.foundation_gap`). The CF is also
+    outward normal of Gamma_C, :func:`ngdual.scene.contact.foundation_gap`). The CF is also
     evaluated inside the body (the pressure at points), where no normal exists: a foundation
     line needs a straight Gamma_C, whose normal is then a constant."""
-    from ...scene.domain import foundation_gap
+    from ...scene.contact import foundation_gap
 
     if contact.foundation is None:
         return scalar_cf(contact.gap_formula)
