@@ -53,17 +53,14 @@
 
 # %%
 import matplotlib.pyplot as plt
-import ngsolve as ngs
 import numpy as np
-import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 import ngdual as nd
 from ngdual import peers
 from ngdual.forms import assemble
 from ngdual.mesh import build_mesh
-from ngdual.sparse import to_scipy
 from ngdual.studies.tutorials import Lesson
+from ngdual.verification.infsup import gram_matrix, smallest_singular_values
 
 lesson = Lesson("01_peers_spaces")                       # figures and results.json go here
 QUICK = lesson.quick
@@ -131,8 +128,9 @@ for level in DOF_LEVELS:
 #
 # We take Example 3.46 with Dirichlet conditions on all four sides (no boundary
 # multipliers) and read $B$ off the assembled system: its block $K[\sigma, (u, \eta)]$ is
-# exactly $b + s$. We find the smallest eigenvalues by shift-invert Lanczos (`eigsh`),
-# solving with the saddle-point matrix
+# exactly $b + s$. `gram_matrix` (`ngdual.verification.infsup`) assembles $X$ and $Y$;
+# `smallest_singular_values` finds the smallest eigenvalues by shift-invert Lanczos
+# (`eigsh`), solving with the saddle-point matrix
 # $\begin{pmatrix} X & B \\ B^\top & \sigma_0 Y \end{pmatrix}$ so that $X^{-1}$ never
 # becomes dense.
 
@@ -142,38 +140,6 @@ clamped = nd.load_scene("thesis-3.46-frictionless",
                          "boundary.neumann=[]", "boundary.contact=[]"])
 lesson.save(nd.plot_geometry(clamped, level=1, title="Example 3.46 clamped on all sides"),
             "geometry_clamped")
-
-
-def gram_matrix(problem) -> sp.csr_matrix:
-    """Block-diagonal Gram matrix: H(div) on the stress rows, L² on u and η."""
-    trial = dict(zip(problem.names, problem.fes.TrialFunction()))
-    test = dict(zip(problem.names, problem.fes.TestFunction()))
-
-    def parts(f):
-        return (peers.stress(f["r1"], f["r2"], f["b1"], f["b2"]),
-                peers.stress_divergence(f["r1"], f["r2"]), ngs.CF((f["u1"], f["u2"])), f["eta"])
-
-    sigma, div_sigma, u, eta = parts(trial)
-    tau, div_tau, v, xi = parts(test)
-    form = ngs.BilinearForm(problem.fes)
-    form += (ngs.InnerProduct(sigma, tau) + div_sigma * div_tau + u * v + eta * xi) * ngs.dx
-    form.Assemble()
-    return to_scipy(form.mat)
-
-
-def smallest_singular_values(X, B, Y, k=3, shift=-1e-6) -> np.ndarray:
-    """The k smallest singular values of B from X-norm to Y-norm (sqrt of eigenvalues)."""
-    n, m = B.shape
-    saddle = spla.splu(sp.bmat([[X, B], [B.T, shift * Y]], format="csc"))
-    x_lu = spla.splu(X.tocsc())
-    schur = spla.LinearOperator((m, m), matvec=lambda y: B.T @ x_lu.solve(B @ y))
-    # (BᵀX⁻¹B − shift·Y)⁻¹ r is the second block of the saddle-point solution with rhs (0, −r)
-    inverse = spla.LinearOperator((m, m),
-                                  matvec=lambda r: saddle.solve(np.r_[np.zeros(n), -r])[n:])
-    values = spla.eigsh(schur, k=k, M=Y, sigma=shift, OPinv=inverse,
-                        return_eigenvectors=False)
-    return np.sqrt(np.maximum(np.sort(values), 0.0))
-
 
 inf_sup_rows = []
 for level in INF_SUP_LEVELS:

@@ -15,7 +15,8 @@ pressure and shear traction on Gamma_C and their errors against them
 solve several levels finer, from the plain arrays both are sampled to.
 :mod:`ngdual.verification.contact_benchmarks`: those errors per level on the shipped contact
 scenes, adaptive runs and the finite-box study; :mod:`ngdual.verification.report`: the
-tables of ``ngdual verify``.
+tables of ``ngdual verify``. :mod:`ngdual.verification.infsup`: the discrete inf-sup constant
+of the PEERS triple (Lemma 3.28) as the smallest singular value of b + s.
 """
 
 from .analytic import (

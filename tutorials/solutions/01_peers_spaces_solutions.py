@@ -5,17 +5,17 @@
 
 # %%
 import matplotlib.pyplot as plt
-import ngsolve as ngs
 import numpy as np
-import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 import ngdual as nd
-from ngdual import peers
 from ngdual.forms import Spaces, assemble
 from ngdual.mesh import build_mesh
-from ngdual.sparse import to_scipy
 from ngdual.studies.tutorials import Lesson
+from ngdual.verification.infsup import (
+    gram_matrix,
+    largest_singular_value,
+    smallest_singular_values,
+)
 
 lesson = Lesson("01_peers_spaces_solutions")
 QUICK = lesson.quick
@@ -39,40 +39,6 @@ clamped = nd.load_scene("thesis-3.46-frictionless",
                         ["boundary.dirichlet=['left', 'right', 'bottom', 'top']",
                          "boundary.neumann=[]", "boundary.contact=[]"])
 
-
-def gram_matrix(problem, with_div: bool) -> sp.csr_matrix:
-    trial = dict(zip(problem.names, problem.fes.TrialFunction()))
-    test = dict(zip(problem.names, problem.fes.TestFunction()))
-
-    def parts(f):
-        return (peers.stress(f["r1"], f["r2"], f["b1"], f["b2"]),
-                peers.stress_divergence(f["r1"], f["r2"]), ngs.CF((f["u1"], f["u2"])), f["eta"])
-
-    sigma, div_sigma, u, eta = parts(trial)
-    tau, div_tau, v, xi = parts(test)
-    integrand = ngs.InnerProduct(sigma, tau) + u * v + eta * xi
-    if with_div:
-        integrand = integrand + div_sigma * div_tau
-    form = ngs.BilinearForm(problem.fes)
-    form += integrand * ngs.dx
-    form.Assemble()
-    return to_scipy(form.mat)
-
-
-def extreme_singular_values(X, B, Y, shift=-1e-6) -> tuple[float, float]:
-    """Smallest and largest singular value of B from the X-norm to the Y-norm."""
-    n, m = B.shape
-    saddle = spla.splu(sp.bmat([[X, B], [B.T, shift * Y]], format="csc"))
-    x_lu = spla.splu(X.tocsc())
-    schur = spla.LinearOperator((m, m), matvec=lambda y: B.T @ x_lu.solve(B @ y))
-    inverse = spla.LinearOperator((m, m),
-                                  matvec=lambda r: saddle.solve(np.r_[np.zeros(n), -r])[n:])
-    smallest = spla.eigsh(schur, k=1, M=Y, sigma=shift, OPinv=inverse,
-                          return_eigenvectors=False).min()
-    largest = spla.eigsh(schur, k=1, M=Y.tocsc(), which="LA", return_eigenvectors=False).max()
-    return float(np.sqrt(max(smallest, 0.0))), float(np.sqrt(largest))
-
-
 singular = {"hdiv": [], "l2": []}
 for level in LEVELS:
     problem = assemble(clamped, build_mesh(clamped.geometry, level))
@@ -80,7 +46,9 @@ for level in LEVELS:
     B = problem.block(s, m)
     for key, with_div in (("hdiv", True), ("l2", False)):
         G = gram_matrix(problem, with_div)
-        singular[key].append(extreme_singular_values(G[s][:, s], B, G[m][:, m]))
+        X, Y = G[s][:, s], G[m][:, m]
+        singular[key].append((float(smallest_singular_values(X, B, Y, k=1)[0]),
+                              largest_singular_value(X, B, Y)))
     print(f"level {level}: (smallest, largest) in H(div) "
           f"({singular['hdiv'][-1][0]:.3f}, {singular['hdiv'][-1][1]:.3f}),  in L2 "
           f"({singular['l2'][-1][0]:.3f}, {singular['l2'][-1][1]:.3f})")

@@ -7,7 +7,8 @@ with d = d_N + d_{C,t} + d_{C,n} of (3.24), X_h the PEERS stresses and |mu|_{1/2
 H^{1/2} norm of the coarse P1 multipliers (the interpolation norm between L^2 and H^1 of
 every boundary part: M V diag((1 + k^2)^{1/2}) V^T M from the eigenpairs (k^2, V) of the
 arc-length stiffness against the mass matrix). beta_h^2 is the smallest eigenvalue of
-B^T A^{-1} B against that norm (A the H(div) Gram matrix of X_h, B = K[sigma, multipliers]).
+B^T A^{-1} B against that norm (A the H(div) Gram matrix of X_h,
+:func:`ngdual.verification.infsup.gram_matrix`; B = K[sigma, multipliers]).
 It must stay bounded away from zero under refinement, with fixed ends (the thesis), with
 free ends next to Gamma_N and at kinks (``contact.ends = "consistent"``).
 """
@@ -16,37 +17,20 @@ from __future__ import annotations
 
 import time
 
-import ngsolve as ngs
 import numpy as np
 import scipy.linalg as sla
-import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ... import peers
 from ...forms import Spaces, assemble
 from ...mesh import build_mesh
 from ...scene import load_scene
+from ...verification.infsup import gram_matrix
 from .measure import header
 
 DEFAULT_SCENES = ("thesis-3.46-frictionless", "hertz-cylinder", "flat-punch", "wedge")
 # the table ngdual bench infsup prints: (title, key of a record, format)
 COLUMNS = (("scene", "scene", "28s"), ("ends", "ends", "10s"), ("level", "level", "5d"),
            ("mult", "multipliers", "6d"), ("X_h", "stresses", "8d"), ("beta_h", "beta", "8.4f"))
-
-
-def hdiv_gram(mesh: ngs.Mesh) -> sp.csr_matrix:
-    """int sigma : tau + div sigma . div tau on X_h (the dof order of :mod:`ngdual.forms`)."""
-    comps = peers.peers_spaces(mesh)
-    fes = ngs.FESpace([comps[c] for c in peers.STRESS])
-    (r1, r2, b1, b2), (s1, s2, c1, c2) = fes.TnT()
-    sig, tau = peers.stress(r1, r2, b1, b2), peers.stress(s1, s2, c1, c2)
-    a = ngs.BilinearForm(fes)
-    a += (ngs.InnerProduct(sig, tau) + peers.stress_divergence(r1, r2)
-          * peers.stress_divergence(s1, s2)) * ngs.dx
-    a.Assemble()
-    rows, cols, vals = a.mat.COO()
-    return sp.csr_matrix((np.asarray(vals), (np.asarray(rows), np.asarray(cols))),
-                         shape=(fes.ndof, fes.ndof))
 
 
 def half_norm(coarse) -> np.ndarray:
@@ -72,8 +56,7 @@ def infsup(scene, level: int) -> dict:
         norms += [n, n]
         names += ["lam_t", "lam_n"]
     B = problem.block(problem.sigma, problem.index(*names)).toarray()
-    A = hdiv_gram(problem.fes.mesh)
-    assert A.shape[0] == len(problem.sigma)
+    A = gram_matrix(problem)[problem.sigma][:, problem.sigma]
     solve = spla.factorized(A.tocsc())
     AinvB = np.column_stack([solve(B[:, j]) for j in range(B.shape[1])])
     S = B.T @ AinvB
