@@ -32,7 +32,9 @@ from .save import figure_texts, save_figure
 from .scales import CORNER_CLIP, clipped_scale, unit_label
 from .traces import TRACE_CLIP, corner_note, plot_contact_traces, trace_range
 
-__all__ = ["CORNER_CLIP", "TRACE_CLIP", "clipped_scale", "corner_note", "figure_texts",
-           "plot_contact_traces", "plot_curves", "plot_domain", "plot_element_field",
-           "plot_field_pair", "plot_geometry", "plot_heatmaps", "plot_mesh", "plot_von_mises",
-           "save_figure", "trace_range", "unit_label"]
+# in the order of the API page: the pictures of a solution, saving, the thesis' figures, the
+# helpers of figure scripts that draw their own panels
+__all__ = ["plot_geometry", "plot_mesh", "plot_element_field", "plot_von_mises",
+           "plot_contact_traces", "save_figure", "figure_texts", "plot_field_pair", "plot_curves",
+           "plot_heatmaps", "plot_domain", "unit_label", "clipped_scale", "trace_range",
+           "corner_note", "CORNER_CLIP", "TRACE_CLIP"]
