@@ -63,13 +63,8 @@ def peers_form(trial: dict, test: dict, lame: tuple[float, float]
         Lame's constants (lambda, mu).
     """
     lam, mu = lame
-
-    def parts(f):
-        return (peers.stress(f["r1"], f["r2"], f["b1"], f["b2"]),
-                peers.stress_divergence(f["r1"], f["r2"]), ngs.CF((f["u1"], f["u2"])), f["eta"])
-
-    sig, div_sig, u, eta = parts(trial)
-    tau, div_tau, v, xi = parts(test)
+    sig, div_sig, u, eta = peers.triple(trial)
+    tau, div_tau, v, xi = peers.triple(test)
     dx = ngs.dx(intrules=EXACT_VOLUME_RULES)
     # three integrals, each compiled on its own: the element matrices of a~, b, s are summed
     # in this order in every assembly

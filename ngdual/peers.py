@@ -64,6 +64,13 @@ def stress_traction(r1, r2) -> ngs.CoefficientFunction:
     return ngs.CF((r1.Trace() * n, r2.Trace() * n))
 
 
+def triple(f: dict):
+    """(sigma, div sigma, u, eta) of the PEERS components of a trial or test function ``f``
+    (a dict keyed by component name, :func:`peers_spaces`)."""
+    return (stress(f["r1"], f["r2"], f["b1"], f["b2"]), stress_divergence(f["r1"], f["r2"]),
+            ngs.CF((f["u1"], f["u2"])), f["eta"])
+
+
 def compliance(sigma, lam: float, mu: float) -> ngs.CoefficientFunction:
     """C^{-1} : sigma = (sigma - lam/(2(lam+mu)) tr(sigma) I) / (2 mu), plane strain."""
     return (sigma - lam / (2 * (lam + mu)) * ngs.Trace(sigma) * ngs.Id(2)) / (2 * mu)

@@ -57,13 +57,8 @@ def gram_matrix(problem, with_div: bool = True) -> sp.csr_matrix:
     """
     trial = dict(zip(problem.names, problem.fes.TrialFunction()))
     test = dict(zip(problem.names, problem.fes.TestFunction()))
-
-    def parts(f):
-        return (peers.stress(f["r1"], f["r2"], f["b1"], f["b2"]),
-                peers.stress_divergence(f["r1"], f["r2"]), ngs.CF((f["u1"], f["u2"])), f["eta"])
-
-    sigma, div_sigma, u, eta = parts(trial)
-    tau, div_tau, v, xi = parts(test)
+    sigma, div_sigma, u, eta = peers.triple(trial)
+    tau, div_tau, v, xi = peers.triple(test)
     integrand = ngs.InnerProduct(sigma, tau)
     if with_div:
         integrand = integrand + div_sigma * div_tau
