@@ -48,6 +48,7 @@ def test_exact_tractions_carry_the_forces_they_are_built_from():
     assert abs(abs(cm.shear(outside)[0]) - 0.3 * cm.pressure(outside)[0]) < 1e-9  # slip
 
 
+@pytest.mark.slow
 def test_hertz_pressure_error_decreases_on_every_level_and_is_below_3_percent_on_level_4():
     rows = uniform_study("hertz", (1, 2, 3, 4))
     errors = [r["l2"] for r in rows]
@@ -76,6 +77,7 @@ def test_cattaneo_mindlin_stick_half_width_is_within_one_friction_cell():
     assert abs(row["Q"]) < 0.3 * row["force"]
 
 
+@pytest.mark.slow
 def test_verify_quick_prints_the_tables_and_writes_them(tmp_path, capsys):
     path = tmp_path / "verify.json"
     assert main(["verify", "--quick", "--json", str(path)]) == 0
@@ -99,6 +101,7 @@ def test_flat_punch_domain_error_shrinks_with_the_box():
     assert domain[2] < 0.003, rows
 
 
+@pytest.mark.slow
 def test_wedge_pressure_converges_to_the_blunt_wedge_solution():
     """The kinked Gamma_C of the wedge against p = (E* s / pi) arccosh(a/|x|), a = P/(E* s):
     the L2 error of p_h falls on every level (slowly: the contact zone spans few h~ cells
