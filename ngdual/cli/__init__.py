@@ -119,7 +119,7 @@ def parser() -> argparse.ArgumentParser:
     tu = sub.add_parser("tutorials", help="list the tutorials or write them as notebooks",
                         parents=[common])
     tu.add_argument("--notebooks", metavar="DIR", default=None,
-                    help="write the tutorials as .ipynb notebooks into DIR (needs jupytext)")
+                    help="write the tutorials as .ipynb notebooks into DIR (the tutorials extra)")
     tu.add_argument("--solutions", action="store_true",
                     help="with --notebooks: also write the exercise solutions to DIR/solutions")
     tu.add_argument("--source", metavar="DIR", default=None,

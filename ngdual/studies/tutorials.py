@@ -28,6 +28,7 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
+from ..extras import require
 from ..io import write_json
 from .sources import scripts_folder
 
@@ -158,11 +159,7 @@ def write_notebooks(dest: str | Path, folder: str | Path | None = None,
     With ``solutions=True`` the solutions go to ``dest/solutions`` as well.
     Returns the paths written. Needs the ``tutorials`` extra (jupytext).
     """
-    try:
-        import jupytext
-    except ImportError:
-        raise ImportError("writing notebooks needs jupytext: pip install -e '.[tutorials]'") \
-            from None
+    jupytext = require("jupytext", "tutorials")
     dest = Path(dest)
     groups = [(dest, list_tutorials(folder))]
     if solutions:
