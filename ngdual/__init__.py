@@ -21,7 +21,8 @@ caller's choice, :func:`save_figure`.
 
 The names are loaded lazily (PEP 562): ``import ngdual`` imports neither NGSolve nor
 matplotlib, so that the command line starts fast; the first use of a name imports its
-module.
+module. Every name here needs only the core dependencies (``install_requires``); a study
+that needs an extra names it (:func:`ngdual.extras.require`).
 """
 
 from __future__ import annotations
