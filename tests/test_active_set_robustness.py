@@ -1,5 +1,5 @@
-"""The active-set solver on fine, adaptively refined and nearly incompressible meshes (issue 13,
-item 5): tolerances relative to the round-off this problem can attain, a damped semismooth
+"""The active-set solver on fine, adaptively refined and nearly incompressible meshes:
+tolerances relative to the round-off this problem can attain, a damped semismooth
 Newton method, a relaxed Coulomb fixed point, and failures that name what failed.
 
 The reported cases: cattaneo-mindlin (nu = 0.4999, mu_f = 0.3) stopped with "linear = 2.1e-09"

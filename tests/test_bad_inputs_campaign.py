@@ -1,4 +1,4 @@
-"""The hard and bad inputs of the issue 24 campaign: each a clear error or a right answer.
+"""Hard and bad inputs found by trying to break ngdual: each a clear error or a right answer.
 
 The command line answers bad input with exit status 2, one line naming the field or flag
 and nothing written; the Python API with a TypeError or ValueError (``SceneTypeError``,

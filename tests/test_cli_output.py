@@ -126,3 +126,17 @@ def test_every_subcommand_and_option_has_help_text():
             if not action.help:
                 missing.append(f"{name} {'/'.join(action.option_strings) or action.dest}")
     assert not missing, missing
+
+
+def test_a_reader_that_stops_early_is_not_reported_as_a_bug():
+    """``ngdual scenes | head -1``: the broken pipe ends ngdual like SIGPIPE ends a Unix tool
+    (status 141), without an 'internal error' line."""
+    import subprocess
+    import sys
+
+    proc = subprocess.Popen([sys.executable, "-m", "ngdual", "scenes"], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE)
+    proc.stdout.close()  # before ngdual writes anything: its first flush meets a broken pipe
+    err = proc.stderr.read().decode()
+    assert proc.wait(timeout=60) == 141, err
+    assert "internal error" not in err and "Traceback" not in err, err

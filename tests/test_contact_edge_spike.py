@@ -1,4 +1,4 @@
-"""The spike at the edge of the contact zone (issue 14, item 6) and Gamma_C read from its one home.
+"""The spike at the edge of the contact zone, and Gamma_C read from its one home.
 
 Case ``frictionless-offnode`` (:mod:`ngdual.verification.manufactured`): contact on
 [-7/3, 7/3], so on every level the edge of the contact zone lies inside an h~ edge, with the
@@ -111,7 +111,7 @@ def spike_bounded(case, sols):
     assert max(scaled[1:]) <= scaled[0] * 1.5, scaled
 
 
-# --- friction reads Gamma_C from ContactBoundary (issue 13, item 1) ---------------------------
+# --- friction reads Gamma_C from ContactBoundary ---------------------------------------------
 
 def _p0_edge_functionals(problem):
     """int_e sigma_n ds, int_e sigma_t ds by the independent route: piecewise constants on

@@ -168,7 +168,7 @@ def test_unknown_solver_method_is_named():
         load_scene("thesis-3.46-coulomb", ["solver.method=newton"])
 
 
-def test_physical_units_scale_exactly():
+def test_physical_units_scale_exactly_in_the_active_set_method():
     base = fast("thesis-3.46-coulomb", 3)
     scaled = fast("thesis-3.46-coulomb", 3, "material.E=2e11",
                   'loads.traction=["0", "-8e8*ifpos(4 - x*x, 1 - x*x/2 + x**4/16, 0)"]')

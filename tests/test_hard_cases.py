@@ -78,7 +78,7 @@ def test_nearly_incompressible_contact_converges_like_compressible():
     assert its[0.4999] <= 2 * its[0.3] + 10, its
 
 
-def test_physical_units_scale_exactly():
+def test_physical_units_scale_exactly_in_the_nested_uzawa_iteration():
     """E = 2e11 Pa and tractions 1e6 times larger: sigma scales by 1e6, u and lambda do not
     change, and the iteration takes the same number of steps (rho is dimensionless)."""
     base = solve_scene(load_scene("thesis-3.46-coulomb", TIGHT), 3)

@@ -1,4 +1,4 @@
-"""No input crashes, hangs or fools ngdual (issue 15).
+"""No input crashes, hangs or fools ngdual.
 
 Every class of bad input, through every subcommand and the Python API, gets one message
 naming the field or flag at fault: exit status 2 from the CLI (``SceneError`` from the

@@ -103,7 +103,7 @@ def test_no_module_reaches_back_up_the_data_flow(module):
 
 
 def test_no_solver_reads_the_scene():
-    """Solvers receive explicit settings (issue 16): ``problem.scene`` appears in no solver
+    """Solvers receive explicit settings: ``problem.scene`` appears in no solver
     module except the dispatch that builds the settings from it."""
     readers = [p.name for p in (PACKAGE / "solvers").glob("*.py")
                if p.name not in ("dispatch.py", "settings.py") and ".scene" in p.read_text()]

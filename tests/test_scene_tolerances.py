@@ -1,5 +1,5 @@
 """Geometric checks compare with the scene's round-off, so moved copies of valid scenes pass
-and solve to the same answer (issue 24, item 5).
+and solve to the same answer.
 
 Elasticity and the Signorini conditions are invariant under rigid motions: a scene rotated
 and translated as a whole (points, arc centres, the foundation line, constant loads) has the

@@ -31,12 +31,19 @@ estimated size exceeds the memory available are refused before meshing;
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 
 from ..extras import MissingExtraError
 from ..marking import STRATEGIES
 from ..scene import SceneError
-from .output import EXIT_BAD_INPUT, EXIT_INTERNAL, EXIT_NOT_CONVERGED, EXIT_WARNINGS
+from .output import (
+    EXIT_BAD_INPUT,
+    EXIT_BROKEN_PIPE,
+    EXIT_INTERNAL,
+    EXIT_NOT_CONVERGED,
+    EXIT_WARNINGS,
+)
 from .pipeline import cmd_adapt, cmd_dofs, cmd_scenes, cmd_solve
 from .studies import cmd_bench, cmd_figures, cmd_tutorials, cmd_verify
 
@@ -251,7 +258,9 @@ def main(argv: list[str] | None = None) -> int:
     if args.debug:
         return args.func(args)
     try:
-        return args.func(args)
+        status = args.func(args)
+        sys.stdout.flush()  # a reader that stopped early shows here, not at interpreter exit
+        return status
     except (SceneError, MissingExtraError) as err:  # the message names the field or the extra
         print(f"ngdual: error: {err}", file=sys.stderr)
         return EXIT_BAD_INPUT
@@ -261,6 +270,10 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("ngdual: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # the reader of stdout stopped (ngdual tutorials | head): not a bug
+        # Python would report the broken pipe again when it flushes stdout at exit
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return EXIT_BROKEN_PIPE
     except Exception as err:  # a bug: one line, the traceback with --debug
         print(f"ngdual: internal error: {type(err).__name__}: {str(err)[:500]} (a bug in "
               "ngdual: run again with --debug for the traceback and report it)",

@@ -7,6 +7,7 @@ import sys
 from ..scene import SceneError, check_level
 
 EXIT_NOT_CONVERGED, EXIT_BAD_INPUT, EXIT_INTERNAL, EXIT_WARNINGS = 1, 2, 3, 4
+EXIT_BROKEN_PIPE = 141  # what a shell reports for a process ended by SIGPIPE (128 + 13)
 HISTORY_ROWS = 8  # residuals shown when an iteration fails
 LARGE_MESH = 2e5  # triangles: say so before meshing
 
