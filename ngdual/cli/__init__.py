@@ -145,8 +145,8 @@ def parser() -> argparse.ArgumentParser:
     fg.add_argument("--workers", type=int, default=None,
                     help="LocalCluster workers (default: one per CPU core)")
     fg.add_argument("--threads", action="store_true",
-                    help="one LocalCluster worker thread in this process: quick to start, one "
-                         "task at a time")
+                    help="the tasks one after another in this process: quick to start, and "
+                         "without dask (the studies extra)")
     fg.add_argument("--only", nargs="+", default=None, metavar="NAME",
                     help="run only the scripts whose name contains one of these")
     fg.add_argument("--source", default=None, metavar="DIR",

@@ -20,7 +20,8 @@ def cmd_figures(args) -> int:
     from ..studies.figures import DEFAULT_MAX_LEVEL, THESIS_MAX_LEVEL, run_figures
     from ..studies.figures.run import select_scripts
 
-    require("dask.distributed", "studies")  # the sweep's; refused before anything is written
+    if args.scheduler or not args.threads:  # a dask sweep; refused before anything is written
+        require("dask.distributed", "studies")
 
     max_level = DEFAULT_MAX_LEVEL if args.max_level is None else args.max_level
     number_flag(max_level, "--max-level", 2, THESIS_MAX_LEVEL, integer=True)

@@ -145,7 +145,8 @@ def script_main(path: str) -> None:
     p = argparse.ArgumentParser(description=f"regenerate {Path(path).stem}")
     p.add_argument("--max-level", type=int, default=DEFAULT_MAX_LEVEL)
     p.add_argument("--out", default="figures-output")
-    p.add_argument("--threads", action="store_true", help="dask workers as threads")
+    p.add_argument("--threads", action="store_true",
+                   help="the tasks one after another in this process (no dask)")
     args = p.parse_args()
     summary = run_figures(args.max_level, args.out, processes=not args.threads,
                           only=[Path(path).stem], source=Path(path).parent)

@@ -54,9 +54,9 @@ class Runner:
     workers : int, optional
         Workers of the LocalCluster started otherwise (default: the CPU count).
     processes : bool
-        Worker processes (default), or one worker thread in this process
-        (quick to start, what the tests use; one task at a time: netgen and
-        NGSolve must not mesh or assemble in two threads at once).
+        Worker processes (default), or the tasks one after another in this process
+        (quick to start, what the tests use, and without dask: netgen and NGSolve must
+        not mesh or assemble in two threads at once, so a thread pool would gain nothing).
     """
 
     def __init__(self, scheduler: str | None = None, workers: int | None = None,
@@ -106,12 +106,15 @@ class Runner:
     def __exit__(self, *exc) -> None:
         self.close()
 
+    @property
+    def in_process(self) -> bool:
+        """The tasks run here, one after another (no scheduler given, no worker processes)."""
+        return not self.scheduler and not self.processes
+
     def run(self, tasks: Iterable[Task], folder: str | Path, desc: str = "sweep"
             ) -> list[dict | None]:
         """Records of ``tasks`` (None where a task could not finish), computing the missing."""
         from tqdm import tqdm
-
-        as_completed = require("dask.distributed", "studies").as_completed
 
         tasks = list(tasks)
         folder = Path(folder)
@@ -120,16 +123,12 @@ class Runner:
         unique = {t.id: t for t in tasks}
         todo = [t for t in unique.values() if load_record(folder, t) is None]
         if todo:
-            client = self.client()
             todo.sort(key=lambda t: -t.cost)
-            futures = {client.submit(run_task, t, str(folder), pure=False,
-                                     priority=len(todo) - i): t for i, t in enumerate(todo)}
             disable = None if self.progress is None else not self.progress
             with tqdm(total=len(todo), desc=desc, unit="task", disable=disable) as bar:
-                for future in as_completed(futures):
-                    task = futures[future]
+                for task, outcome in self._outcomes(todo, folder):
                     try:
-                        record, arrays = future.result()
+                        record, arrays = outcome()
                     except Exception as err:  # noqa: BLE001 - e.g. a worker killed by the OS
                         record, arrays = {"status": "error", "message": repr(err)}, {}
                     else:
@@ -142,3 +141,18 @@ class Runner:
                     bar.set_postfix_str(task.label[:40])
                     bar.update()
         return [load_record(folder, t) for t in tasks]
+
+    def _outcomes(self, todo: list[Task], folder: Path):
+        """(task, a function returning its (record, arrays) or raising) as tasks finish."""
+        if self.in_process:
+            if not self.computed:
+                warm_up()
+            for task in todo:
+                yield task, (lambda t=task: run_task(t, str(folder)))
+            return
+        client = self.client()
+        futures = {client.submit(run_task, t, str(folder), pure=False,
+                                 priority=len(todo) - i): t for i, t in enumerate(todo)}
+        as_completed = require("dask.distributed", "studies").as_completed
+        for future in as_completed(futures):
+            yield futures[future], future.result
