@@ -4,9 +4,8 @@ The packages of the extras (``setup.cfg``), with every package they pull in that
 does not, are blocked in a subprocess by an import hook, as if they were not installed.
 There ngdual and every module of its pipeline import (fast tier) and, in the slow tier, a
 scene with contact and Coulomb friction is solved on level 1, adapted one step and solved
-by the README's first command; ``ngdual figures --threads`` runs a figure in this process,
-while ``ngdual figures`` on dask workers names the extra it needs
-(:func:`ngdual.extras.require`).
+by the README's first command; ``ngdual figures`` runs a figure in this process (saying so),
+while ``ngdual figures --workers 2`` names the extra it needs (:func:`ngdual.extras.require`).
 """
 
 import configparser
@@ -113,9 +112,9 @@ with warnings.catch_warnings():
     solution = nd.solve(scene)
     history = nd.adapt(scene, steps=2, level=1)
 status = main(["solve", "thesis-3.46-coulomb", "--level", "1", "--out", sys.argv[2]])
-figures = main(["figures", "--only", "tab_3_1", "--max-level", "2", "--out", sys.argv[2] + "-f"])
-in_process = main(["figures", "--only", "tab_3_1", "--max-level", "2", "--threads",
-                   "--out", sys.argv[2] + "-t"])
+figures = main(["figures", "--only", "tab_3_1", "--max-level", "2", "--workers", "2",
+                "--out", sys.argv[2] + "-f"])
+in_process = main(["figures", "--only", "tab_3_1", "--max-level", "2", "--out", sys.argv[2] + "-t"])
 loaded = sorted({m.partition(".")[0] for m in sys.modules} & BLOCKED)
 print(json.dumps({"converged": bool(solution.converged), "steps": len(history),
                   "elements": [r["elements"] for r in history], "cli": status,
@@ -166,6 +165,8 @@ def test_solve_adapt_and_the_cli_solve_run_with_the_extras_uninstalled(blocked, 
     assert result["figures"] == EXIT_BAD_INPUT
     assert 'pip install "ngdual[studies]"' in run.stderr
     assert result["in_process"] == 0 and (tmp_path / "out-t" / "index.md").is_file()
+    assert "run one after another in this process" in run.stderr
+    assert not (tmp_path / "out-f").exists()
 
 
 def test_a_missing_extra_is_named_with_its_install_command():

@@ -14,14 +14,22 @@ from .output import EXIT_BAD_INPUT, EXIT_NOT_CONVERGED, level_flags, number_flag
 def cmd_figures(args) -> int:
     """Regenerate the figures and tables of Sections 3.4 and 4.2 into DIR (see figures/)."""
     from .. import budget
-    from ..extras import require
+    from ..extras import MissingExtraError, require
     from ..io import check_output_dir
     from ..scene import Geometry
     from ..studies.figures import DEFAULT_MAX_LEVEL, THESIS_MAX_LEVEL, run_figures
     from ..studies.figures.run import select_scripts
 
-    if args.scheduler or not args.threads:  # a dask sweep; refused before anything is written
+    in_process = args.threads
+    if args.scheduler or args.workers is not None:  # asked for dask: refused before writing
         require("dask.distributed", "studies")
+    elif not in_process:
+        try:
+            require("dask.distributed", "studies")
+        except MissingExtraError:
+            print("ngdual: dask (the studies extra) is not installed: the tasks run one after "
+                  "another in this process (--threads)", file=sys.stderr)
+            in_process = True
 
     max_level = DEFAULT_MAX_LEVEL if args.max_level is None else args.max_level
     number_flag(max_level, "--max-level", 2, THESIS_MAX_LEVEL, integer=True)
@@ -37,7 +45,7 @@ def cmd_figures(args) -> int:
     budget.check(Geometry(), max_level, "--max-level", args.allow_large)
     try:
         summary = run_figures(max_level, args.out, args.scheduler, args.workers,
-                              not args.threads, args.only, args.source)
+                              not in_process, args.only, args.source)
     except (FileNotFoundError, ValueError) as err:
         print(f"ngdual: error: {err}", file=sys.stderr)
         return EXIT_BAD_INPUT
