@@ -11,6 +11,11 @@ Tables 3.2/3.3, iterations and the wall time of every phase; given the norms of 
 solution (e.g. Aitken-extrapolated from uniform levels, :func:`reference_norms`), also the
 total error (3.124) and the effectivity index estimate / e_tot (Table 4.4). Uniform
 refinement is ``marking="max", theta=0``.
+
+The loop aims at a goal (:data:`GOALS`): ``"stress"``, the thesis' (4.50), or
+``"pressure"``, the contact pressure on Gamma_C (:mod:`ngdual.goal`). Given a tolerance
+``tol`` it stops as soon as the goal's relative estimate (:func:`relative_estimate`) is
+below it, ``steps`` being then only a bound.
 """
 
 from __future__ import annotations
@@ -26,6 +31,7 @@ import numpy as np
 from . import budget
 from .boundary import BoundaryMeshes
 from .estimator import ASYMMETRY_NORMS, Estimate, estimate
+from .goal import GOALS, goal_estimate
 from .marking import STRATEGIES, mark
 from .mesh import build_mesh
 from .quantities import norms
@@ -35,6 +41,13 @@ from .solvers import solve_on_mesh, solve_scene
 from .solvers.result import Solution
 
 StepCallback = Callable[[dict, Solution, Estimate, np.ndarray | None], None]
+
+# The thesis' marking (Section 4.2, Tables 4.1-4.4): Doerfler with theta = 0.5.
+MARKING, THETA = "dorfler", 0.5
+# Doerfler's theta of a tolerance-driven run: the unknowns grow by 1.5-2x per step on
+# hertz-cylinder and thesis-3.46-frictionless (docs/theory/estimator.md, "A goal and a
+# tolerance"), so that the cost of all steps stays a small multiple of the last one's.
+THETA_TOL = 0.8
 
 
 def refine(mesh: ngs.Mesh, marked: np.ndarray) -> ngs.Mesh:
@@ -75,18 +88,26 @@ def refine_towards(scene: Scene, mesh: ngs.Mesh, point, times: int
     return mesh, coarse
 
 
-def adapt(scene: Scene, marking: str = "dorfler", theta: float = 0.5, steps: int = 5,
-          level: int | None = None, asymmetry: str = "l2", reference: dict | None = None,
-          on_step: StepCallback | None = None, allow_large: bool = False) -> list[dict]:
-    """Run ``steps`` adaptive steps on ``scene`` from its mesh on ``level``.
+def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
+          steps: int = 5, level: int | None = None, asymmetry: str = "l2",
+          reference: dict | None = None, on_step: StepCallback | None = None,
+          allow_large: bool = False, goal: str = "stress", tol: float | None = None
+          ) -> list[dict]:
+    """Run ``steps`` adaptive steps on ``scene`` from its mesh on ``level``, or fewer when
+    the goal's relative estimate falls below ``tol``.
 
     Parameters
     ----------
     scene : Scene
-    marking : {"max", "fraction", "dorfler"}
-        Marking strategy (:func:`ngdual.marking.mark`) with parameter ``theta``.
+    marking : {"max", "fraction", "dorfler"}, optional
+        Marking strategy (:func:`ngdual.marking.mark`) with parameter ``theta``; default
+        Doerfler.
+    theta : float, optional
+        Marking parameter in [0, 1]; default :data:`THETA` = 0.5 (the thesis'), with a
+        ``tol`` :data:`THETA_TOL` (faster growth of the unknowns).
     steps : int
-        Number of SOLVE-ESTIMATE steps (``steps - 1`` refinements).
+        Number of SOLVE-ESTIMATE steps (``steps - 1`` refinements); with ``tol`` the
+        largest number of steps.
     level : int, optional
         Level of the initial mesh (default: the scene's).
     asymmetry : {"hdiv", "l2"}
@@ -101,16 +122,29 @@ def adapt(scene: Scene, marking: str = "dorfler", theta: float = 0.5, steps: int
     allow_large : bool
         Refine even when the next mesh's estimated memory exceeds what the machine has
         available (:mod:`ngdual.budget`; refused with a SceneError otherwise).
+    goal : {"stress", "pressure"}
+        What the indicators that drive MARK estimate (:data:`GOALS`): ``"stress"`` the
+        error of (3.124) by (4.50), ``"pressure"`` ||p - p_h||_{L2(Gamma_C)}
+        (:func:`ngdual.goal.goal_estimate`).
+    tol : float, optional
+        Stop after the first step whose ``relative_estimate`` (:func:`relative_estimate`)
+        is at most ``tol``.
 
     Returns
     -------
     list of dict
         One record per step (see :func:`step_record`), with the physics checks its
-        solution fails under ``warnings`` (recorded, not issued as Python warnings).
+        solution fails under ``warnings`` (recorded, not issued as Python warnings), and
+        ``goal``, ``goal_estimate``, ``relative_estimate`` and the wall time since the
+        start of ``adapt``, ``elapsed_s``. The last record's ``stopped_by`` is ``"tol"``
+        or ``"steps"``.
     """
     _check_adapt_arguments(scene, marking, theta, steps, level, asymmetry, reference, on_step,
-                           allow_large)
+                           allow_large, goal, tol)
+    marking = MARKING if marking is None else marking
+    theta = (THETA if tol is None else THETA_TOL) if theta is None else theta
     budget.check(scene.geometry, level, "level", allow_large, method=scene.solver.method)
+    start = time.perf_counter()
     mesh = build_mesh(scene.geometry, level)
     coarse = BoundaryMeshes.for_scene(scene, mesh)
     history = []
@@ -120,14 +154,19 @@ def adapt(scene: Scene, marking: str = "dorfler", theta: float = 0.5, steps: int
         # ESTIMATE
         estimated = estimate(solution, asymmetry)
         record = step_record(step, solution, estimated, reference)
+        indicators = _goal_indicators(record, solution, estimated, goal)
         history.append(record)
-        last = step == steps - 1
+        converged = tol is not None and record["relative_estimate"] <= tol
+        last = converged or step == steps - 1
         # MARK
         marked = None
         if not last:
             with _timed(record, "mark"):
-                marked = mark(estimated.indicators, theta, marking)
+                marked = mark(indicators, theta, marking)
             record["marked"] = int(marked.sum())
+        record["elapsed_s"] = time.perf_counter() - start
+        if last:
+            record["stopped_by"] = "tol" if converged else "steps"
         if on_step is not None:
             on_step(record, solution, estimated, marked)
         if last:
@@ -136,7 +175,37 @@ def adapt(scene: Scene, marking: str = "dorfler", theta: float = 0.5, steps: int
         _check_refinement_size(scene, mesh, marked, allow_large)
         with _timed(record, "refine"):
             mesh, coarse = refine_with_boundary(scene, mesh, coarse, marked)
+        record["elapsed_s"] = time.perf_counter() - start
     return history
+
+
+def relative_estimate(record: dict) -> float:
+    """The goal's estimate relative to the size of the solution it measures.
+
+    ``"stress"``: the estimate (sum_T eta_{tot,T}^2)^{1/2} of (4.50) over ||sigma_h||_{H(div)}
+    (``norms["sigma_X"]``), the leading part of the total error (3.124) that (4.50) bounds.
+    ``"pressure"``: the estimate of ||p - p_h||_{L2(Gamma_C)} over ||p_h||_{L2(Gamma_C)}
+    (:func:`ngdual.goal.goal_estimate`).
+    """
+    size = record["goal_size"]
+    return record["goal_estimate"] / size if size > 0 else float("inf")
+
+
+def _goal_indicators(record: dict, solution: Solution, estimated: Estimate,
+                     goal: str) -> np.ndarray:
+    """The element indicators of ``goal``; adds ``goal``, ``goal_estimate``, ``goal_size``
+    and ``relative_estimate`` to the step's record."""
+    if goal == "stress":
+        indicators, total, size = (estimated.indicators, estimated.total,
+                                   record["norms"]["sigma_X"])
+    else:
+        with _timed(record, "goal"):
+            pressure = goal_estimate(solution, estimated)
+        indicators, total, size = pressure.indicators, pressure.total, pressure.size
+        record["goal_terms"] = pressure.summed()
+    record.update(goal=goal, goal_estimate=float(total), goal_size=float(size))
+    record["relative_estimate"] = relative_estimate(record)
+    return indicators
 
 
 @contextmanager
@@ -148,16 +217,29 @@ def _timed(record: dict, phase: str) -> Iterator[None]:
 
 
 def _check_adapt_arguments(scene, marking, theta, steps, level, asymmetry, reference, on_step,
-                           allow_large) -> None:
+                           allow_large, goal, tol) -> None:
     """A SceneError (SceneTypeError for a wrong type) naming the first bad argument."""
     ensure_valid(scene)
     check_level(level, "level", optional=True)
-    if marking not in STRATEGIES:
+    if not isinstance(goal, str):
+        raise SceneTypeError("goal", f"must be one of {', '.join(GOALS)}, got "
+                                     f"{type(goal).__name__}")
+    if goal not in GOALS:
+        raise SceneError("goal", f"unknown goal {goal!r}; use one of " + ", ".join(GOALS))
+    if goal == "pressure" and not scene.labels("contact"):
+        raise SceneError("goal", f"scene {scene.name!r} has no contact boundary: no pressure "
+                                 "to aim at")
+    if tol is not None:
+        if isinstance(tol, bool) or not isinstance(tol, (int, float)):
+            raise SceneTypeError("tol", f"must be a number > 0, got {tol!r}")
+        if not 0 < tol < float("inf"):
+            raise SceneError("tol", f"must be a finite number > 0, got {tol!r}")
+    if marking is not None and marking not in STRATEGIES:
         raise SceneError("marking", f"unknown marking {marking!r}; use one of "
                                     + ", ".join(STRATEGIES))
-    if isinstance(theta, bool) or not isinstance(theta, (int, float)):
+    if theta is not None and (isinstance(theta, bool) or not isinstance(theta, (int, float))):
         raise SceneTypeError("theta", f"must be a number in [0, 1], got {theta!r}")
-    if not 0 <= theta <= 1:
+    if theta is not None and not 0 <= theta <= 1:
         raise SceneError("theta", f"must lie in [0, 1], got {theta!r}")
     if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)):
         raise SceneTypeError("steps", f"must be an integer >= 1, got {steps!r}")

@@ -23,7 +23,7 @@ STAGES = [
     ("forms", ["forms", "friction", "quadrature_check"]),
     ("solvers", ["solvers", "checks"]),
     ("quantities", ["quantities"]),
-    ("estimator", ["estimator"]),
+    ("estimator", ["estimator", "goal"]),
     ("marking", ["marking"]),
     ("afem", ["afem"]),
     ("post", ["post", "plot"]),

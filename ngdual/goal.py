@@ -1,0 +1,153 @@
+"""A goal for the adaptive loop: the error of the contact pressure on Gamma_C.
+
+The estimator of Chapter 4 (4.50) bounds the whole stress error; on a contact problem it
+refines the clamped corners first and does not see the pressure. :func:`goal_estimate`
+estimates ||p - p_h||_{L2(Gamma_C)}, with p_h the h~-hat projection of -sigma_n^h
+(:func:`ngdual.friction.hat_projection`, the pressure the contact conditions of (3.62)
+control), by element indicators that carry the contact-zone terms, each squared and in
+units of pressure^2 x length, per fine edge e of Gamma_C (its element T)::
+
+    ``residual``         |e| (sigma_n^h + p_h)^2                 the part of sigma_n^h
+                                                                 p_h does not represent
+    ``complementarity``  E* |e| p_h lambda_n / h~_e              p_h lambda_n = 0 violated
+    ``kink``             (E* [d(g_h - lambda_n)/dt])^2 h~ / 2    at the last contact node,
+                                                                 on each of its two edges
+    ``far``              eta_{sigma,T}^2 / (h~_C + dist(T, Gamma_C))   every element
+
+with E* = E / (1 - nu^2) the plane-strain modulus, h~_e the h~ edge holding e, h~_C the
+h~ of the nearest fine Gamma_C edge and eta_{sigma,T}^2 the stress terms of (4.15) with
+the strain terms (w_h) scaled by (2 mu)^2 into stress. docs/theory/estimator.md ("A goal:
+the contact pressure") derives each power of h~ and says what is proven and what is
+heuristic. The estimate is ``CALIBRATION`` times the root of the sum.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import ngsolve as ngs
+import numpy as np
+from scipy.spatial import cKDTree
+
+from .estimator import Estimate, _BoundaryEdges
+from .friction import hat_projection
+from .quantities import fields
+from .solvers.result import Solution
+
+GOALS = ("stress", "pressure")
+TERMS = ("residual", "complementarity", "kink", "far")
+# terms of (4.15) in units of stress x length, and those of w_h ~ grad u (strain x length)
+STRESS_TERMS = ("residual", "asymmetry")
+STRAIN_TERMS = ("curl", "jump_interior", "jump_dirichlet", "jump_neumann", "jump_contact")
+# One constant, chosen so that the effectivity estimate / ||p - p_h|| is near 1 on
+# hertz-cylinder (the geometric mean over its adaptive steps; docs/theory/estimator.md).
+CALIBRATION = 1.0
+# lambda_n below this share of its largest value on Gamma_C is contact
+CONTACT_SHARE = 1e-6
+
+
+@dataclass
+class PressureEstimate:
+    """The indicators of ||p - p_h||_{L2(Gamma_C)}: ``terms[k]`` squared per element.
+
+    ``size`` is ||p_h||_{L2(Gamma_C)}, the size the relative estimate is taken against.
+    """
+
+    terms: dict[str, np.ndarray]
+    size: float
+
+    @property
+    def indicators(self) -> np.ndarray:
+        """The element indicators, CALIBRATION (sum_k terms[k])^{1/2} (they drive MARK)."""
+        return CALIBRATION * np.sqrt(sum(self.terms.values()))
+
+    @property
+    def total(self) -> float:
+        """The estimate of ||p - p_h||_{L2(Gamma_C)}: (sum_T indicators_T^2)^{1/2}."""
+        return float(np.sqrt(np.sum(self.indicators**2)))
+
+    def summed(self) -> dict[str, float]:
+        """CALIBRATION (sum_T terms[k]_T)^{1/2} of every term."""
+        return {k: float(CALIBRATION * np.sqrt(v.sum())) for k, v in self.terms.items()}
+
+
+def goal_estimate(solution: Solution, estimated: Estimate) -> PressureEstimate:
+    """The estimate of ||p - p_h||_{L2(Gamma_C)} and its element indicators.
+
+    Parameters
+    ----------
+    solution : Solution
+        A discrete solution of (3.62) of a scene with a contact boundary.
+    estimated : Estimate
+        Its indicators of (4.50) (:func:`ngdual.estimator.estimate`), for the ``far`` term.
+
+    Returns
+    -------
+    PressureEstimate
+    """
+    pb = solution.problem
+    scene, spaces, mesh = pb.scene, pb.spaces, pb.fes.mesh
+    gamma_c = spaces.gamma_c
+    lam, mu = scene.material.lame
+    e_star = 4 * mu * (lam + mu) / (lam + 2 * mu)
+    length = gamma_c.lengths
+    htilde = gamma_c.coarse.edge_lengths()[gamma_c.htilde_edge]
+
+    # sigma_n^h per fine edge (constant for RT_0): its mean over the edge
+    edges = _BoundaryEdges(mesh)
+    n = ngs.specialcf.normal(2)
+    sigma_n_cf = ngs.BoundaryFromVolumeCF(fields(solution).sigma) * n * n
+    dofs = np.array([edges.dof_of_edge[frozenset(map(int, p))] for p in gamma_c.vertices])
+    sigma_n = edges.integrals(sigma_n_cf, scene.labels("contact"))[dofs] / length
+    element = edges.element[dofs]
+
+    # p_h = -(hat projection of sigma_n^h), as means over the fine edges
+    p_mean = np.zeros(len(length))
+    for hats in (spaces.prolongations["lam_n"], spaces.end_hats["lam_n"]):
+        means = gamma_c.hat_means(hats)
+        if means.shape[1]:
+            p_mean += means @ -hat_projection(means, length, sigma_n)
+    size = float(np.sqrt(np.sum(length * p_mean**2)))
+
+    # lambda_n and g_h at the fine vertices, chain by chain (n_edges + 1 per chain)
+    fine = pb.to_fine(solution.x)
+    rng = pb.fes.Range(pb.names.index("lam_n"))
+    lam_n = gamma_c.vertex_values(fine[rng.start:rng.stop])
+    gap = gamma_c.discrete_gap_at_vertices(spaces.prolongations["lam_n"],
+                                           spaces.end_hats["lam_n"])
+    starts, kinks = [], np.zeros(len(length))
+    first_vertex = 0
+    contact = lam_n <= CONTACT_SHARE * max(float(np.max(np.abs(lam_n))), 1e-300)
+    opening = gap - lam_n
+    first_edge = 0
+    for chain in gamma_c.coarse.chains:
+        m = chain.n_edges
+        v = np.arange(first_vertex, first_vertex + m)          # start vertex of every edge
+        starts.append(v)
+        slope = (opening[v + 1] - opening[v]) / length[first_edge:first_edge + m]
+        for k in range(1, m):   # interior vertex k between edges k - 1 and k
+            here = first_vertex + k
+            last = contact[here] and not (contact[here - 1] and contact[here + 1])
+            if last:
+                jump = (e_star * (slope[k] - slope[k - 1]))**2
+                kinks[first_edge + k - 1] += 0.5 * jump * htilde[first_edge + k - 1]
+                kinks[first_edge + k] += 0.5 * jump * htilde[first_edge + k]
+        first_vertex += m + 1
+        first_edge += m
+    v = np.concatenate(starts)
+    lam_mean = 0.5 * (lam_n[v] + lam_n[v + 1])
+
+    on_edges = {
+        "residual": length * (sigma_n + p_mean)**2,
+        "complementarity": e_star * length * np.maximum(p_mean, 0) * lam_mean / htilde,
+        "kink": kinks,
+    }
+    terms = {k: np.bincount(element, values, mesh.ne) for k, values in on_edges.items()}
+
+    eta_sigma = (sum(estimated.terms[k] for k in STRESS_TERMS)
+                 + (2 * mu)**2 * sum(estimated.terms[k] for k in STRAIN_TERMS))
+    centres = np.array([np.mean([mesh[v].point for v in el.vertices], axis=0)
+                        for el in mesh.Elements(ngs.VOL)])
+    distance, nearest = cKDTree(gamma_c.midpoints).query(centres)
+    terms["far"] = eta_sigma * htilde[nearest] / (htilde[nearest] + distance)**2
+    return PressureEstimate(terms, size)
