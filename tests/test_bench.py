@@ -96,3 +96,22 @@ def test_primal_peer_reports_the_hertz_errors_and_rejects_a_law_without_friction
     assert row["reaction"] == pytest.approx(row["force"], rel=0.01)
     assert main(["bench", "primal-peer", "--law", "tresca"]) == 2
     assert "--law" in capsys.readouterr().err
+
+
+def test_adaptive_splits_every_step_into_phases_that_add_up_to_its_wall_time(tmp_path):
+    from ngdual.afem import adapt
+    from ngdual.scene import load_scene
+
+    study = run_bench(tmp_path, "adaptive", "--scene", "thesis-3.46-frictionless", "--set",
+                      "contact.ends=consistent", "--level", "1", "--steps", "3")
+    records = study["records"]
+    history = adapt(load_scene("thesis-3.46-frictionless", ["contact.ends=consistent"]),
+                    marking="dorfler", theta=0.5, steps=3, level=1)
+    assert [r["ndof"] for r in records] == [h["dofs"]["total"] for h in history]
+    assert records[0]["seconds"]["refine"] == 0 < records[1]["seconds"]["refine"]
+    for r in records:
+        seconds = r["seconds"]
+        phases = sum(v for k, v in seconds.items() if k not in ("step", "unit"))
+        assert phases == pytest.approx(seconds["step"], rel=1e-12)
+        assert 0 < seconds["unit"] < seconds["step"]
+        assert r["ratio"] == pytest.approx(seconds["step"] / seconds["unit"])

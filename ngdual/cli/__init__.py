@@ -243,6 +243,19 @@ def parser() -> argparse.ArgumentParser:
     ve.set_defaults(func=cmd_verify)
     return p
 
+    adp = bench.add_parser("adaptive", help="the cost of every adaptive step (Doerfler) "
+                                            "against one linear solve of its mesh",
+                           parents=[sized, json_out])
+    adp.add_argument("--scene", default="hertz-cylinder",
+                     help="a TOML scene or a shipped scene (default: hertz-cylinder)")
+    adp.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                     dest="overrides", help="override a scene entry, e.g. "
+                                            "--set contact.ends=consistent")
+    adp.add_argument("--level", type=int, default=None,
+                     help="level of the initial mesh (default: the scene's)")
+    adp.add_argument("--steps", type=int, default=8, help="adaptive steps (default 8)")
+    adp.add_argument("--theta", type=float, default=0.5,
+                     help="Doerfler's bulk parameter (default 0.5)")
 
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit status (see the module docstring).

@@ -183,9 +183,23 @@ def _primal_peer_settings(args) -> dict:
             "hc": args.hc, "thetas": args.thetas, "gammas": args.gammas, **physics}
 
 
+def _adaptive_settings(args) -> dict:
+    from .. import budget
+    from ..scene import check_level, load_scene
+
+    level = check_level(args.level, "--level", optional=True)
+    number_flag(args.steps, "--steps", 1, 100, integer=True)
+    number_flag(args.theta, "--theta", 0, 1)
+    scene = load_scene(args.scene, args.overrides)
+    budget.check(scene.geometry, level, "--level", args.allow_large,
+                 method=scene.solver.method)
+    return {"scene": args.scene, "overrides": args.overrides, "level": level,
+            "steps": args.steps, "theta": args.theta, "allow_large": args.allow_large}
+
+
 BENCH_SETTINGS = {"limit-ratio": _limit_ratio_settings, "levels": _levels_settings,
                   "estimator-cost": _estimator_cost_settings, "infsup": _infsup_settings,
-                  "primal-peer": _primal_peer_settings}
+                  "primal-peer": _primal_peer_settings, "adaptive": _adaptive_settings}
 
 
 def cmd_verify(args) -> int:
