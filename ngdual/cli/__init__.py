@@ -5,7 +5,8 @@
 solves one scene, prints the result table and writes ``DIR/result.json``
 (atomically) plus figures. ``ngdual scenes`` lists the shipped scenes;
 ``ngdual dofs SCENE --levels 1 2 3`` prints DOF counts without solving;
-``ngdual adapt SCENE --marking max|fraction|dorfler --theta T --steps N --out DIR [--vtk]
+``ngdual adapt SCENE --marking max|fraction|dorfler --theta T --steps N --goal stress|pressure
+--tol TOL --out DIR [--vtk]
 [--strict]``
 runs the adaptive loop and writes ``DIR/history.json`` plus a mesh (.vol, .png with the
 marked triangles shaded) and, with ``--vtk``, a VTK file per step.
@@ -103,8 +104,18 @@ def parser() -> argparse.ArgumentParser:
                          "fraction (the theta share of the triangles with the largest "
                          "eta_T) or dorfler (the fewest triangles carrying theta of the "
                          "squared estimate, Doerfler; default)")
-    ad.add_argument("--theta", type=float, default=0.5, help="marking parameter in [0, 1]")
-    ad.add_argument("--steps", type=int, default=5, help="number of solves (default 5)")
+    ad.add_argument("--theta", type=float, default=None,
+                    help="marking parameter in [0, 1] (default 0.5, the thesis'; with --tol "
+                         "0.8, which grows the unknowns faster)")
+    ad.add_argument("--steps", type=int, default=5,
+                    help="number of solves (default 5); with --tol the largest number")
+    ad.add_argument("--goal", choices=["stress", "pressure"], default="stress",
+                    help="what the indicators estimate: stress, the error of (3.124) by "
+                         "(4.50) (default), or pressure, ||p - p_h|| in L2 on Gamma_C")
+    ad.add_argument("--tol", type=float, default=None,
+                    help="stop at the first step whose goal estimate relative to the "
+                         "solution's size (||sigma_h|| in H(div), ||p_h|| on Gamma_C) is at "
+                         "most TOL")
     ad.add_argument("--level", type=int, default=None, help="initial mesh level")
     ad.add_argument("--asymmetry", choices=["hdiv", "l2"], default="l2",
                     help="norm of as(sigma_h) in the estimator (default: L2; 'hdiv' as printed "

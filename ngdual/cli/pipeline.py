@@ -123,14 +123,17 @@ def cmd_adapt(args) -> int:
 def _adapt(args) -> int:
 
     from .. import budget, plot, post
-    from ..afem import adapt, reference_norms
+    from ..afem import THETA, THETA_TOL, adapt, reference_norms
     from ..io import check_output_dir, versions, write_json
     from ..mesh import mesh_arrays
     from ..solvers.result import ConvergenceError
 
     level = check_level(args.level, "--level", optional=True)
-    number_flag(args.theta, "--theta", 0, 1)
+    if args.theta is not None:
+        number_flag(args.theta, "--theta", 0, 1)
     number_flag(args.steps, "--steps", 1, 10_000, integer=True)
+    if args.tol is not None and not 0 < args.tol < float("inf"):
+        raise SceneError("--tol", f"must be a finite number > 0, got {args.tol}")
     if args.reference_levels is not None:
         level_flags(args.reference_levels, "--reference-levels")
         if len(args.reference_levels) < 3:
@@ -142,8 +145,10 @@ def _adapt(args) -> int:
     for reference in args.reference_levels or []:
         budget.check(scene.geometry, reference, "--reference-levels", args.allow_large,
                      method=scene.solver.method)
-    run = {"scene": scene.name, "marking": args.marking, "theta": args.theta,
+    theta = args.theta if args.theta is not None else THETA if args.tol is None else THETA_TOL
+    run = {"scene": scene.name, "marking": args.marking, "theta": theta,
            "steps": args.steps, "level": level, "asymmetry": args.asymmetry,
+           "goal": args.goal, "tol": args.tol,
            "parameters": scene.to_dict(), "versions": versions(), "history": []}
     if args.reference_levels:
         print(f"reference norms: Aitken extrapolation from levels {args.reference_levels}")
@@ -158,7 +163,11 @@ def _adapt(args) -> int:
         line = (f"step {record['step']:3d}  dofs {record['dofs']['total']:8d}  "
                 f"estimator {record['estimator']:.4e}"
                 + (f"  e_tot {record['e_tot']:.4e}  effectivity {effectivity:.3f}"
-                   if effectivity else "") + f"  marked {record['marked']}")
+                   if effectivity else "")
+                + f"  {record['goal']} {record['relative_estimate']:.3e}"
+                + f"  marked {record['marked']}  {record['elapsed_s']:.1f} s"
+                + (f"  (stopped by {record['stopped_by']})" if "stopped_by" in record
+                   else ""))
         if args.strict and record["warnings"]:
             print(line + "\n" + warning_lines(record["warnings"], "    "))
             step = record["step"]
@@ -183,8 +192,9 @@ def _adapt(args) -> int:
             print(warning_lines(record["warnings"], "    "))
 
     try:
-        adapt(scene, args.marking, args.theta, args.steps, level, args.asymmetry,
-              run.get("reference_norms"), on_step, allow_large=args.allow_large)
+        adapt(scene, args.marking, theta, args.steps, level, args.asymmetry,
+              run.get("reference_norms"), on_step, allow_large=args.allow_large,
+              goal=args.goal, tol=args.tol)
     except ConvergenceError as err:
         return not_converged(err)
     except StrictFailure as err:

@@ -1,0 +1,72 @@
+"""The adaptive loop's goal (stress or contact pressure) and its stopping tolerance."""
+
+import ngsolve as ngs
+import numpy as np
+import pytest
+
+from ngdual.afem import adapt
+from ngdual.scene import SceneError, SceneTypeError, load_scene
+
+
+@pytest.fixture(scope="module")
+def hertz():
+    return load_scene("hertz-cylinder")
+
+
+@pytest.mark.parametrize("kwargs, field", [
+    ({"goal": "force"}, "goal"), ({"goal": 1}, "goal"), ({"tol": 0.0}, "tol"),
+    ({"tol": -1.0}, "tol"), ({"tol": float("nan")}, "tol"), ({"tol": "1%"}, "tol"),
+    ({"tol": True}, "tol"),
+])
+def test_a_bad_goal_or_tol_is_a_scene_error_naming_it(hertz, kwargs, field):
+    with pytest.raises((SceneError, SceneTypeError)) as err:
+        adapt(hertz, steps=2, **kwargs)
+    assert err.value.field == field
+
+
+def test_the_pressure_goal_first_refines_a_band_around_gamma_c(hertz):
+    """Every triangle of the first marked set lies within three h~ of Gamma_C."""
+    first = {}
+
+    def on_step(record, solution, estimated, marked):
+        if marked is not None and not first:
+            gamma_c = solution.problem.spaces.gamma_c
+            mesh = solution.problem.fes.mesh
+            centres = np.array([np.mean([mesh[v].point for v in el.vertices], axis=0)
+                                for el in mesh.Elements(ngs.VOL)])
+            gaps = np.linalg.norm(centres[:, None, :] - gamma_c.midpoints[None], axis=2)
+            first["distance"] = gaps.min(axis=1)[marked]
+            first["htilde"] = gamma_c.coarse.edge_lengths().max()
+
+    adapt(hertz, steps=2, goal="pressure", on_step=on_step)
+    assert len(first["distance"]) > 0
+    assert first["distance"].max() <= 3 * first["htilde"]
+
+
+def test_a_tolerance_stops_the_loop_by_itself(hertz):
+    history = adapt(hertz, steps=8, goal="pressure", tol=0.045)
+    assert history[-1]["stopped_by"] == "tol"
+    assert history[-1]["relative_estimate"] <= 0.045
+    assert all(r["relative_estimate"] > 0.045 for r in history[:-1])
+    assert 2 <= len(history) < 8
+    elapsed = [r["elapsed_s"] for r in history]
+    assert all(b > a > 0 for a, b in zip(elapsed, elapsed[1:]))
+
+
+def test_without_tol_the_loop_runs_its_steps_and_says_so(hertz):
+    history = adapt(hertz, steps=2, goal="pressure")
+    assert [r.get("stopped_by") for r in history] == [None, "steps"]
+    assert all(r["goal"] == "pressure" and r["goal_size"] > 0 for r in history)
+
+
+def test_the_default_loop_is_the_stress_goal_with_the_thesis_marking():
+    """adapt(scene, steps=3) is bit for bit the loop with Doerfler theta = 0.5 and (4.50)."""
+    scene = load_scene("thesis-3.46-frictionless")
+    keys = ("elements", "dofs", "estimator", "estimator_sum", "norms", "marked")
+    default = adapt(scene, steps=3, level=1)
+    explicit = adapt(scene, "dorfler", 0.5, 3, 1, goal="stress")
+    assert [{k: r[k] for k in keys} for r in default] == \
+        [{k: r[k] for k in keys} for r in explicit]
+    assert all(r["goal_estimate"] == r["estimator"] for r in default)
+    assert all(r["relative_estimate"] == r["estimator"] / r["norms"]["sigma_X"]
+               for r in default)
