@@ -14,6 +14,7 @@ the right-hand side is ``(g, b)`` as in (3.103).
 
 from __future__ import annotations
 
+import contextlib
 import time
 from dataclasses import dataclass, field
 
@@ -42,6 +43,19 @@ TRACE_RULES = {ngs.SEGM: ngs.IntegrationRule(ngs.SEGM, TRACE_ORDER)}
 # default (degree 6, twice the order 3 of the bubble space) gives the same matrix to
 # round-off with twice the points.
 EXACT_VOLUME_RULES = {ngs.TRIG: ngs.IntegrationRule(ngs.TRIG, 4)}
+# NGSolve's task manager wakes and synchronises its threads in every parallel loop: on a
+# 2-core machine with the other core busy a loop waits up to ~0.1 s for the descheduled
+# worker whatever its size (d.Assemble of hertz-cylinder, 28 000 unknowns: 0.11 s in the
+# task manager, 0.003 s without). It pays only for the volume forms from this many elements
+# on (level 5 of Example 3.46, twice as fast on an idle machine); the boundary forms are
+# always assembled in one thread. Both assemble the same matrices bit for bit.
+PARALLEL_ELEMENTS = 8192
+
+
+def parallel_tasks(mesh: ngs.Mesh):
+    """NGSolve's task manager for a volume assembly on ``mesh`` from
+    :data:`PARALLEL_ELEMENTS` triangles on, else a context that does nothing."""
+    return ngs.TaskManager() if mesh.ne >= PARALLEL_ELEMENTS else contextlib.nullcontext()
 
 
 def peers_form(trial: dict, test: dict, lame: tuple[float, float]
@@ -254,10 +268,11 @@ def assemble(scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes | None = None
     names = list(spaces.components)
     fes = ngs.FESpace([spaces.components[n] for n in names])
     a, d, rhs = _forms(scene, fes, names)
-    with ngs.TaskManager():
-        for form in (a, d, rhs):
-            if form is not None:
-                form.Assemble()
+    with parallel_tasks(mesh):
+        a.Assemble()
+    for form in (d, rhs):
+        if form is not None:
+            form.Assemble()
     blocks_p, blocks, offset = [], {}, 0
     for name in names:
         p = spaces.prolongations.get(name)

@@ -31,7 +31,6 @@ affine function t(zeta) = t_hat - S zeta of zeta (:class:`ContactSchur`).
 
 from __future__ import annotations
 
-import contextlib
 import time
 from dataclasses import dataclass
 
@@ -40,7 +39,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .. import peers
-from ..forms import DiscreteProblem, boundary_regex, peers_form
+from ..forms import DiscreteProblem, boundary_regex, parallel_tasks, peers_form
 from ..geometry import tangent
 from ..sparse import to_scipy
 from .settings import Model
@@ -107,15 +106,6 @@ def _normal_fluxes(hdiv: ngs.FESpace, mesh: ngs.Mesh, labels: list[str]) -> np.n
     return np.array(out)
 
 
-# NGSolve's task manager starts its threads on entry (0.2-0.4 s on 2 cores): worth it only
-# from this many elements on (level 5 of Example 3.46)
-PARALLEL_ELEMENTS = 8192
-
-
-def _tasks(mesh: ngs.Mesh):
-    return ngs.TaskManager() if mesh.ne >= PARALLEL_ELEMENTS else contextlib.nullcontext()
-
-
 class HybridSystem:
     """The hybridised, statically condensed system of (3.62), reduced to H w = r.
 
@@ -159,7 +149,7 @@ class HybridSystem:
         # mu . tau n_T is constant on every element edge (P0 times the RT_0 normal trace)
         dT = ngs.dx(element_boundary=True, intrules={ngs.SEGM: ngs.IntegrationRule(ngs.SEGM, 2)})
         a += (m * traction(test) + k * traction(trial)).Compile() * dT
-        with _tasks(self.mesh):
+        with parallel_tasks(self.mesh):
             a.Assemble()
         # the only local load is -f(v) in the u rows: taken from the assembled F of (3.62)
         self.rhs = a.mat.CreateColVector()
@@ -170,7 +160,7 @@ class HybridSystem:
             values[rg.start:rg.stop] = problem.rhs[problem.blocks[name]]
         condensed = self.rhs.CreateVector()
         condensed.data = self.rhs
-        with _tasks(self.mesh):
+        with parallel_tasks(self.mesh):
             condensed.data += a.harmonic_extension_trans * self.rhs
         self.form = a
         self.assemble_seconds = time.perf_counter() - start
@@ -291,7 +281,7 @@ class HybridSystem:
         gf = ngs.GridFunction(fes)
         vec = gf.vec
         vec.FV().NumPy()[:] = self.T @ w + self.c0
-        with _tasks(self.mesh):
+        with parallel_tasks(self.mesh):
             vec.data += self.form.harmonic_extension * vec
             vec.data += self.form.inner_solve * self.rhs
         values = vec.FV().NumPy()
