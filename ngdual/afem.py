@@ -135,8 +135,10 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
     list of dict
         One record per step (see :func:`step_record`), with the physics checks its
         solution fails under ``warnings`` (recorded, not issued as Python warnings), and
-        ``goal``, ``goal_estimate``, ``relative_estimate`` and the wall time since the
-        start of ``adapt``, ``elapsed_s``. The last record's ``stopped_by`` is ``"tol"``
+        ``goal``, ``goal_estimate``, ``relative_estimate`` and ``elapsed_s``, the wall time
+        of SOLVE, ESTIMATE, MARK and REFINE from the start of ``adapt`` to the end of the
+        step (without the time spent in ``on_step``; before ``on_step`` it holds the time
+        up to MARK). The last record's ``stopped_by`` is ``"tol"``
         or ``"steps"``.
     """
     _check_adapt_arguments(scene, marking, theta, steps, level, asymmetry, reference, on_step,
@@ -168,7 +170,9 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
         if last:
             record["stopped_by"] = "tol" if converged else "steps"
         if on_step is not None:
+            called = time.perf_counter()
             on_step(record, solution, estimated, marked)
+            start += time.perf_counter() - called   # output files are not the loop's cost
         if last:
             break
         # REFINE
