@@ -1,11 +1,16 @@
 """The adaptive loop's goal (stress or contact pressure) and its stopping tolerance."""
 
+import json
+
 import ngsolve as ngs
 import numpy as np
 import pytest
 
-from ngdual.afem import adapt
+from ngdual.afem import THETA_TOL, adapt
+from ngdual.cli import main
 from ngdual.scene import SceneError, SceneTypeError, load_scene
+from ngdual.verification.benchmark import center_coordinate, exact_solution
+from ngdual.verification.traction import pressure_errors, traction_profile
 
 
 @pytest.fixture(scope="module")
@@ -70,3 +75,36 @@ def test_the_default_loop_is_the_stress_goal_with_the_thesis_marking():
     assert all(r["goal_estimate"] == r["estimator"] for r in default)
     assert all(r["relative_estimate"] == r["estimator"] / r["norms"]["sigma_X"]
                for r in default)
+
+
+def test_ngdual_adapt_with_goal_and_tol_records_them_and_stops(tmp_path, capsys):
+    assert main(["adapt", "hertz-cylinder", "--goal", "pressure", "--tol", "0.045",
+                 "--steps", "6", "--out", str(tmp_path)]) == 0
+    run = json.loads((tmp_path / "history.json").read_text())
+    assert (run["goal"], run["tol"], run["theta"]) == ("pressure", 0.045, THETA_TOL)
+    assert run["history"][-1]["stopped_by"] == "tol"
+    assert "(stopped by tol)" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("flag, value", [("--tol", "0"), ("--tol", "inf"), ("--theta", "2")])
+def test_ngdual_adapt_refuses_a_bad_tol_naming_the_flag(tmp_path, capsys, flag, value):
+    assert main(["adapt", "hertz-cylinder", flag, value, "--out", str(tmp_path)]) == 2
+    assert flag in capsys.readouterr().err
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["hertz-cylinder", "cattaneo-mindlin"])
+def test_the_pressure_estimate_is_within_a_factor_3_of_the_true_pressure_error(name):
+    """Effectivity = relative estimate / true relative L2 pressure error (analytic
+    Hertz pressure) stays in [0.3, 3] over five pressure-driven steps."""
+    scene = load_scene(name)
+    effectivity = []
+
+    def on_step(record, solution, estimated, marked):
+        exact = exact_solution(scene, traction_profile(solution).force)
+        true = pressure_errors(solution, exact, x0=center_coordinate(scene))["l2"]
+        effectivity.append(record["relative_estimate"] / true)
+
+    adapt(scene, steps=5, goal="pressure", theta=THETA_TOL, on_step=on_step)
+    print(f"{name}: effectivity {np.round(effectivity, 2).tolist()}")
+    assert 0.3 <= min(effectivity) and max(effectivity) <= 3
