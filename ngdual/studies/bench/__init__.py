@@ -12,7 +12,9 @@ records with the package versions and the machine (:func:`~.measure.header`) and
   solve;
 * :mod:`~.infsup` (``infsup``): the discrete inf-sup constants of the boundary multipliers;
 * :mod:`~.primal_peer` (``primal-peer``): the primal Nitsche peer against Hertz and
-  Cattaneo-Mindlin.
+  Cattaneo-Mindlin;
+* :mod:`~.adaptive` (``adaptive``): every phase of an adaptive step against one linear
+  solve of its mesh.
 
 :mod:`~.measure` is how they measure (median times, peak memory, a fresh process, the
 machine).
