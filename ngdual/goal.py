@@ -14,7 +14,8 @@ units of pressure^2 x length, per fine edge e of Gamma_C (its element T)::
                                                                  on each of its two edges
     ``far``              eta_{sigma,T}^2 / (h~_C + dist(T, Gamma_C))   every element
 
-with E* = E / (1 - nu^2) the plane-strain modulus, h~_e the h~ edge holding e, h~_C the
+with E* = 4 mu (lambda + mu) / (lambda + 2 mu) the scene's 2D modulus (E / (1 - nu^2) in
+plane strain), h~_e the h~ edge holding e, h~_C the
 h~ of the nearest fine Gamma_C edge and eta_{sigma,T}^2 the stress terms of (4.15) with
 the strain terms (w_h) scaled by (2 mu)^2 into stress. docs/theory/estimator.md ("A goal:
 the contact pressure") derives each power of h~ and says what is proven and what is
@@ -117,32 +118,13 @@ def goal_estimate(solution: Solution, estimated: Estimate) -> PressureEstimate:
     lam_n = gamma_c.vertex_values(fine[rng.start:rng.stop])
     gap = gamma_c.discrete_gap_at_vertices(spaces.prolongations["lam_n"],
                                            spaces.end_hats["lam_n"])
-    starts, kinks = [], np.zeros(len(length))
-    first_vertex = 0
-    contact = lam_n <= CONTACT_SHARE * max(float(np.max(np.abs(lam_n))), 1e-300)
-    opening = gap - lam_n
-    first_edge = 0
-    for chain in gamma_c.coarse.chains:
-        m = chain.n_edges
-        v = np.arange(first_vertex, first_vertex + m)          # start vertex of every edge
-        starts.append(v)
-        slope = (opening[v + 1] - opening[v]) / length[first_edge:first_edge + m]
-        for k in range(1, m):   # interior vertex k between edges k - 1 and k
-            here = first_vertex + k
-            last = contact[here] and not (contact[here - 1] and contact[here + 1])
-            if last:
-                jump = (e_star * (slope[k] - slope[k - 1]))**2
-                kinks[first_edge + k - 1] += 0.5 * jump * htilde[first_edge + k - 1]
-                kinks[first_edge + k] += 0.5 * jump * htilde[first_edge + k]
-        first_vertex += m + 1
-        first_edge += m
-    v = np.concatenate(starts)
-    lam_mean = 0.5 * (lam_n[v] + lam_n[v + 1])
+    starts = _edge_starts(gamma_c)
+    lam_mean = 0.5 * (lam_n[starts] + lam_n[starts + 1])
 
     on_edges = {
         "residual": length * (sigma_n + p_mean)**2,
         "complementarity": e_star * length * np.maximum(p_mean, 0) * lam_mean / htilde,
-        "kink": kinks,
+        "kink": _kinks(gamma_c, gap - lam_n, lam_n, starts, e_star * e_star * htilde),
     }
     terms = {k: np.bincount(element, values, mesh.ne) for k, values in on_edges.items()}
 
@@ -153,3 +135,35 @@ def goal_estimate(solution: Solution, estimated: Estimate) -> PressureEstimate:
     distance, nearest = cKDTree(gamma_c.midpoints).query(centres)
     terms["far"] = eta_sigma * htilde[nearest] / (htilde[nearest] + distance)**2
     return PressureEstimate(terms, size)
+
+
+def _edge_starts(gamma_c) -> np.ndarray:
+    """The vertex (``path_points`` order, n_edges + 1 per chain) where every fine edge of
+    Gamma_C starts."""
+    out, first = [], 0
+    for chain in gamma_c.coarse.chains:
+        out.append(np.arange(first, first + chain.n_edges))
+        first += chain.n_edges + 1
+    return np.concatenate(out)
+
+
+def _kinks(gamma_c, opening: np.ndarray, lam_n: np.ndarray, starts: np.ndarray,
+           weight: np.ndarray) -> np.ndarray:
+    """weight_e [d(opening)/dt]^2 / 2 on both fine edges at every last contact node.
+
+    ``opening`` = g_h - lambda_n = u_n^h at the vertices; a last contact node is an interior
+    vertex of a chain where lambda_n vanishes (``CONTACT_SHARE``) and a neighbour separates.
+    """
+    slope = (opening[starts + 1] - opening[starts]) / gamma_c.lengths
+    contact = lam_n <= CONTACT_SHARE * np.max(np.abs(lam_n), initial=0.0)
+    out = np.zeros(len(starts))
+    first = 0
+    for chain in gamma_c.coarse.chains:
+        for e in range(first + 1, first + chain.n_edges):   # vertex between e - 1 and e
+            here = starts[e]
+            if contact[here] and not (contact[here - 1] and contact[here + 1]):
+                jump = (slope[e] - slope[e - 1])**2
+                out[e - 1] += 0.5 * jump * weight[e - 1]
+                out[e] += 0.5 * jump * weight[e]
+        first += chain.n_edges
+    return out
