@@ -243,17 +243,6 @@ def parser() -> argparse.ArgumentParser:
                     help="Poisson ratio (default: 0.3 for hertz, 0.49 for cattaneo-mindlin)")
     pp.add_argument("--law", choices=["coulomb", "tresca"], default=None,
                     help="friction law of cattaneo-mindlin (default: coulomb)")
-    be.set_defaults(func=cmd_bench)
-    ve = sub.add_parser("verify", help="errors against exact solutions: manufactured contact "
-                                       "problems and the Hertz, flat-punch and "
-                                       "Cattaneo-Mindlin benchmarks, with observed orders")
-    ve.add_argument("--quick", action="store_true",
-                    help="two levels of two manufactured cases and of every benchmark (~20 s)")
-    ve.add_argument("--json", default=None, metavar="FILE",
-                    help="also write every row (with package versions) to FILE, atomically")
-    ve.set_defaults(func=cmd_verify)
-    return p
-
     adp = bench.add_parser("adaptive", help="the cost of every adaptive step (Doerfler) "
                                             "against one linear solve of its mesh",
                            parents=[sized, json_out])
@@ -267,6 +256,17 @@ def parser() -> argparse.ArgumentParser:
     adp.add_argument("--steps", type=int, default=8, help="adaptive steps (default 8)")
     adp.add_argument("--theta", type=float, default=0.5,
                      help="Doerfler's bulk parameter (default 0.5)")
+    be.set_defaults(func=cmd_bench)
+    ve = sub.add_parser("verify", help="errors against exact solutions: manufactured contact "
+                                       "problems and the Hertz, flat-punch and "
+                                       "Cattaneo-Mindlin benchmarks, with observed orders")
+    ve.add_argument("--quick", action="store_true",
+                    help="two levels of two manufactured cases and of every benchmark (~20 s)")
+    ve.add_argument("--json", default=None, metavar="FILE",
+                    help="also write every row (with package versions) to FILE, atomically")
+    ve.set_defaults(func=cmd_verify)
+    return p
+
 
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit status (see the module docstring).
