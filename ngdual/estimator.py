@@ -134,7 +134,7 @@ def _element_integrals(cf, mesh: ngs.Mesh) -> np.ndarray:
                          element_wise=True).NumPy().copy()
 
 
-class _BoundaryEdges:
+class BoundaryEdges:
     """Integrals over the boundary edges, each added to the one element that owns it."""
 
     def __init__(self, mesh: ngs.Mesh):
@@ -254,7 +254,7 @@ def estimate(solution: Solution, asymmetry: str = "l2") -> Estimate:
         h_int * (jump * jump) * ngs.dx(element_boundary=True, bonus_intorder=BONUS_ORDER),
         mesh, element_wise=True).NumPy().copy()
 
-    edges = _BoundaryEdges(mesh)
+    edges = BoundaryEdges(mesh)
     he = edges.length
     w_t = ngs.BoundaryFromVolumeCF(w) * t
     u_gamma = ngs.BoundaryFromVolumeCF(f.u)
@@ -311,7 +311,7 @@ def neighbour_ratio(coarse) -> float:
     return ratio
 
 
-def _friction_term(solution: Solution, edges: _BoundaryEdges, sigma_t, labels) -> np.ndarray:
+def _friction_term(solution: Solution, edges: BoundaryEdges, sigma_t, labels) -> np.ndarray:
     """h~_e ||sigma_t - F nu||_e^2 on the fine Gamma_C edges of A_C = supp F.
 
     F (``friction_bound``) is given per fine edge of Gamma_C and nu per h^ edge, in the

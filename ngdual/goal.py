@@ -30,7 +30,7 @@ import ngsolve as ngs
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .estimator import Estimate, _BoundaryEdges
+from .estimator import BoundaryEdges, Estimate
 from .friction import hat_projection
 from .quantities import fields
 from .solvers.result import Solution
@@ -97,7 +97,7 @@ def goal_estimate(solution: Solution, estimated: Estimate) -> PressureEstimate:
     htilde = gamma_c.coarse.edge_lengths()[gamma_c.htilde_edge]
 
     # sigma_n^h per fine edge (constant for RT_0): its mean over the edge
-    edges = _BoundaryEdges(mesh)
+    edges = BoundaryEdges(mesh)
     n = ngs.specialcf.normal(2)
     sigma_n_cf = ngs.BoundaryFromVolumeCF(fields(solution).sigma) * n * n
     dofs = np.array([edges.dof_of_edge[frozenset(map(int, p))] for p in gamma_c.vertices])
