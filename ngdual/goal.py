@@ -12,7 +12,7 @@ units of pressure^2 x length, per fine edge e of Gamma_C (its element T)::
     ``complementarity``  E* |e| p_h lambda_n / h~_e              p_h lambda_n = 0 violated
     ``kink``             (E* [d(g_h - lambda_n)/dt])^2 h~ / 2    at the last contact node,
                                                                  on each of its two edges
-    ``far``              eta_{sigma,T}^2 / (h~_C + dist(T, Gamma_C))   every element
+    ``far``              eta_{sigma,T}^2 h~_C / (h~_C + dist(T, Gamma_C))^2   every element
 
 with E* = 4 mu (lambda + mu) / (lambda + 2 mu) the scene's 2D modulus (E / (1 - nu^2) in
 plane strain), h~_e the h~ edge holding e, h~_C the
