@@ -49,7 +49,7 @@ import numpy as np
 from . import peers
 from .contact import gap_coefficient
 from .expr import Expression
-from .forms import boundary_regex
+from .forms import boundary_regex, parallel_tasks
 from .geometry import tangent
 from .mesh import element_diameters
 from .quantities import fields, require_solution
@@ -122,16 +122,18 @@ def _interpolate(mesh: ngs.Mesh, cfs) -> list[ngs.GridFunction]:
     """Element-wise L2 projections onto P2 (exact for the PEERS fields), to differentiate them."""
     space = ngs.L2(mesh, order=W_ORDER)
     out = []
-    for cf in cfs:
-        gf = ngs.GridFunction(space)
-        gf.Set(cf)
-        out.append(gf)
+    with parallel_tasks(mesh):
+        for cf in cfs:
+            gf = ngs.GridFunction(space)
+            gf.Set(cf.Compile())  # the same values, in half the time of the uncompiled tree
+            out.append(gf)
     return out
 
 
 def _element_integrals(cf, mesh: ngs.Mesh) -> np.ndarray:
-    return ngs.Integrate(cf * ngs.dx(bonus_intorder=BONUS_ORDER), mesh,
-                         element_wise=True).NumPy().copy()
+    with parallel_tasks(mesh):
+        return ngs.Integrate(cf.Compile() * ngs.dx(bonus_intorder=BONUS_ORDER), mesh,
+                             element_wise=True).NumPy().copy()
 
 
 class BoundaryEdges:
@@ -251,7 +253,8 @@ def estimate(solution: Solution, asymmetry: str = "l2") -> Estimate:
     w_other = ngs.CF(tuple(p.Other() for p in w_parts), dims=(2, 2))
     jump = (w - w_other) * t
     terms["jump_interior"] = ngs.Integrate(
-        h_int * (jump * jump) * ngs.dx(element_boundary=True, bonus_intorder=BONUS_ORDER),
+        (h_int * (jump * jump)).Compile()
+        * ngs.dx(element_boundary=True, bonus_intorder=BONUS_ORDER),
         mesh, element_wise=True).NumPy().copy()
 
     edges = BoundaryEdges(mesh)
