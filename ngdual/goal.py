@@ -35,6 +35,8 @@ from .friction import hat_projection
 from .quantities import fields
 from .solvers.result import Solution
 
+__all__ = ["CALIBRATION", "GOALS", "TERMS", "PressureEstimate", "goal_estimate"]
+
 GOALS = ("stress", "pressure")
 TERMS = ("residual", "complementarity", "kink", "far")
 # terms of (4.15) in units of stress x length, and those of w_h ~ grad u (strain x length);
