@@ -86,7 +86,8 @@ class ForceBalance:
     edge for RT_0, the Curl bubbles have no normal trace). ``multiplier_force`` =
     sum_i t_i over the h~ hats mu_i with a dof, t_i = int sigma n mu_i ds: the contact
     force the discrete contact conditions see (the moments d_C(mu_i, sigma) of (3.62)).
-    ``normal_moments`` are the t_{n,i} of those hats, ``end_moments`` the normal moments
+    ``normal_moments`` and ``tangential_moments`` are the t_{n,i}, t_{t,i} = d_Ct(mu_i,
+    sigma) of those hats, ``end_moments`` the normal moments
     of the hats at the fixed ends (no dof, their value prescribed), ``end_points`` where
     these sit. ``scale`` is F_ref (module docstring); ``mismatch`` = |resultant -
     multiplier_force| / F_ref, the force the end hats carry; ``tension`` = sum of the
@@ -96,6 +97,7 @@ class ForceBalance:
     resultant: np.ndarray
     multiplier_force: np.ndarray
     normal_moments: np.ndarray
+    tangential_moments: np.ndarray
     end_moments: np.ndarray
     end_points: np.ndarray
     scale: float
@@ -134,12 +136,13 @@ def contact_forces(solution: Solution, forms: FrictionForms | None = None) -> Fo
     ends = gamma_c.hat_means(pb.spaces.end_hats["lam_n"])
     moments, end_moments = hats.T @ force, ends.T @ force  # (hats, 2): int sigma n mu_i
     normal = hats.T @ (force * gamma_c.normals).sum(axis=1)
+    tangential = hats.T @ (force * gamma_c.tangents).sum(axis=1)
     end_normal = ends.T @ (force * gamma_c.normals).sum(axis=1)
     total = float(np.sum(np.linalg.norm(moments, axis=1))
                   + np.sum(np.linalg.norm(end_moments, axis=1)))
     noise = NOISE * pb.scene.material.E * displacement_scale(solution)
     scale = max(total, float(np.sum(gamma_c.lengths)) * stress_rms(solution), noise)
-    return ForceBalance(force.sum(axis=0), moments.sum(axis=0), normal, end_normal,
+    return ForceBalance(force.sum(axis=0), moments.sum(axis=0), normal, tangential, end_normal,
                         gamma_c.coarse.end_points(), scale)
 
 
@@ -176,7 +179,7 @@ def physics_checks(solution: Solution) -> list[CheckWarning]:
                       pb.scene.contact, curved),
              _force_balance(balance, inconsistent, pb.scene.contact, curved),
              _penetration(solution),
-             _friction_bound(solution, forms, balance.scale),
+             _friction_bound(solution, forms, balance),
              _contact_at_clamped_end(solution, clamped)]
     if inconsistent:
         found.append(_thesis_ends_warning(inconsistent, displacement_scale(solution)))
@@ -268,7 +271,7 @@ def _penetration(solution: Solution) -> CheckWarning | None:
         depth / scale, PENETRATION_TOL)
 
 
-def _friction_bound(solution: Solution, forms: FrictionForms, scale: float
+def _friction_bound(solution: Solution, forms: FrictionForms, balance: ForceBalance
                     ) -> CheckWarning | None:
     """|t_{t,i}| = |d_Ct(mu_i, sigma)| against int F mu_i at every h~ node: the bound the
     discrete problem imposes (F is the h^ mean of mu_f |p_h|, so |t_t| / |t_n| may exceed
@@ -276,11 +279,10 @@ def _friction_bound(solution: Solution, forms: FrictionForms, scale: float
     if solution.friction_bound is None:
         return None
     pb = solution.problem
-    t_t = pb.block(pb.sigma, pb.index("lam_t")).T @ solution.x[pb.sigma]
     bound = np.asarray(forms.q_matrix(solution.friction_bound).sum(axis=0)).ravel()
-    excess = np.abs(t_t) - bound
+    excess = np.abs(balance.tangential_moments) - bound
     worst = int(np.argmax(excess))
-    size = _ratio(max(float(excess[worst]), 0.0), scale)
+    size = _ratio(max(float(excess[worst]), 0.0), balance.scale)
     if size <= FRICTION_TOL:
         return None
     where = pb.spaces.contact.node_points()[worst]

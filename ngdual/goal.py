@@ -26,13 +26,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import ngsolve as ngs
 import numpy as np
 from scipy.spatial import cKDTree
 
+from .checks import friction_forms_of
 from .estimator import BoundaryEdges, Estimate
 from .friction import hat_projection
-from .quantities import fields
+from .mesh import mesh_arrays
 from .solvers.result import Solution
 
 __all__ = ["CALIBRATION", "GOALS", "TERMS", "PressureEstimate", "goal_estimate"]
@@ -98,13 +98,11 @@ def goal_estimate(solution: Solution, estimated: Estimate) -> PressureEstimate:
     length = gamma_c.lengths
     htilde = gamma_c.coarse.edge_lengths()[gamma_c.htilde_edge]
 
-    # sigma_n^h per fine edge (constant for RT_0): its mean over the edge
+    # sigma_n^h per fine edge (constant for RT_0), from the solver's fine-edge operators
+    sigma_n = friction_forms_of(solution).T_n @ solution.x
     edges = BoundaryEdges(mesh)
-    n = ngs.specialcf.normal(2)
-    sigma_n_cf = ngs.BoundaryFromVolumeCF(fields(solution).sigma) * n * n
-    dofs = np.array([edges.dof_of_edge[frozenset(map(int, p))] for p in gamma_c.vertices])
-    sigma_n = edges.integrals(sigma_n_cf, scene.labels("contact"))[dofs] / length
-    element = edges.element[dofs]
+    element = edges.element[[edges.dof_of_edge[frozenset(map(int, p))]
+                             for p in gamma_c.vertices]]
 
     # p_h = -(hat projection of sigma_n^h), as means over the fine edges
     p_mean = np.zeros(len(length))
@@ -132,8 +130,8 @@ def goal_estimate(solution: Solution, estimated: Estimate) -> PressureEstimate:
 
     eta_sigma = (sum(estimated.terms[k] for k in STRESS_TERMS)
                  + (2 * mu)**2 * sum(estimated.terms[k] for k in STRAIN_TERMS))
-    centres = np.array([np.mean([mesh[v].point for v in el.vertices], axis=0)
-                        for el in mesh.Elements(ngs.VOL)])
+    points, triangles = mesh_arrays(mesh)
+    centres = points[triangles].mean(axis=1)
     distance, nearest = cKDTree(gamma_c.midpoints).query(centres)
     terms["far"] = eta_sigma * htilde[nearest] / (htilde[nearest] + distance)**2
     return PressureEstimate(terms, size)
