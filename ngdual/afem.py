@@ -48,6 +48,18 @@ MARKING, THETA = "dorfler", 0.5
 # hertz-cylinder and thesis-3.46-frictionless (docs/theory/estimator.md, "A goal and a
 # tolerance"), so that the cost of all steps stays a small multiple of the last one's.
 THETA_TOL = 0.8
+# The number of solves: the thesis' runs take 5; a tolerance-driven run stops by its
+# tolerance (or the memory budget), and STEPS_TOL only bounds a tolerance it cannot reach.
+STEPS, STEPS_TOL = 5, 30
+
+
+def loop_defaults(tol: float | None, theta: float | None, steps: int | None
+                  ) -> tuple[float, int]:
+    """(theta, steps) of :func:`adapt`, the ones not given taking their defaults: THETA and
+    STEPS, or with a ``tol`` THETA_TOL and STEPS_TOL."""
+    theta = (THETA if tol is None else THETA_TOL) if theta is None else theta
+    steps = (STEPS if tol is None else STEPS_TOL) if steps is None else steps
+    return theta, steps
 
 
 def refine(mesh: ngs.Mesh, marked: np.ndarray) -> ngs.Mesh:
@@ -89,7 +101,7 @@ def refine_towards(scene: Scene, mesh: ngs.Mesh, point, times: int
 
 
 def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
-          steps: int = 5, level: int | None = None, asymmetry: str = "l2",
+          steps: int | None = None, level: int | None = None, asymmetry: str = "l2",
           reference: dict | None = None, on_step: StepCallback | None = None,
           allow_large: bool = False, goal: str = "stress", tol: float | None = None
           ) -> list[dict]:
@@ -105,9 +117,9 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
     theta : float, optional
         Marking parameter in [0, 1]; default :data:`THETA` = 0.5 (the thesis'), with a
         ``tol`` :data:`THETA_TOL` (faster growth of the unknowns).
-    steps : int
-        Number of SOLVE-ESTIMATE steps (``steps - 1`` refinements); with ``tol`` the
-        largest number of steps.
+    steps : int, optional
+        Number of SOLVE-ESTIMATE steps (``steps - 1`` refinements); default :data:`STEPS`
+        = 5; with ``tol`` the largest number of steps, default :data:`STEPS_TOL` = 30.
     level : int, optional
         Level of the initial mesh (default: the scene's).
     asymmetry : {"hdiv", "l2"}
@@ -144,7 +156,7 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
     _check_adapt_arguments(scene, marking, theta, steps, level, asymmetry, reference, on_step,
                            allow_large, goal, tol)
     marking = MARKING if marking is None else marking
-    theta = (THETA if tol is None else THETA_TOL) if theta is None else theta
+    theta, steps = loop_defaults(tol, theta, steps)
     budget.check(scene.geometry, level, "level", allow_large, method=scene.solver.method)
     start = time.perf_counter()
     mesh = build_mesh(scene.geometry, level)
@@ -245,9 +257,10 @@ def _check_adapt_arguments(scene, marking, theta, steps, level, asymmetry, refer
         raise SceneTypeError("theta", f"must be a number in [0, 1], got {theta!r}")
     if theta is not None and not 0 <= theta <= 1:
         raise SceneError("theta", f"must lie in [0, 1], got {theta!r}")
-    if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)):
+    if steps is not None and (isinstance(steps, bool)
+                              or not isinstance(steps, (int, np.integer))):
         raise SceneTypeError("steps", f"must be an integer >= 1, got {steps!r}")
-    if steps < 1:
+    if steps is not None and steps < 1:
         raise SceneError("steps", f"must be >= 1, got {steps}")
     if asymmetry not in ASYMMETRY_NORMS:
         raise SceneError("asymmetry", f"unknown norm {asymmetry!r}; use one of "

@@ -6,7 +6,7 @@ import ngsolve as ngs
 import numpy as np
 import pytest
 
-from ngdual.afem import THETA_TOL, adapt
+from ngdual.afem import STEPS_TOL, THETA_TOL, adapt, loop_defaults
 from ngdual.cli import main
 from ngdual.scene import SceneError, SceneTypeError, load_scene
 from ngdual.verification.benchmark import center_coordinate, exact_solution
@@ -75,6 +75,15 @@ def test_the_default_loop_is_the_stress_goal_with_the_thesis_marking():
     assert all(r["goal_estimate"] == r["estimator"] for r in default)
     assert all(r["relative_estimate"] == r["estimator"] / r["norms"]["sigma_X"]
                for r in default)
+
+
+def test_a_tolerance_run_takes_as_many_steps_as_it_needs_by_default():
+    """With a tol, steps only bounds the loop (STEPS_TOL), so the tol stops it; without, the
+    thesis' 5 solves with Doerfler 0.5."""
+    assert loop_defaults(None, None, None) == (0.5, 5)
+    assert loop_defaults(0.01, None, None) == (THETA_TOL, STEPS_TOL)
+    assert STEPS_TOL > 5
+    assert loop_defaults(0.01, 0.3, 7) == (0.3, 7)
 
 
 def test_ngdual_adapt_with_goal_and_tol_records_them_and_stops(tmp_path, capsys):

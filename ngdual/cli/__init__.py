@@ -107,8 +107,9 @@ def parser() -> argparse.ArgumentParser:
     ad.add_argument("--theta", type=float, default=None,
                     help="marking parameter in [0, 1] (default 0.5, the thesis'; with --tol "
                          "0.8, which grows the unknowns faster)")
-    ad.add_argument("--steps", type=int, default=5,
-                    help="number of solves (default 5); with --tol the largest number")
+    ad.add_argument("--steps", type=int, default=None,
+                    help="number of solves (default 5); with --tol the largest number "
+                         "(default 30)")
     ad.add_argument("--goal", choices=["stress", "pressure"], default="stress",
                     help="what the indicators estimate: stress, the error of (3.124) by "
                          "(4.50) (default), or pressure, ||p - p_h|| in L2 on Gamma_C")

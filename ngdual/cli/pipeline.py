@@ -123,7 +123,7 @@ def cmd_adapt(args) -> int:
 def _adapt(args) -> int:
 
     from .. import budget, plot, post
-    from ..afem import THETA, THETA_TOL, adapt, reference_norms
+    from ..afem import adapt, loop_defaults, reference_norms
     from ..io import check_output_dir, versions, write_json
     from ..mesh import mesh_arrays
     from ..solvers.result import ConvergenceError
@@ -131,7 +131,8 @@ def _adapt(args) -> int:
     level = check_level(args.level, "--level", optional=True)
     if args.theta is not None:
         number_flag(args.theta, "--theta", 0, 1)
-    number_flag(args.steps, "--steps", 1, 10_000, integer=True)
+    if args.steps is not None:
+        number_flag(args.steps, "--steps", 1, 10_000, integer=True)
     if args.tol is not None and not 0 < args.tol < float("inf"):
         raise SceneError("--tol", f"must be a finite number > 0, got {args.tol}")
     if args.reference_levels is not None:
@@ -145,9 +146,9 @@ def _adapt(args) -> int:
     for reference in args.reference_levels or []:
         budget.check(scene.geometry, reference, "--reference-levels", args.allow_large,
                      method=scene.solver.method)
-    theta = args.theta if args.theta is not None else THETA if args.tol is None else THETA_TOL
+    theta, steps = loop_defaults(args.tol, args.theta, args.steps)
     run = {"scene": scene.name, "marking": args.marking, "theta": theta,
-           "steps": args.steps, "level": level, "asymmetry": args.asymmetry,
+           "steps": steps, "level": level, "asymmetry": args.asymmetry,
            "goal": args.goal, "tol": args.tol,
            "parameters": scene.to_dict(), "versions": versions(), "history": []}
     if args.reference_levels:
@@ -192,7 +193,7 @@ def _adapt(args) -> int:
             print(warning_lines(record["warnings"], "    "))
 
     try:
-        adapt(scene, args.marking, theta, args.steps, level, args.asymmetry,
+        adapt(scene, args.marking, theta, steps, level, args.asymmetry,
               run.get("reference_norms"), on_step, allow_large=args.allow_large,
               goal=args.goal, tol=args.tol)
     except ConvergenceError as err:
