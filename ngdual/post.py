@@ -14,7 +14,7 @@ from dataclasses import asdict, dataclass
 import ngsolve as ngs
 import numpy as np
 
-from .checks import ForceBalance, contact_forces
+from .checks import ForceBalance, contact_forces, friction_forms_of
 from .checks import in_contact as _in_contact
 from .friction import hat_projection
 from .geometry import tangent
@@ -82,12 +82,10 @@ def contact_traces(solution: Solution) -> ContactTraces:
         raise SceneTypeError("solution", "must be an ngdual Solution (see nd.solve), got "
                                          f"{type(solution).__name__}")
     pb = solution.problem
-    mesh, contact = pb.fes.mesh, pb.spaces.contact
+    contact = pb.spaces.contact
     if contact is None:
         raise SceneError("solution", f"scene {pb.scene.name!r} has no contact boundary "
                                      "(boundary.contact is empty): no traces on Gamma_C")
-    f = fields(solution)
-    sigma = f.sigma
     lam_n_c, lam_t_c = solution.part("lam_n"), solution.part("lam_t")
     in_contact = _in_contact(lam_n_c, lam_t_c)
     # fine nodal values of the coarse P1 multipliers, with the prescribed end values
@@ -97,8 +95,7 @@ def contact_traces(solution: Solution) -> ContactTraces:
     fine_n, fine_t = fine[rng_n.start:rng_n.stop], fine[rng_t.start:rng_t.stop]
     gamma_c = pb.spaces.gamma_c
 
-    s_n, s_t, active = [], [], []
-    offset = 0
+    active, offset = [], 0
     for c, chain in enumerate(contact.chains):
         interior = contact.dof_positions(c)
         flags = in_contact[offset:offset + len(interior)]
@@ -108,16 +105,11 @@ def contact_traces(solution: Solution) -> ContactTraces:
         for k in range(chain.n_edges):
             e = np.searchsorted(nodes, k, side="right") - 1
             active.append(int(nodes[e]) in contact_pos or int(nodes[e + 1]) in contact_pos)
-    # sigma n on every fine edge, evaluated just inside the body at the edge midpoint
-    for mid, normal, along, length in zip(gamma_c.midpoints, gamma_c.normals, gamma_c.tangents,
-                                          gamma_c.lengths):
-        st = np.array(sigma(mesh(*(mid - 1e-9 * length * normal)))).reshape(2, 2)
-        traction = st @ normal
-        s_n.append(normal @ traction)
-        s_t.append(along @ traction)
+    # sigma_n, sigma_t on every fine edge (constant for RT_0): the solver's fine-edge operators
+    forms = friction_forms_of(solution)
+    s_n, s_t = forms.T_n @ solution.x, forms.T_t @ solution.x
     node_xy = np.vstack([chain.path_points for chain in contact.chains])
     coarse_xy = contact.node_points()
-    s_n, s_t = np.array(s_n), np.array(s_t)
     projected = []
     for hats in (pb.spaces.prolongations["lam_n"], pb.spaces.end_hats["lam_n"]):
         means = gamma_c.hat_means(hats)
