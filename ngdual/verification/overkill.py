@@ -10,9 +10,20 @@ can be compared later:
   the P1 rotation are polynomials of degree <= 2 on each triangle, so the P2 interpolant
   at these nodes *is* the field, triangle by triangle (values taken inside the triangle,
   discontinuities kept).
-* the contact pressure on a horizontal Gamma_C as a P1 function on the h~ mesh: the lumped
-  L2 projection of -sigma_n^h onto the h~ hats (:func:`ngdual.verification.traction.
+* the contact pressure on Gamma_C as a P1 function on the h~ mesh: the lumped L2
+  projection of -sigma_n^h onto the h~ hats (:func:`ngdual.verification.traction.
   traction_profile`; the fine-edge values of sigma_n^h oscillate, see there).
+
+The pressure on Gamma_C. Gamma_C must be a graph over x (every contact boundary of the
+shipped scenes is: the straight bottoms, Hertz's arc, the wedge's V); the pressure is a
+function of x, compared at the same x, and integrated in arc length, ds = (|e| / |dx_e|) dx
+on every edge e of the mesh's Gamma_C (exact: the edges are straight, also on an arc, whose
+refined vertices netgen places on the arc). A P1 pressure on the h~ mesh is taken linear in
+x between its nodes (along an arc it is linear in arc length, which differs by
+O(h~ slope / R) relative, far below the errors measured). Where two chains of Gamma_C meet at
+a kink the pressure may jump: the left chain's value holds on the left, the right chain's on
+the right. A Gamma_C that is not a graph over x (a vertical edge, edges overlapping in x)
+raises a ValueError (:func:`graph_over_x`).
 
 Errors (:func:`field_errors`, :func:`pressure_error`) are integrals over the reference's
 triangles and edges. For uniform candidates the meshes are nested (red refinement of one
@@ -27,6 +38,10 @@ coarse edges, so the pressure error is exact on the union of both edge sets.
 >>> ref = {"x": np.array([0.0, 0.5, 1.0]), "p": np.array([0.0, 1.0, 0.0])}
 >>> x, w, p = nodes_to_samples(np.array([0.0, 1.0]), np.array([0.0, 0.0]), ref)
 >>> round(pressure_error(x, w, p, ref)["l2"] ** 2, 12)  # int of the hat squared
+0.333333333333
+>>> v = np.array([[[0.0, 1.0], [0.5, 0.0]], [[0.5, 0.0], [1.0, 1.0]]])  # a V: |e| = 1.118
+>>> x, w, p = nodes_to_samples(np.array([0.0, 1.0]), np.array([0.0, 0.0]), ref, v)
+>>> round(pressure_error(x, w, p, ref)["l2"] ** 2 / math.sqrt(5), 12)  # ds = sqrt(5) dx
 0.333333333333
 """
 
@@ -70,15 +85,81 @@ def _interp(nodes: dict, x: np.ndarray) -> np.ndarray:
     return np.interp(x, nodes["x"], nodes["p"])
 
 
-def nodes_to_samples(x, p, reference: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def graph_over_x(edges) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The edges of Gamma_C (m, 2, 2: start and end point of every edge) as a graph over x.
+
+    Returns
+    -------
+    x0, x1 : numpy.ndarray
+        The x interval of every edge, x0 < x1, in the order of ``edges``.
+    y0, y1 : numpy.ndarray
+        y at x0 and at x1.
+
+    Raises
+    ------
+    ValueError
+        If an edge is vertical (|dx| <= 1e-9 |e|) or two edges overlap in x (then Gamma_C
+        is not a graph over x and a pressure over x means nothing).
+    """
+    edges = np.asarray(edges, float)
+    d = edges[:, 1] - edges[:, 0]
+    if np.any(np.abs(d[:, 0]) <= 1e-9 * np.hypot(d[:, 0], d[:, 1])):
+        raise ValueError("Gamma_C has a vertical edge: it is not a graph over x")
+    left = np.where((d[:, 0] > 0)[:, None], edges[:, 0], edges[:, 1])
+    right = np.where((d[:, 0] > 0)[:, None], edges[:, 1], edges[:, 0])
+    order = np.argsort(left[:, 0], kind="stable")
+    overlap = left[order[1:], 0] - right[order[:-1], 0]
+    if np.any(overlap < -1e-9 * (right[:, 0] - left[:, 0]).min()):
+        raise ValueError("edges of Gamma_C overlap in x: it is not a graph over x")
+    return left[:, 0], right[:, 0], left[:, 1], right[:, 1]
+
+
+def edge_samples(edges, subdivisions: int = 1) -> tuple[np.ndarray, np.ndarray]:
+    """3-point Gauss points (N, 2) on every edge of Gamma_C (m, 2, 2), each edge split into
+    ``subdivisions`` equal parts in x, and their arc-length weights: the dx weights of
+    :func:`gauss_samples` times |e| / |dx_e| (Gamma_C a graph over x, :func:`graph_over_x`),
+    so that the weights of an edge sum to its length.
+
+    >>> edges = np.array([[[0.0, 0.0], [3.0, 4.0]]])
+    >>> xy, w = edge_samples(edges, 2)
+    >>> round(float(w.sum()), 12), xy[1].tolist()
+    (5.0, [0.75, 1.0])
+    """
+    x0, x1, y0, y1 = graph_over_x(edges)
+    x, w = gauss_samples(x0, x1, subdivisions)
+    per_edge = len(x) // len(x0)
+    stretch = np.hypot(x1 - x0, y1 - y0) / (x1 - x0)
+    slope = (y1 - y0) / (x1 - x0)
+    start = np.repeat(x0, per_edge)
+    y = np.repeat(y0, per_edge) + np.repeat(slope, per_edge) * (x - start)
+    return np.column_stack([x, y]), w * np.repeat(stretch, per_edge)
+
+
+def nodes_to_samples(x, p, reference: dict, edges=None
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Gauss samples (points, weights, values) of a P1 candidate with nodes ``x`` and values
     ``p`` on the union of its and the reference's nodes: both are linear on every piece,
-    so the squared difference is integrated exactly."""
-    breaks = np.unique(np.concatenate([x, reference["x"]]))
+    so the squared difference is integrated exactly.
+
+    ``edges`` (m, 2, 2): the fine edges of the candidate's Gamma_C. The weights are then in
+    arc length, dx times |e| / |dx_e| of the edge holding the point, and the pieces are cut
+    where that factor changes too (the vertices of a curved or kinked Gamma_C). Without
+    ``edges`` Gamma_C is taken horizontal (ds = dx).
+    """
+    breaks = [x, reference["x"]]
+    if edges is not None:
+        x0, x1, y0, y1 = graph_over_x(edges)
+        order = np.argsort(x0)
+        x0, stretch = x0[order], (np.hypot(x1 - x0, y1 - y0) / (x1 - x0))[order]
+        breaks.append(x0[1:][stretch[1:] != stretch[:-1]])
+    breaks = np.unique(np.concatenate(breaks))
     lo, hi = max(np.min(x), reference["x"].min()), min(np.max(x), reference["x"].max())
     breaks = breaks[(breaks >= lo) & (breaks <= hi)]
     points, weights = gauss_samples(breaks[:-1], breaks[1:])
-    order = np.argsort(x)
+    if edges is not None:
+        k = np.clip(np.searchsorted(x0, points, side="right") - 1, 0, len(x0) - 1)
+        weights = weights * stretch[k]
+    order = np.argsort(x, kind="stable")
     return points, weights, np.interp(points, np.asarray(x)[order], np.asarray(p)[order])
 
 
@@ -94,10 +175,10 @@ def gauss_samples(x0, x1, subdivisions: int = 1) -> tuple[np.ndarray, np.ndarray
 
 
 def pressure_error(x, w, p, reference: dict, window: float | None = None) -> dict:
-    """||p_h - p_ref||_L2 and ||p_ref||_L2 on Gamma_C (or on |x| <= ``window``), from
-    Gauss samples of the candidate on pieces where the reference (P1 ``nodes``) is linear;
-    ``rel`` their ratio, ``max`` the largest difference at the samples relative to
-    max |p_ref|."""
+    """||p_h - p_ref||_L2 and ||p_ref||_L2 on Gamma_C (or on its part |x| <= ``window``),
+    from Gauss samples of the candidate (points x, arc-length weights w) on pieces where the
+    reference (P1 in x, ``x`` and ``p``) is linear; ``rel`` their ratio, ``max`` the largest
+    difference at the samples relative to max |p_ref|."""
     x, w, p = map(np.asarray, (x, w, p))
     keep = np.ones(len(x), bool) if window is None else np.abs(x) <= window
     ref = _interp(reference, x[keep])
@@ -184,7 +265,8 @@ def field_errors(candidate: dict, reference: dict, lam: float, mu: float,
 def solution_samples(solution) -> dict:
     """A discrete ngdual solution as arrays: :func:`element_samples` of sigma (4 components,
     row-major), u and the rotation eta, and the Gamma_C pressure (``p_nodes``, ``p``: P1 on
-    the h~ mesh) when the scene has a contact boundary."""
+    the h~ mesh; ``p_edges``: the fine edges of Gamma_C, (m, 2, 2), for the arc-length
+    weights) when the scene has a contact boundary."""
     from ..quantities import fields
     from .traction import traction_profile
 
@@ -203,8 +285,16 @@ def solution_samples(solution) -> dict:
              for q in (coarse.nodes[c][:-1] if chain.closed else coarse.nodes[c])]
             for c, chain in enumerate(coarse.chains)])
         pressure[fixed] = 0.0
-        order = np.argsort(profile.x, kind="stable")
-        out.update(p_nodes=profile.x[order], p=pressure[order])
+        # a node shared by two chains (a kink of Gamma_C) appears once per chain, with that
+        # chain's value: the chain lying further left comes first, so that np.interp takes
+        # each side's value on its side
+        stops = [*profile.chain_starts[1:], len(profile.x)]
+        side = np.concatenate([np.full(stop - start, profile.x[start:stop].mean())
+                               for start, stop in zip(profile.chain_starts, stops)])
+        order = np.lexsort((side, profile.x))
+        edges = np.concatenate([np.stack([chain.path_points[:-1], chain.path_points[1:]], 1)
+                                for chain in coarse.chains])
+        out.update(p_nodes=profile.x[order], p=pressure[order], p_edges=edges)
     return out
 
 
@@ -218,14 +308,16 @@ def true_errors(candidate: dict, reference: dict, lam: float, mu: float,
     """Every true error of a candidate against a reference (both sample arrays): the field
     errors of :func:`field_errors` and the pressure error (``pressure_rel``: relative L2 on
     Gamma_C, ``pressure_max``). A candidate carries its pressure either as a P1 function
-    (``p_nodes``, ``p``: ngdual) or as quadrature samples (``p_x``, ``p_w``, ``p``: any method)."""
+    (``p_nodes``, ``p`` and ``p_edges`` if Gamma_C is not horizontal: ngdual) or as
+    quadrature samples in x with arc-length weights (``p_x``, ``p_w``, ``p``: any method)."""
     out = field_errors(candidate, reference, lam, mu)
     if "p" in candidate and "p" in reference:
         ref = pressure_of(reference)
         if "p_w" in candidate:
             x, w, p = candidate["p_x"], candidate["p_w"], candidate["p"]
         else:
-            x, w, p = nodes_to_samples(candidate["p_nodes"], candidate["p"], ref)
+            x, w, p = nodes_to_samples(candidate["p_nodes"], candidate["p"], ref,
+                                       candidate.get("p_edges"))
         e = pressure_error(x, w, p, ref, window)
         out.update(pressure_rel=e["rel"], pressure_l2=e["l2"], pressure_max=e["max"])
     return out

@@ -4,7 +4,10 @@ This is "the method a user would pick instead" of ngdual's dual-dual mixed metho
 P1 or P2 Lagrange elements for the displacement of a 2D plane-strain elastic body, unilateral
 contact with a rigid foundation (``u_n <= g`` on Gamma_C, n the body's outward normal) imposed
 by Nitsche's method, frictionless or with Tresca / Coulomb friction, solved by a semismooth
-(generalised) Newton method with a sparse direct solver (UMFPACK).
+(generalised) Newton method with a sparse direct solver (UMFPACK). n and t = (n_2, -n_1)
+are the normal and tangent of each boundary edge (NGSolve's ``specialcf.normal`` in the
+contact integrals), so on a curved Gamma_C (an arc meshed by straight edges) or a kinked
+one the contact conditions hold in the local normal and tangential directions.
 
 Nitsche's method (Chouly & Hild 2013; Chouly, Hild & Renard 2015). With beta = gamma / h,
 gamma = gamma0 * E and h the length of the boundary edge (NGSolve's ``specialcf.mesh_size``
@@ -152,8 +155,14 @@ def solve_primal(mesh: ngs.Mesh, *, E: float, nu: float, dirichlet, neumann=(), 
     ``dirichlet``, ``neumann``, ``contact``: lists of boundary labels of ``mesh``
     (``displacement`` prescribed on the first, ``traction`` on the second; sides in none of
     them are traction free). Loads are pairs of numbers / formulas in x, y / CFs or a
-    2-vector CF; ``gap`` and ``tresca_bound`` scalars of the same kinds. ``law``: "none",
-    "tresca" (bound ``tresca_bound``) or "coulomb" (coefficient ``mu_f``).
+    2-vector CF; ``gap`` and ``tresca_bound`` scalars of the same kinds. ``gap`` may also be
+    a function ``gap(x, y, n_x, n_y)`` of the point and the outward unit normal n of
+    Gamma_C that takes numpy arrays and NGSolve coefficient functions alike (the distance
+    to a foundation line along n, :func:`ngdual.scene.contact.foundation_gap`): on a curved
+    or kinked Gamma_C the gap then follows the local normal, NGSolve's normal in the
+    contact integrals and the normal of the edge a point lies on in :meth:`PrimalResult.
+    pressure`. ``law``: "none", "tresca" (bound ``tresca_bound``) or "coulomb" (coefficient
+    ``mu_f``).
 
     Newton stops when the residual (on the free DOFs) is below ``tol`` times the initial one;
     otherwise :class:`NewtonError` is raised.
@@ -184,7 +193,7 @@ def solve_primal(mesh: ngs.Mesh, *, E: float, nu: float, dirichlet, neumann=(), 
     t = tangent(n)
     h = ngs.specialcf.mesh_size
     beta = gamma0 * E / h
-    g = scalar_cf(gap)
+    g = gap(ngs.x, ngs.y, n[0], n[1]) if callable(gap) else scalar_cf(gap)
     dsc = ngs.ds(skeleton=True, definedon=mesh.Boundaries("|".join(contact)))
 
     def parts(w):
@@ -305,7 +314,12 @@ def solve_primal(mesh: ngs.Mesh, *, E: float, nu: float, dirichlet, neumann=(), 
         mp = mesh(q[:, 0], q[:, 1])
         sig = np.asarray(sigma(mp)).reshape(-1, 2, 2)
         disp = np.asarray(gfu(mp)).reshape(-1, 2)
-        gap_val = np.asarray(g(mp)).reshape(-1)
+        if callable(gap):
+            # at the point the search found, as the formula gap g(mp) below
+            xq, yq = np.asarray(ngs.CF((ngs.x, ngs.y))(mp)).reshape(-1, 2).T
+            gap_val = gap(xq, yq, nn[:, 0], nn[:, 1])
+        else:
+            gap_val = np.asarray(g(mp)).reshape(-1)
         sn_vec = np.einsum("kij,kj->ki", sig, nn)
         b = gamma0 * E / hh
         p_n = np.einsum("ki,ki->k", sn_vec, nn) - b * (np.einsum("ki,ki->k", disp, nn) - gap_val)
@@ -332,7 +346,3 @@ def solve_primal(mesh: ngs.Mesh, *, E: float, nu: float, dirichlet, neumann=(), 
                         stick_length=stick_length, support_force=support_force,
                         pressure_cf=p_cf, traction_cf=lt_cf,
                         _edges=edges, _pointwise=pointwise)
-
-
-# --------------------------------------------------------------------------------------------
-# An ngdual scene solved by the peer, as the sample arrays of ngdual.verification.overkill

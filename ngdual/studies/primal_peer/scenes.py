@@ -3,27 +3,24 @@
 from __future__ import annotations
 
 import time
+from functools import partial
 
-import ngsolve as ngs
 import numpy as np
 
-from .nitsche import scalar_cf, solve_primal, stress
-from .result import ContactEdges, PrimalResult
+from .nitsche import solve_primal, stress
+from .result import PrimalResult
 
 
-def _scene_gap(contact, mesh: ngs.Mesh, labels: list[str]) -> ngs.CoefficientFunction:
-    """The scene's gap as a CF (a formula, or the distance to the foundation line along the
-    outward normal of Gamma_C, :func:`ngdual.scene.contact.foundation_gap`). The CF is also
-    evaluated inside the body (the pressure at points), where no normal exists: a foundation
-    line needs a straight Gamma_C, whose normal is then a constant."""
+def _scene_gap(contact):
+    """The scene's gap for :func:`~.nitsche.solve_primal`: its formula, or the distance to
+    the foundation line along the outward normal of Gamma_C as a function of the point and
+    the normal (:func:`ngdual.scene.contact.foundation_gap`, the gap ngdual's own forms use),
+    so that on a curved or kinked Gamma_C every edge sees the gap along its own normal."""
     from ...scene.contact import foundation_gap
 
     if contact.foundation is None:
-        return scalar_cf(contact.gap_formula)
-    normals = ContactEdges.of(mesh, labels).normal
-    if np.ptp(normals, axis=0).max() > 1e-12:
-        raise ValueError("a foundation line needs a straight Gamma_C for the peer")
-    return foundation_gap(contact, ngs.x, ngs.y, float(normals[0, 0]), float(normals[0, 1]))
+        return contact.gap_formula
+    return partial(foundation_gap, contact)
 
 
 def solve_scene_primal(scene, level: int, order: int, **kw) -> tuple[PrimalResult, float]:
@@ -44,7 +41,7 @@ def solve_scene_primal(scene, level: int, order: int, **kw) -> tuple[PrimalResul
         neumann=scene.labels("neumann"), contact=scene.labels("contact"),
         body_force=scene.loads.body_force, traction=scene.loads.traction,
         displacement=scene.loads.displacement,
-        gap=_scene_gap(scene.contact, mesh, scene.labels("contact")), order=order,
+        gap=_scene_gap(scene.contact), order=order,
         law=law, mu_f=scene.friction.mu if law == "coulomb" else 0.0,
         tresca_bound=scene.friction.bound if law == "tresca" else None, **kw)
     return result, time.perf_counter() - start
@@ -53,23 +50,18 @@ def solve_scene_primal(scene, level: int, order: int, **kw) -> tuple[PrimalResul
 def primal_samples(scene, result: PrimalResult, subdivisions: int = 1) -> dict:
     """The peer's solution as sample arrays (:mod:`ngdual.verification.overkill`): sigma
     and u at the P2 nodes of every triangle (exact for P1 and P2), and the pressure at
-    3-point Gauss points of every Gamma_C edge split into ``subdivisions`` parts (``p_x``,
-    ``p_w``, ``p``), so that each part lies in one edge of a reference ``log2(subdivisions)``
-    levels finer."""
-    from ...verification.overkill import element_samples, gauss_samples
+    3-point Gauss points of every Gamma_C edge split into ``subdivisions`` equal parts in x
+    (``p_x``; ``p_w`` the arc-length weights, ``p``), so that on a straight Gamma_C each
+    part lies in one edge of a reference ``log2(subdivisions)`` levels finer (on an arc the
+    refined vertices move onto the arc, a part may straddle a reference node and the
+    quadrature of the reference's kink there is then accurate to O(h^2) instead of exact).
+    Gamma_C must be a graph over x (:func:`ngdual.verification.overkill.graph_over_x`)."""
+    from ...verification.overkill import edge_samples, element_samples
 
     lam, mu = scene.material.lame
     mesh = result.u.space.mesh
     out = element_samples(mesh, {"sigma": stress(result.u, mu, lam), "u": result.u})
     edges = result._edges
-    if np.ptp(edges.p0[:, 1]) > 1e-12 or np.ptp(edges.p1[:, 1]) > 1e-12:
-        raise ValueError("pressure samples need a horizontal Gamma_C")
-    x0 = np.minimum(edges.p0[:, 0], edges.p1[:, 0])
-    x1 = np.maximum(edges.p0[:, 0], edges.p1[:, 0])
-    x, w = gauss_samples(x0, x1, subdivisions)
-    y = np.full_like(x, edges.p0[0, 1])
-    out.update(p_x=x, p_w=w, p=result.pressure(np.column_stack([x, y])))
+    xy, w = edge_samples(np.stack([edges.p0, edges.p1], axis=1), subdivisions)
+    out.update(p_x=xy[:, 0], p_w=w, p=result.pressure(xy))
     return out
-
-
-# --------------------------------------------------------------------------------------------
