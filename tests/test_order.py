@@ -12,6 +12,8 @@ linear elasticity with a smooth manufactured solution (ngdual.verification.order
 * The discrete inf-sup constant of b + s stays above a fixed bound under refinement.
 """
 
+from pathlib import Path
+
 import ngsolve as ngs
 import numpy as np
 import pytest
@@ -22,6 +24,7 @@ from ngdual.scene import SceneError
 from ngdual.sparse import to_scipy
 from ngdual.verification.order import convergence_study, infsup_constants
 
+DOCS = Path(__file__).resolve().parents[1] / "docs" / "theory" / "order.md"
 TOLERANCE = 0.15
 # The rotation of PEERS_1 reaches its order from below: 1.84 between levels 2 and 3, 1.93
 # between 3 and 4 (docs/theory/order.md); the fast tier checks it on levels 2, 3 with this
@@ -105,9 +108,20 @@ def test_order_2_converges_like_h_cubed(family):
     _check_orders(convergence_study(family, 2, levels=(2, 3)), family, 2)
 
 
-def test_the_inf_sup_constant_of_peers_0_and_1_on_two_levels_is_above_the_bound():
+def documented_betas(family: str, k: int) -> list[float]:
+    """The inf-sup constants of the table in docs/theory/order.md, levels 0-3."""
+    label = {"peers": "PEERS", "afw": "AFW"}[family]
+    for line in DOCS.read_text().splitlines():
+        cells = [c.strip() for c in line.strip("|").split("|")]
+        if cells[:2] == [label, str(k)] and len(cells) == 6:
+            return [float(c.split()[0]) for c in cells[2:]]
+    raise LookupError(f"{label} {k} in {DOCS}")
+
+
+def test_the_inf_sup_constants_of_peers_0_and_1_are_those_of_the_docs_and_above_the_bound():
     for k in (0, 1):
         betas = [row["beta"] for row in infsup_constants("peers", k, levels=(0, 1))]
+        assert betas == pytest.approx(documented_betas("peers", k)[:2], abs=5e-5)
         assert min(betas) > BETA_MIN
 
 
@@ -116,5 +130,6 @@ def test_the_inf_sup_constant_of_peers_0_and_1_on_two_levels_is_above_the_bound(
 @pytest.mark.parametrize("k", [0, 1, 2])
 def test_the_inf_sup_constant_stays_above_a_fixed_bound_over_four_refinements(family, k):
     betas = [row["beta"] for row in infsup_constants(family, k, levels=(0, 1, 2, 3))]
+    assert betas == pytest.approx(documented_betas(family, k), abs=5e-5)
     assert min(betas) > BETA_MIN
     assert betas[-1] / betas[-2] > 0.95        # settled: the last refinement moves it little
