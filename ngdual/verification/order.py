@@ -97,6 +97,13 @@ class ExactElasticity:
         return -ngs.CF(tuple(s[i, 0].Diff(ngs.x) + s[i, 1].Diff(ngs.y) for i in range(2)))
 
 
+def component_indices(fes: ngs.FESpace, names: list[str], *components: str) -> np.ndarray:
+    """Indices in the product space ``fes`` (components ``names``) of the listed components
+    that it has."""
+    ranges = [fes.Range(names.index(c)) for c in components if c in names]
+    return np.concatenate([np.arange(r.start, r.stop) for r in ranges])
+
+
 @dataclass
 class ElasticitySystem:
     """The PEERS block of (3.62) of one family and order on one mesh, with its load.
@@ -118,9 +125,7 @@ class ElasticitySystem:
 
     def index(self, *names: str) -> np.ndarray:
         """Indices of the listed components in the unknown vector."""
-        return np.concatenate([np.arange(self.fes.Range(self.names.index(n)).start,
-                                         self.fes.Range(self.names.index(n)).stop)
-                               for n in names if n in self.names])
+        return component_indices(self.fes, self.names, *names)
 
     @property
     def sigma(self) -> np.ndarray:
@@ -164,7 +169,7 @@ def assemble_elasticity(mesh: ngs.Mesh, family: str = "peers", order: int = 0,
     a = ngs.BilinearForm(fes)
     a += exact_rule(peers_form(trial, test, exact.lame), degree)
     a.Assemble()
-    _, div_tau, v, _ = peers.triple(test)
+    v = peers.triple(test)[2]
     trac_tau = peers.stress_traction(test["r1"], test["r2"])
     load = ngs.LinearForm(fes)
     load += -exact.f * v * ngs.dx(bonus_intorder=4)
@@ -175,10 +180,7 @@ def assemble_elasticity(mesh: ngs.Mesh, family: str = "peers", order: int = 0,
     if neumann:
         region = mesh.Boundaries(neumann)
         on_neumann = np.flatnonzero(np.array(fes.GetDofs(region), dtype=bool))
-        rows = set(np.concatenate([np.arange(fes.Range(names.index(r)).start,
-                                             fes.Range(names.index(r)).stop)
-                                   for r in ("r1", "r2")]))
-        fixed = np.array([i for i in on_neumann if i in rows], dtype=int)
+        fixed = np.intersect1d(on_neumann, component_indices(fes, names, "r1", "r2"))
         lift = ngs.GridFunction(fes)
         for i, r in enumerate(("r1", "r2")):
             row = ngs.CF((exact.sigma[i, 0], exact.sigma[i, 1]))
