@@ -71,8 +71,8 @@ def peers_form(trial: dict, test: dict, lame: tuple[float, float]
     ----------
     trial, test : dict
         Trial and test functions keyed by the names of :data:`ngdual.peers.PEERS`, from
-        any product space that holds the PEERS triple: the conforming one of
-        :func:`assemble` or the broken one of :class:`ngdual.solvers.hybrid.HybridSystem`.
+        any product space that holds the PEERS triple (the broken one of
+        :func:`broken_peers`, the conforming one of :mod:`ngdual.verification`).
     lame : tuple of float
         Lame's constants (lambda, mu).
     """
@@ -156,6 +156,85 @@ class Spaces:
 
 
 @dataclass
+class BrokenPeers:
+    """The PEERS block of (3.62), assembled once, element by element.
+
+    The Raviart-Thomas rows of sigma are broken (every triangle has its own three normal
+    fluxes); the bubbles, u and eta are those of the conforming space. The element matrices
+    of a~ + b + s are the same as on the conforming space, but no two triangles share a
+    stress unknown, so ``matrix`` keeps every triangle's matrix apart: the conforming PEERS
+    block is K = E^T K_b E (:meth:`summed`), E the 0/1 map from conforming to broken
+    unknowns, and the hybridisation (:class:`ngdual.solvers.hybrid.HybridSystem`) eliminates
+    the element-local unknowns from the same matrix.
+
+    Attributes
+    ----------
+    fes : ngsolve.FESpace
+        The broken product space, components :data:`ngdual.peers.PEERS`.
+    matrix : scipy.sparse.csr_matrix
+        K_b, with NGSolve's sparsity pattern (every pair of unknowns of a triangle, explicit
+        zeros included).
+    conforming : numpy.ndarray
+        The conforming PEERS unknown that every broken unknown restricts (E as an index map).
+    """
+
+    fes: ngs.FESpace
+    matrix: sp.csr_matrix
+    conforming: np.ndarray
+
+    def summed(self, size: int) -> sp.csr_matrix:
+        """K = E^T K_b E, the PEERS block of (3.62), as the leading block of a ``size`` x
+        ``size`` matrix (the PEERS unknowns come first).
+
+        Every entry is the sum of at most two element entries (an edge has two triangles),
+        so it equals the conforming assembly's bit for bit, whatever the order of the sum.
+        """
+        coo = self.matrix.tocoo()
+        index = self.conforming
+        return sp.csr_matrix((coo.data, (index[coo.row], index[coo.col])), shape=(size, size))
+
+
+def broken_peers(spaces: Spaces, lame: tuple[float, float]) -> BrokenPeers:
+    """Assemble the PEERS block of (3.62) with broken Raviart-Thomas rows (:class:`BrokenPeers`)."""
+    mesh = spaces.mesh
+    broken_rt = ngs.HDiv(mesh, order=0, discontinuous=True)
+    comps = {name: broken_rt if name in ("r1", "r2") else spaces.components[name]
+             for name in peers.PEERS}
+    fes = ngs.FESpace(list(comps.values()))
+    a = ngs.BilinearForm(fes)
+    a += peers_form(dict(zip(peers.PEERS, fes.TrialFunction())),
+                    dict(zip(peers.PEERS, fes.TestFunction())), lame)
+    with parallel_tasks(mesh):
+        a.Assemble()
+    # the continuous RT_0 function of an edge restricts to one broken function on each of its
+    # triangles, with the same orientation: every row of ConvertOperator's matrix (an L^2
+    # projection, exact up to rounding) is one 1
+    restrict = to_scipy(ngs.ConvertOperator(spaces.components["r1"], broken_rt))
+    edge = _unit_column(restrict)
+    conforming, offset = [], 0
+    for name in peers.PEERS:
+        own = edge if name in ("r1", "r2") else np.arange(comps[name].ndof)
+        conforming.append(offset + own)
+        offset += spaces.components[name].ndof
+    return BrokenPeers(fes, to_scipy(a.mat), np.concatenate(conforming))
+
+
+def _unit_column(matrix: sp.csr_matrix, tol: float = 1e-8) -> np.ndarray:
+    """The column of the one entry 1 in every row of ``matrix`` (the others zero, both up to
+    ``tol``)."""
+    dense_rows = np.repeat(np.arange(matrix.shape[0]), np.diff(matrix.indptr))
+    ones = np.abs(matrix.data - 1.0) <= tol
+    if not (np.all(ones | (np.abs(matrix.data) <= tol))
+            and np.array_equal(np.bincount(dense_rows[ones], minlength=matrix.shape[0]),
+                               np.ones(matrix.shape[0], dtype=int))):
+        raise RuntimeError("NGSolve's broken Raviart-Thomas functions are not restrictions "
+                           "of the continuous ones")
+    column = np.empty(matrix.shape[0], dtype=np.int64)
+    column[dense_rows[ones]] = matrix.indices[ones]
+    return column
+
+
+@dataclass
 class DiscreteProblem:
     """The assembled discrete problem (3.62) without friction terms.
 
@@ -170,6 +249,8 @@ class DiscreteProblem:
         Gamma_N (zero for the homogeneous Dirichlet data of the thesis).
     blocks : dict[str, slice]
         Position of every component in the unknown vector.
+    broken : BrokenPeers
+        The PEERS block element by element, from which K's PEERS block was summed.
     """
 
     scene: Scene
@@ -181,6 +262,7 @@ class DiscreteProblem:
     rhs: np.ndarray
     blocks: dict[str, slice]
     lift: np.ndarray
+    broken: BrokenPeers
     assemble_seconds: float
     level: int | None = None
 
@@ -219,11 +301,12 @@ class DiscreteProblem:
 
 
 def _forms(scene: Scene, fes: ngs.FESpace, names: list[str]):
-    """The forms of (3.62): the PEERS block a~ + b + s on T_h, the couplings d_N, d_C with the
-    boundary multipliers (None without Gamma_N and Gamma_C) and the right-hand side.
+    """The forms of (3.62) besides the PEERS block (:func:`broken_peers`): the couplings d_N,
+    d_C with the boundary multipliers (None without Gamma_N and Gamma_C) and the right-hand
+    side.
 
-    Two bilinear forms, so that the large volume matrix never meets the prolongation of the
-    multipliers (:func:`assemble`).
+    The PEERS block is a form of its own, so that the large volume matrix never meets the
+    prolongation of the multipliers (:func:`assemble`).
     """
     mesh = fes.mesh
     trial = dict(zip(names, fes.TrialFunction()))
@@ -233,8 +316,6 @@ def _forms(scene: Scene, fes: ngs.FESpace, names: list[str]):
     trac_sig = peers.stress_traction(trial["r1"], trial["r2"])
     trac_tau = peers.stress_traction(test["r1"], test["r2"])
     v = ngs.CF((test["u1"], test["u2"]))
-    a = ngs.BilinearForm(fes)
-    a += peers_form(trial, test, scene.material.lame)
     d = ngs.BilinearForm(fes) if {"phi1", "lam_n"} & set(names) else None
     rhs = ngs.LinearForm(fes)
     f = ngs.CF(tuple(Expression(e).coefficient() for e in scene.loads.body_force))
@@ -257,7 +338,7 @@ def _forms(scene: Scene, fes: ngs.FESpace, names: list[str]):
         d += (trial["lam_n"] * (n * trac_tau) + test["lam_n"] * (n * trac_sig)) * ds_c  # d_Cn
         if scene.contact.discrete_gap == "thesis":
             rhs += gap_coefficient(scene) * (n * trac_tau) * ds_c             # g(tau)
-    return a, d, rhs
+    return d, rhs
 
 
 def assemble(scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes | None = None
@@ -267,9 +348,8 @@ def assemble(scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes | None = None
     spaces = Spaces.build(scene, mesh, coarse)
     names = list(spaces.components)
     fes = ngs.FESpace([spaces.components[n] for n in names])
-    a, d, rhs = _forms(scene, fes, names)
-    with parallel_tasks(mesh):
-        a.Assemble()
+    broken = broken_peers(spaces, scene.material.lame)
+    d, rhs = _forms(scene, fes, names)
     for form in (d, rhs):
         if form is not None:
             form.Assemble()
@@ -281,10 +361,8 @@ def assemble(scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes | None = None
         blocks[name] = slice(offset, offset + p.shape[1])
         offset += p.shape[1]
     P = sp.block_diag(blocks_p, format="csr")
-    # the PEERS unknowns come first and are not prolonged: their block is a's matrix as it is
-    # (shared, not copied: the sum below or the copy makes K's own arrays)
-    n_peers = sum(spaces.components[c].ndof for c in peers.PEERS)
-    volume = _leading_block(to_scipy(a.mat, copy=False), n_peers, P.shape[1])
+    # the PEERS unknowns come first and are not prolonged
+    volume = broken.summed(P.shape[1])
     lift = _end_lift(scene, spaces, fes, names)
     F = P.T @ rhs.vec.FV().NumPy()
     if d is not None:
@@ -293,19 +371,10 @@ def assemble(scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes | None = None
         # a has no entries in the multipliers' columns, where lift and the gap live
         F -= P.T @ (D @ (lift - _discrete_gap(scene, spaces, fes, names)))
     else:
-        K = volume.copy()
+        K = volume
     K.eliminate_zeros()
-    return DiscreteProblem(scene, spaces, fes, names, P, K, F, blocks, lift,
+    return DiscreteProblem(scene, spaces, fes, names, P, K, F, blocks, lift, broken,
                            time.perf_counter() - start)
-
-
-def _leading_block(K_fine: sp.csr_matrix, n: int, size: int) -> sp.csr_matrix:
-    """``K_fine``, whose nonzeros all lie in its leading n x n block, as a ``size`` x ``size``
-    matrix (the same arrays: the rows after n are empty)."""
-    if K_fine.indptr[n] != K_fine.nnz:
-        raise ValueError("the volume form couples unknowns after the PEERS triple")
-    indptr = np.concatenate([K_fine.indptr[:n + 1], np.full(size - n, K_fine.nnz)])
-    return sp.csr_matrix((K_fine.data, K_fine.indices, indptr), shape=(size, size))
 
 
 def _discrete_gap(scene: Scene, spaces: Spaces, fes: ngs.FESpace, names: list[str]

@@ -24,8 +24,6 @@ def test_parallel_and_serial_assembly_agree_bit_for_bit(monkeypatch):
     assert mesh.ne >= forms.PARALLEL_ELEMENTS
     parallel = assembled(scene, mesh)
     monkeypatch.setattr(forms, "parallel_tasks", lambda mesh: contextlib.nullcontext())
-    monkeypatch.setattr("ngdual.solvers.hybrid.parallel_tasks",
-                        lambda mesh: contextlib.nullcontext())
     serial = assembled(scene, mesh)
     for p, s in zip(parallel, serial):
         if hasattr(p, "tocsr"):

@@ -7,8 +7,9 @@ Cholesky factorisation. Breaking the normal continuity of the Raviart-Thomas row
 
     a~(sigma, tau) + b(u, tau) + s(eta, tau) + sum_T int_{dT} mu . tau n_T ds = ...,
 
-makes sigma, the bubbles and u element-local. NGSolve eliminates them element by element
-(``condense=True``); what remains couples only the edge multipliers mu and the rotation eta,
+makes sigma, the bubbles and u element-local. They are eliminated triangle by triangle
+from the element matrices the problem assembled (:class:`ngdual.forms.BrokenPeers`); what
+remains couples only the edge multipliers mu and the rotation eta,
 and its negative is symmetric positive definite (the negated Schur complement of an
 invertible saddle point whose multipliers satisfy the inf-sup condition).
 
@@ -39,7 +40,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .. import peers
-from ..forms import DiscreteProblem, boundary_regex, parallel_tasks, peers_form
+from ..forms import DiscreteProblem, boundary_regex
 from ..geometry import tangent
 from ..sparse import to_scipy
 from .settings import Model
@@ -115,10 +116,21 @@ class HybridSystem:
     the rows of (3.62) for sigma, u, eta, phi, and t(zeta) = r_z - (H w)_z are the
     traction moments (int_e sigma_n, int_e sigma_t) on the fine Gamma_C edges.
 
+    The element matrices of a~ + b + s are those the problem assembled once
+    (:class:`ngdual.forms.BrokenPeers`); only the coupling sum_T int_{dT} mu . tau n_T ds is
+    assembled here. The element-local unknowns (the broken sigma rows, the bubbles, u) are
+    eliminated triangle by triangle: with B_T their block, C_T their coupling to the
+    interface unknowns (eta, mu) of T and f_T their load,
+
+        S = K_II - sum_T C_T^T B_T^{-1} C_T,    g = - sum_T C_T^T B_T^{-1} f_T,
+
+    and they are recovered from the interface values x_I as B_T^{-1} (f_T - C_T x_I).
+
     Parameters
     ----------
     problem : DiscreteProblem
-        The assembled problem (its mesh, spaces, prolongations and phi right-hand side).
+        The assembled problem (its mesh, spaces, prolongations, phi right-hand side and
+        element matrices).
     model : Model
         Lamé's constants and the labels of Gamma_D, Gamma_N, Gamma_C.
     """
@@ -128,52 +140,98 @@ class HybridSystem:
         self.problem = problem
         mesh = problem.fes.mesh
         self.mesh = mesh
-        rt = ngs.HDiv(mesh, order=0, discontinuous=True)
-        bubble, p0 = peers.cubic_bubbles(mesh), ngs.L2(mesh, order=0)
+        broken = problem.broken
         facet = ngs.FacetFESpace(mesh, order=0)
-        comps = {"r1": rt, "r2": rt, "b1": bubble, "b2": bubble, "u1": p0, "u2": p0,
-                 "eta": ngs.H1(mesh, order=1), "m1": facet, "m2": facet}
-        self.names = list(comps)
-        self.fes = ngs.FESpace(list(comps.values()))
-        self.rt = rt
-        trial = dict(zip(self.names, self.fes.TrialFunction()))
-        test = dict(zip(self.names, self.fes.TestFunction()))
-        n = ngs.specialcf.normal(2)
-
-        def traction(f):  # sigma . n_T on the element boundary (the bubbles' Curl has none)
-            return ngs.CF((f["r1"] * n, f["r2"] * n))
-
-        a = ngs.BilinearForm(self.fes, condense=True)
-        a += peers_form(trial, test, model.lame)
-        m, k = ngs.CF((trial["m1"], trial["m2"])), ngs.CF((test["m1"], test["m2"]))
-        # mu . tau n_T is constant on every element edge (P0 times the RT_0 normal trace)
-        dT = ngs.dx(element_boundary=True, intrules={ngs.SEGM: ngs.IntegrationRule(ngs.SEGM, 2)})
-        a += (m * traction(test) + k * traction(trial)).Compile() * dT
-        with parallel_tasks(self.mesh):
-            a.Assemble()
-        # the only local load is -f(v) in the u rows: taken from the assembled F of (3.62)
-        self.rhs = a.mat.CreateColVector()
-        self.rhs[:] = 0.0
-        values = self.rhs.FV().NumPy()
-        for name in ("u1", "u2"):
-            rg = self.fes.Range(self.names.index(name))
-            values[rg.start:rg.stop] = problem.rhs[problem.blocks[name]]
-        condensed = self.rhs.CreateVector()
-        condensed.data = self.rhs
-        with parallel_tasks(self.mesh):
-            condensed.data += a.harmonic_extension_trans * self.rhs
-        self.form = a
+        self.n_eta = broken.fes.Range(peers.PEERS.index("eta")).stop - \
+            broken.fes.Range(peers.PEERS.index("eta")).start
+        self.n_interface = self.n_eta + 2 * facet.ndof
+        self._elements(broken, _edge_coupling(broken.fes.components[0], facet), facet.ndof)
+        self._convert = _to_continuous(problem)
         self.assemble_seconds = time.perf_counter() - start
 
         start = time.perf_counter()
-        self._reduction(model, facet, condensed.FV().NumPy())
+        S, g = self._condense(broken)
+        self._reduction(model, facet, S, g)
         self.reduce_seconds = time.perf_counter() - start
 
-    def _reduction(self, model: Model, facet: ngs.FESpace, r_cond: np.ndarray) -> None:
-        """Build c = T w + c0 (coupling values from the reduced unknowns), H and r."""
-        pb, mesh, fes = self.problem, self.mesh, self.fes
-        ranges = {name: fes.Range(i) for i, name in enumerate(self.names)}
-        m1, m2, eta = ranges["m1"].start, ranges["m2"].start, ranges["eta"]
+    def _elements(self, broken, coupling: sp.csr_matrix, n_facets: int) -> None:
+        """Every triangle's local unknowns, its interface unknowns and its blocks B_T, C_T.
+
+        Read from NGSolve's sparsity pattern: a row of an element-local unknown holds
+        exactly the unknowns of its triangle, sorted, the local ones (the broken sigma rows,
+        the bubbles, u) before eta.
+        """
+        pb, fes = self.problem, broken.fes
+        K = broken.matrix
+        ranges = [fes.Range(i) for i in range(len(peers.PEERS))]
+        eta = ranges[peers.PEERS.index("eta")]
+        u1 = ranges[peers.PEERS.index("u1")]
+        width = int(K.indptr[u1.start + 1] - K.indptr[u1.start])
+        # one row of u1 (P0) per triangle: its columns are the triangle's unknowns
+        dofs = K.indices[K.indptr[u1.start:u1.stop, None] + np.arange(width)]
+        n_local = int(np.count_nonzero(dofs[0] < eta.start))
+        local = dofs[:, :n_local]
+        if not (np.all(np.diff(K.indptr)[:eta.start] == width)
+                and np.all(dofs[:, n_local:] >= eta.start) and np.all(local < eta.start)):
+            raise RuntimeError("the PEERS matrix does not have one block per triangle")
+        at = K.indptr[local][..., None] + np.arange(width)
+        if not np.array_equal(K.indices[at], np.broadcast_to(dofs[:, None, :], at.shape)):
+            raise RuntimeError("the PEERS matrix does not have one block per triangle")
+        values = K.data[at]
+        del at
+        rt_rows = []
+        for name in ("r1", "r2"):
+            rg = ranges[peers.PEERS.index(name)]
+            inside = (dofs[0, :n_local] >= rg.start) & (dofs[0, :n_local] < rg.stop)
+            rt_rows.append((np.flatnonzero(inside), local[:, inside] - rg.start))
+        positions, rt = rt_rows[0]
+        n_edges = len(positions)
+        at = coupling.indptr[rt][..., None] + np.arange(n_edges)
+        if not np.all(np.diff(coupling.indptr) == n_edges):
+            raise RuntimeError("the edge coupling does not have one block per triangle")
+        facets = coupling.indices[at[:, 0, :]]
+        flux = coupling.data[at]
+        n_eta = width - n_local
+        self.interface = np.concatenate([dofs[:, n_local:] - eta.start,
+                                         self.n_eta + facets,
+                                         self.n_eta + n_facets + facets], axis=1)
+        C = np.zeros((len(local), n_local, n_eta + 2 * n_edges))
+        C[:, :, :n_eta] = values[:, :, n_local:]
+        for k, (pos, _) in enumerate(rt_rows):
+            C[:, pos[:, None], n_eta + k * n_edges + np.arange(n_edges)] = flux
+        load = np.zeros(fes.ndof)
+        for name in ("u1", "u2"):
+            rg = ranges[peers.PEERS.index(name)]
+            load[rg.start:rg.stop] = pb.rhs[pb.blocks[name]]
+        self.local, self._B, self._C, self._f = local, values[:, :, :n_local], C, load[local]
+        self._ranges = ranges
+
+    def _condense(self, broken) -> tuple[sp.csr_matrix, np.ndarray]:
+        """S and g on the interface unknowns (eta, mu_1, mu_2); keeps B_T^{-1} C_T and
+        B_T^{-1} f_T for :meth:`unknowns`."""
+        C = self._C
+        solved = np.linalg.solve(self._B, np.concatenate([C, self._f[..., None]], axis=2))
+        self._extension, self._inner = solved[..., :-1], solved[..., -1]
+        del self._B, self._f
+        schur = -np.einsum("eki,ekj->eij", C, self._extension)
+        iface, n = self.interface, self.n_interface
+        g = -np.bincount(iface.ravel(), np.einsum("eki,ek->ei", C, self._inner).ravel(),
+                         minlength=n)
+        del self._C
+        width = iface.shape[1]
+        S = sp.csr_matrix((schur.ravel(), (np.repeat(iface, width, axis=1).ravel(),
+                                           np.tile(iface, (1, width)).ravel())), shape=(n, n))
+        eta = self._ranges[peers.PEERS.index("eta")]
+        K_eta = broken.matrix[eta.start:eta.stop][:, eta.start:eta.stop].tocoo()
+        if K_eta.nnz and np.any(K_eta.data):
+            S = S + sp.csr_matrix((K_eta.data, (K_eta.row, K_eta.col)), shape=(n, n))
+        return S, g
+
+    def _reduction(self, model: Model, facet: ngs.FESpace, S: sp.csr_matrix,
+                   r_cond: np.ndarray) -> None:
+        """Build c = T w + c0 (interface values from the reduced unknowns), H and r."""
+        pb, mesh = self.problem, self.mesh
+        m1, m2 = self.n_eta, self.n_eta + facet.ndof
         hdiv = pb.spaces.components["r1"]
         labelled = _boundary_edges(mesh, facet, hdiv)
         fluxes = _normal_fluxes(hdiv, mesh, model.labels("dirichlet") + model.labels("contact"))
@@ -185,11 +243,10 @@ class HybridSystem:
             return np.vstack(rows) if rows else np.zeros((0, 4), dtype=int)
 
         dirichlet, neumann = edges_of("dirichlet"), edges_of("neumann")
-        K = to_scipy(self.form.mat)
         interior = np.setdiff1d(np.arange(facet.ndof),
                                 np.concatenate([e[:, 0] for e in labelled.values()]))
         self.contact = self._contact_edges(model, labelled, fluxes, F1, F2)
-        n_int, n_v = len(interior), ranges["eta"].stop - ranges["eta"].start
+        n_int, n_v = len(interior), self.n_eta
         n_phi = pb.spaces.coarse_ndof("phi1") if "phi1" in pb.blocks else 0
         n_c = len(self.contact)
         blocks = np.cumsum([0, n_int, n_int, n_v, n_phi, n_phi, n_c, n_c])
@@ -205,8 +262,8 @@ class HybridSystem:
         k = np.arange(n_int)
         put(m1 + interior, blocks[0] + k, 1.0)
         put(m2 + interior, blocks[1] + k, 1.0)
-        put(eta.start + np.arange(n_v), blocks[2] + np.arange(n_v), 1.0)
-        c0 = np.zeros(fes.ndof)
+        put(np.arange(n_v), blocks[2] + np.arange(n_v), 1.0)
+        c0 = np.zeros(self.n_interface)
         if len(dirichlet):  # F = int_e u_D . tau n ds (3.62): minus the mean of u_D
             rt = dirichlet[:, 1]
             c0[m1 + dirichlet[:, 0]] = -F1[rt] / fluxes[0][rt]
@@ -230,17 +287,14 @@ class HybridSystem:
             put(start + ce.edges, blocks[5] + j, ce.normals[:, comp])
             put(start + ce.edges, blocks[6] + j, ce.tangents[:, comp])
         T = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                          shape=(fes.ndof, self.n_w))
+                          shape=(self.n_interface, self.n_w))
         self.T, self.c0 = T, c0
-        # T vanishes on the local dofs, so only the condensed coupling block enters
-        self.H = (-(T.T @ (K @ T))).tocsr()
+        self.H = (-(T.T @ (S @ T))).tocsr()
         self.H.sum_duplicates()
-        r = -(T.T @ (r_cond - K @ c0))
+        r = -(T.T @ (r_cond - S @ c0))
         if n_phi:
             r[self.phi_index] -= pb.rhs[pb.index("phi1", "phi2")]
         self.r = r
-        self._continuous = peers.raviart_thomas(mesh)
-        self._convert = ngs.ConvertOperator(self.rt, self._continuous)
 
     def _contact_edges(self, model: Model, labelled: dict, fluxes: np.ndarray, F1: np.ndarray,
                        F2: np.ndarray) -> ContactEdges:
@@ -274,32 +328,40 @@ class HybridSystem:
                  lam_n: np.ndarray | None = None) -> np.ndarray:
         """The unknown vector of ``problem.K`` from w (and the contact multipliers).
 
-        Recovers the element-local sigma, bubbles and u (NGSolve's harmonic extension
-        and inner solve) and maps the broken Raviart-Thomas rows to the continuous ones.
+        Recovers the element-local sigma, bubbles and u triangle by triangle and maps the
+        broken Raviart-Thomas rows to the continuous ones.
         """
-        pb, fes = self.problem, self.fes
-        gf = ngs.GridFunction(fes)
-        vec = gf.vec
-        vec.FV().NumPy()[:] = self.T @ w + self.c0
-        with parallel_tasks(self.mesh):
-            vec.data += self.form.harmonic_extension * vec
-            vec.data += self.form.inner_solve * self.rhs
-        values = vec.FV().NumPy()
+        pb = self.problem
+        interface = self.T @ w + self.c0
+        values = np.zeros(pb.broken.fes.ndof)
+        values[self.local] = self._inner - np.einsum("eij,ej->ei", self._extension,
+                                                     interface[self.interface])
+        eta = self._ranges[peers.PEERS.index("eta")]
+        values[eta.start:eta.stop] = interface[:self.n_eta]
         x = np.zeros(pb.K.shape[0])
-        ranges = {name: fes.Range(i) for i, name in enumerate(self.names)}
-        broken = ngs.GridFunction(self.rt)
-        cont = ngs.GridFunction(self._continuous)
-        for name in ("r1", "r2"):
-            rg = ranges[name]
-            broken.vec.FV().NumPy()[:] = values[rg.start:rg.stop]
-            cont.vec.data = self._convert * broken.vec
-            x[pb.blocks[name]] = cont.vec.FV().NumPy()
-        for name in ("b1", "b2", "u1", "u2", "eta"):
-            rg = ranges[name]
-            x[pb.blocks[name]] = values[rg.start:rg.stop]
+        for name, rg in zip(peers.PEERS, self._ranges):
+            part = values[rg.start:rg.stop]
+            x[pb.blocks[name]] = self._convert @ part if name in ("r1", "r2") else part
         if "phi1" in pb.blocks:
             x[pb.index("phi1", "phi2")] = w[self.phi_index]
         if lam_t is not None:
             x[pb.index("lam_t")] = lam_t
             x[pb.index("lam_n")] = lam_n
         return x
+
+
+def _edge_coupling(broken_rt: ngs.FESpace, facet: ngs.FESpace) -> sp.csr_matrix:
+    """D[i, j] = int_{dT} mu_j (psi_i . n_T) ds for the broken RT_0 functions psi_i and the
+    edge multipliers mu_j (constant on every element edge: P0 times the RT_0 normal trace)."""
+    n = ngs.specialcf.normal(2)
+    dT = ngs.dx(element_boundary=True, intrules={ngs.SEGM: ngs.IntegrationRule(ngs.SEGM, 2)})
+    form = ngs.BilinearForm(trialspace=facet, testspace=broken_rt)
+    form += facet.TrialFunction() * (broken_rt.TestFunction() * n) * dT
+    form.Assemble()
+    return to_scipy(form.mat)
+
+
+def _to_continuous(problem: DiscreteProblem) -> sp.csr_matrix:
+    """NGSolve's map from broken to continuous RT_0 coefficients (normal continuity holds)."""
+    rt = problem.broken.fes.components[0]
+    return to_scipy(ngs.ConvertOperator(rt, problem.spaces.components["r1"]))
