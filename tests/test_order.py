@@ -94,7 +94,11 @@ def _check_orders(rows, family, k, rotation=TOLERANCE):
 @pytest.mark.parametrize("family", peers.FAMILIES)
 @pytest.mark.parametrize("k", [0, 1])
 def test_sigma_u_and_the_rotation_converge_like_h_to_the_k_plus_1(family, k):
-    _check_orders(convergence_study(family, k, levels=(2, 3)), family, k, ROTATION_MARGIN)
+    rows = convergence_study(family, k, levels=(2, 3))
+    _check_orders(rows, family, k, ROTATION_MARGIN)
+    for row in rows:          # the table of docs/theory/order.md, to its three digits
+        assert [row[q] for q in ("sigma", "u", "eta")] == pytest.approx(
+            documented_errors(family, k, row["level"]), rel=6e-3)
 
 
 @pytest.mark.slow
@@ -116,6 +120,16 @@ def documented_betas(family: str, k: int) -> list[float]:
         if cells[:2] == [label, str(k)] and len(cells) == 6:
             return [float(c.split()[0]) for c in cells[2:]]
     raise LookupError(f"{label} {k} in {DOCS}")
+
+
+def documented_errors(family: str, k: int, level: int) -> list[float]:
+    """The L^2 errors of sigma, u, eta of the convergence table in docs/theory/order.md."""
+    label = {"peers": "PEERS", "afw": "AFW"}[family]
+    for line in DOCS.read_text().splitlines():
+        cells = [c.strip() for c in line.strip("|").split("|")]
+        if cells[:3] == [label, str(k), str(level)] and len(cells) == 11:
+            return [float(cells[i]) for i in (5, 7, 9)]
+    raise LookupError(f"{label} {k} level {level} in {DOCS}")
 
 
 def test_the_inf_sup_constants_of_peers_0_and_1_are_those_of_the_docs_and_above_the_bound():
