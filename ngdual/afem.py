@@ -103,8 +103,8 @@ def refine_towards(scene: Scene, mesh: ngs.Mesh, point, times: int
 def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
           steps: int | None = None, level: int | None = None, asymmetry: str = "l2",
           reference: dict | None = None, on_step: StepCallback | None = None,
-          allow_large: bool = False, goal: str = "stress", tol: float | None = None
-          ) -> list[dict]:
+          allow_large: bool = False, goal: str = "stress", tol: float | None = None,
+          window: tuple[float, float] | None = None) -> list[dict]:
     """Run ``steps`` adaptive steps on ``scene`` from its mesh on ``level``, or fewer when
     the goal's relative estimate falls below ``tol``.
 
@@ -141,6 +141,10 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
     tol : float, optional
         Stop after the first step whose ``relative_estimate`` (:func:`relative_estimate`)
         is at most ``tol``.
+    window : (float, float), optional
+        With ``goal="pressure"``: the pressure's error is that on the part of Gamma_C whose
+        x lies in [lo, hi] (:func:`ngdual.goal.goal_estimate`), e.g. the core |x| < a/2 of
+        a flat punch, whose pressure is not in L2 at its edges. Default: all of Gamma_C.
 
     Returns
     -------
@@ -154,7 +158,7 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
         or ``"steps"``.
     """
     _check_adapt_arguments(scene, marking, theta, steps, level, asymmetry, reference, on_step,
-                           allow_large, goal, tol)
+                           allow_large, goal, tol, window)
     marking = MARKING if marking is None else marking
     theta, steps = loop_defaults(tol, theta, steps)
     budget.check(scene.geometry, level, "level", allow_large, method=scene.solver.method)
@@ -168,7 +172,7 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
         # ESTIMATE
         estimated = estimate(solution, asymmetry)
         record = step_record(step, solution, estimated, reference)
-        indicators = _goal_indicators(record, solution, estimated, goal)
+        indicators = _goal_indicators(record, solution, estimated, goal, window)
         history.append(record)
         converged = tol is not None and record["relative_estimate"] <= tol
         last = converged or step == steps - 1
@@ -208,7 +212,7 @@ def relative_estimate(record: dict) -> float:
 
 
 def _goal_indicators(record: dict, solution: Solution, estimated: Estimate,
-                     goal: str) -> np.ndarray:
+                     goal: str, window: tuple[float, float] | None) -> np.ndarray:
     """The element indicators of ``goal``; adds ``goal``, ``goal_estimate``, ``goal_size``
     and ``relative_estimate`` to the step's record."""
     if goal == "stress":
@@ -216,7 +220,7 @@ def _goal_indicators(record: dict, solution: Solution, estimated: Estimate,
                                    record["norms"]["sigma_X"])
     else:
         with _timed(record, "goal"):
-            pressure = goal_estimate(solution, estimated)
+            pressure = goal_estimate(solution, estimated, window)
         indicators, total, size = pressure.indicators, pressure.total, pressure.size
         record["goal_terms"] = pressure.summed()
     record.update(goal=goal, goal_estimate=float(total), goal_size=float(size))
@@ -233,7 +237,7 @@ def _timed(record: dict, phase: str) -> Iterator[None]:
 
 
 def _check_adapt_arguments(scene, marking, theta, steps, level, asymmetry, reference, on_step,
-                           allow_large, goal, tol) -> None:
+                           allow_large, goal, tol, window) -> None:
     """A SceneError (SceneTypeError for a wrong type) naming the first bad argument."""
     ensure_valid(scene)
     check_level(level, "level", optional=True)
@@ -245,6 +249,15 @@ def _check_adapt_arguments(scene, marking, theta, steps, level, asymmetry, refer
     if goal == "pressure" and not scene.labels("contact"):
         raise SceneError("goal", f"scene {scene.name!r} has no contact boundary: no pressure "
                                  "to aim at")
+    if window is not None:
+        if goal != "pressure":
+            raise SceneError("window", "a window selects part of Gamma_C for the pressure "
+                                       "goal; use it with goal='pressure'")
+        if (not isinstance(window, (tuple, list)) or len(window) != 2
+                or any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in window)):
+            raise SceneTypeError("window", f"must be two numbers (lo, hi), got {window!r}")
+        if not -float("inf") < window[0] < window[1] < float("inf"):
+            raise SceneError("window", f"must be finite with lo < hi, got {tuple(window)}")
     if tol is not None:
         if isinstance(tol, bool) or not isinstance(tol, (int, float)):
             raise SceneTypeError("tol", f"must be a number > 0, got {tol!r}")

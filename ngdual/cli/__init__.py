@@ -6,8 +6,7 @@ solves one scene, prints the result table and writes ``DIR/result.json``
 (atomically) plus figures. ``ngdual scenes`` lists the shipped scenes;
 ``ngdual dofs SCENE --levels 1 2 3`` prints DOF counts without solving;
 ``ngdual adapt SCENE --marking max|fraction|dorfler --theta T --steps N --goal stress|pressure
---tol TOL --out DIR [--vtk]
-[--strict]``
+--tol TOL [--window LO HI] --out DIR [--vtk] [--strict]``
 runs the adaptive loop and writes ``DIR/history.json`` plus a mesh (.vol, .png with the
 marked triangles shaded) and, with ``--vtk``, a VTK file per step.
 ``ngdual tutorials [--notebooks DIR] [--solutions]`` lists the lecture tutorials or
@@ -117,6 +116,11 @@ def parser() -> argparse.ArgumentParser:
                     help="stop at the first step whose goal estimate relative to the "
                          "solution's size (||sigma_h|| in H(div), ||p_h|| on Gamma_C) is at "
                          "most TOL")
+    ad.add_argument("--window", type=float, nargs=2, default=None, metavar=("LO", "HI"),
+                    help="with --goal pressure: the error of the pressure on the part of "
+                         "Gamma_C with LO <= x <= HI only (default: all of Gamma_C), e.g. "
+                         "--window -0.125 0.125 for the flat punch's core, whose pressure "
+                         "is not in L2 at the punch edges")
     ad.add_argument("--level", type=int, default=None, help="initial mesh level")
     ad.add_argument("--asymmetry", choices=["hdiv", "l2"], default="l2",
                     help="norm of as(sigma_h) in the estimator (default: L2; 'hdiv' as printed "

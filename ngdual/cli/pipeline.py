@@ -135,6 +135,11 @@ def _adapt(args) -> int:
         number_flag(args.steps, "--steps", 1, 10_000, integer=True)
     if args.tol is not None and not 0 < args.tol < float("inf"):
         raise SceneError("--tol", f"must be a finite number > 0, got {args.tol}")
+    if args.window is not None and args.goal != "pressure":
+        raise SceneError("--window", "selects part of Gamma_C for --goal pressure")
+    if args.window is not None and not -float("inf") < args.window[0] < args.window[1] \
+            < float("inf"):
+        raise SceneError("--window", f"must be finite with LO < HI, got {args.window}")
     if args.reference_levels is not None:
         level_flags(args.reference_levels, "--reference-levels")
         if len(args.reference_levels) < 3:
@@ -149,7 +154,7 @@ def _adapt(args) -> int:
     theta, steps = loop_defaults(args.tol, args.theta, args.steps)
     run = {"scene": scene.name, "marking": args.marking, "theta": theta,
            "steps": steps, "level": level, "asymmetry": args.asymmetry,
-           "goal": args.goal, "tol": args.tol,
+           "goal": args.goal, "tol": args.tol, "window": args.window,
            "parameters": scene.to_dict(), "versions": versions(), "history": []}
     if args.reference_levels:
         print(f"reference norms: Aitken extrapolation from levels {args.reference_levels}")
@@ -195,7 +200,8 @@ def _adapt(args) -> int:
     try:
         adapt(scene, args.marking, theta, steps, level, args.asymmetry,
               run.get("reference_norms"), on_step, allow_large=args.allow_large,
-              goal=args.goal, tol=args.tol)
+              goal=args.goal, tol=args.tol,
+              window=None if args.window is None else tuple(args.window))
     except ConvergenceError as err:
         return not_converged(err)
     except StrictFailure as err:
