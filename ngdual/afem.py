@@ -38,6 +38,7 @@ from .quantities import norms
 from .rates import extrapolated_norms, total_error
 from .scene import Scene, SceneError, SceneTypeError, check_level, ensure_valid
 from .solvers import solve_on_mesh, solve_scene
+from .solvers.active_set import ContactStart
 from .solvers.result import Solution
 
 StepCallback = Callable[[dict, Solution, Estimate, np.ndarray | None], None]
@@ -165,10 +166,10 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
     start = time.perf_counter()
     mesh = build_mesh(scene.geometry, level)
     coarse = BoundaryMeshes.for_scene(scene, mesh)
-    history = []
+    history, warm = [], None
     for step in range(steps):
         # SOLVE
-        solution = solve_on_mesh(scene, mesh, coarse)
+        solution = solve_on_mesh(scene, mesh, coarse, start=warm)
         # ESTIMATE
         estimated = estimate(solution, asymmetry)
         record = step_record(step, solution, estimated, reference)
@@ -195,8 +196,17 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
         _check_refinement_size(scene, mesh, marked, allow_large)
         with _timed(record, "refine"):
             mesh, coarse = refine_with_boundary(scene, mesh, coarse, marked)
+            warm = _warm_start(solution)
         record["elapsed_s"] = time.perf_counter() - start
     return history
+
+
+def _warm_start(solution: Solution) -> ContactStart | None:
+    """The contact multipliers the next step's active-set iteration starts from (None
+    without contact or for the thesis' Uzawa algorithms, which start from zero)."""
+    if solution.method.startswith("active-set"):
+        return ContactStart.of(solution)
+    return None
 
 
 def relative_estimate(record: dict) -> float:

@@ -53,6 +53,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg as sla
@@ -134,9 +135,70 @@ def _roundoff_probe(problem: DiscreteProblem, hybrid: HybridSystem, chol: SchurC
     return level
 
 
+@dataclass(frozen=True)
+class ContactStart:
+    """The contact multipliers of a solution on another (coarser) mesh of the same Gamma_C,
+    to start the contact iteration from (the adaptive loop's warm start).
+
+    ``segments`` (n, 2, 2) are the fine Gamma_C edges of that mesh, ``lam_n`` and ``lam_t``
+    (n, 2) the multipliers at their ends: P1 on h~, so linear on every fine edge.
+    """
+
+    segments: np.ndarray
+    lam_n: np.ndarray
+    lam_t: np.ndarray
+
+    @classmethod
+    def of(cls, solution: Solution) -> ContactStart:
+        """The multipliers lambda_n, lambda_t of ``solution`` on its fine Gamma_C edges."""
+        pb = solution.problem
+        gamma_c = pb.spaces.gamma_c
+        fine = pb.to_fine(solution.x)
+        points = np.vstack([chain.path_points for chain in gamma_c.coarse.chains])
+        starts, first = [], 0
+        for chain in gamma_c.coarse.chains:
+            starts.append(np.arange(first, first + chain.n_edges))
+            first += chain.n_edges + 1
+        ends = np.column_stack([np.concatenate(starts), np.concatenate(starts) + 1])
+        values = {}
+        for name in ("lam_n", "lam_t"):
+            rng = pb.fes.Range(pb.names.index(name))
+            values[name] = gamma_c.vertex_values(fine[rng.start:rng.stop])[ends]
+        return cls(points[ends], values["lam_n"], values["lam_t"])
+
+    def at(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """lambda_n, lambda_t at ``points`` of Gamma_C, linear along the nearest edge (a
+        refined mesh's vertices on a curved Gamma_C lie off the coarser mesh's chords)."""
+        a, b = self.segments[:, 0], self.segments[:, 1]
+        d = b - a
+        t = np.clip(np.einsum("qsk,sk->qs", points[:, None, :] - a[None], d)
+                    / np.einsum("sk,sk->s", d, d), 0.0, 1.0)
+        foot = a[None] + t[..., None] * d[None]
+        nearest = np.argmin(np.linalg.norm(points[:, None, :] - foot, axis=2), axis=1)
+        w = t[np.arange(len(points)), nearest]
+        return tuple((1 - w) * v[nearest, 0] + w * v[nearest, 1]
+                     for v in (self.lam_n, self.lam_t))
+
+
+def _first_state(problem: DiscreteProblem, start: ContactStart | None, n_c: int,
+                 n_rows: int) -> BoundarySolution | None:
+    """The semismooth Newton start from ``start`` at this mesh's h~ nodes (dof order):
+    the contact set of the coarser solution, prolonged (None: the cold start z = 0)."""
+    if start is None:
+        return None
+    coarse = problem.spaces.gamma_c.coarse
+    nodes = np.vstack([chain.path_points[coarse.dof_positions(c)]
+                       for c, chain in enumerate(coarse.chains)])
+    lam_n, lam_t = start.at(nodes)
+    return BoundarySolution(np.maximum(lam_n, 0.0), lam_t, np.zeros(n_rows),
+                            np.zeros(n_c, dtype=bool), np.zeros(n_rows, dtype=bool), 0, False,
+                            {})
+
+
 def active_set_solve(problem: DiscreteProblem, settings: ActiveSetSettings,
                      tol: float = COULOMB_FIXED_POINT_TOL, ordering: str = "amd",
-                     progress: Callable[[int, float], None] | None = None) -> Solution:
+                     progress: Callable[[int, float], None] | None = None,
+                     start: ContactStart | None = None) -> Solution:
     """Solve (3.62) by condensation onto Gamma_C and semismooth Newton there.
 
     Parameters
@@ -150,6 +212,10 @@ def active_set_solve(problem: DiscreteProblem, settings: ActiveSetSettings,
         round-off level, where it stagnates above ``tol``).
     ordering : {"amd", "metis"}
         Fill-reducing ordering of the hybridised matrix.
+    start : ContactStart, optional
+        The multipliers of a solution on a coarser mesh: the semismooth Newton method starts
+        from their values at this mesh's h~ nodes (its first sets are their contact set),
+        not from z = 0. The solution is the same.
 
     Raises
     ------
@@ -164,7 +230,7 @@ def active_set_solve(problem: DiscreteProblem, settings: ActiveSetSettings,
     # and immune to the spin-waiting of threaded BLAS on busy cores
     with threadpool_limits(limits=BLAS_THREADS, user_api="blas"):
         try:
-            return _active_set_solve(problem, settings, tol, ordering, progress)
+            return _active_set_solve(problem, settings, tol, ordering, progress, start)
         except ConvergenceError as err:
             if model.has_friction and model.hhat_factor == 1:
                 raise ConvergenceError(f"{err}; with h^ = h~ the inf-sup condition (3.74) "
@@ -175,7 +241,8 @@ def active_set_solve(problem: DiscreteProblem, settings: ActiveSetSettings,
 
 
 def _active_set_solve(problem: DiscreteProblem, settings: ActiveSetSettings, tol: float,
-                      ordering: str, progress: Callable[[int, float], None] | None) -> Solution:
+                      ordering: str, progress: Callable[[int, float], None] | None,
+                      warm: ContactStart | None) -> Solution:
     model = settings.model
     law, mu_f = model.law, model.mu_f
     timings = {"assemble": problem.assemble_seconds}
@@ -212,11 +279,14 @@ def _active_set_solve(problem: DiscreteProblem, settings: ActiveSetSettings, tol
     if law == "coulomb":                                                        # step 3
         noise = SAFETY * level * mu_f * boundary.stress_scale
         state, bound, history, iterations = _coulomb_fixed_point(
-            boundary, forms, mu_f, tol, settings.max_iter, progress, noise)
+            boundary, forms, mu_f, tol, settings.max_iter, progress, noise,
+            _first_state(problem, warm, boundary.n_c, 0))
     else:
         bound = tresca_bound(forms, problem) if law == "tresca" else None
-        state = semismooth_newton(boundary.G, boundary.b, boundary.n_c,
-                                  forms.q_matrix(bound).toarray() if bound is not None else None,
+        Q = forms.q_matrix(bound).toarray() if bound is not None else None
+        state = semismooth_newton(boundary.G, boundary.b, boundary.n_c, Q,
+                                  _first_state(problem, warm, boundary.n_c,
+                                               0 if Q is None else Q.shape[0]),
                                   tol=SAFETY * boundary.roundoff)
         history, iterations = [], {"outer": 1, "inner": state.iterations}
     ce = hybrid.contact                                                         # step 4
@@ -284,9 +354,11 @@ class BoundaryProblem:
 
 
 def _coulomb_fixed_point(boundary: BoundaryProblem, forms: FrictionForms, mu_f: float,
-                         tol: float, max_iter: int, progress, noise: float):
+                         tol: float, max_iter: int, progress, noise: float,
+                         first: BoundarySolution | None = None):
     """Remark 3.45 on Gamma_C: F^0 from the frictionless solution, then Phi(F) = mu_f |sigma_n|
-    of (3.123) for the Tresca solution with bound F, warm-started, until F = Phi(F).
+    of (3.123) for the Tresca solution with bound F, warm-started, until F = Phi(F). The
+    frictionless solve starts from ``first`` (None: z = 0).
 
     Stops when the fixed-point residual ||Phi(F) - F|| / ||Phi(F)|| is <= ``tol``, or when it
     has stagnated (no longer halves) below SAFETY eps kappa_1(G), the round-off of F;
@@ -302,7 +374,7 @@ def _coulomb_fixed_point(boundary: BoundaryProblem, forms: FrictionForms, mu_f: 
     """
     G, b, n_c = boundary.G, boundary.b, boundary.n_c
     floor = SAFETY * boundary.roundoff  # = kkt_tolerance(G)
-    state = semismooth_newton(G, b, n_c, tol=floor)
+    state = semismooth_newton(G, b, n_c, start=first, tol=floor)
     inner = state.iterations
     bound = _coulomb_bound(forms, boundary.normal_stress(state), mu_f, noise)
     history: list[float] = []

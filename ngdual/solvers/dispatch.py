@@ -31,7 +31,7 @@ from ..forms import DiscreteProblem, assemble
 from ..mesh import build_mesh
 from ..quadrature_check import check_formulas
 from ..scene import Scene, SceneError, SceneTypeError, check_level, ensure_valid
-from .active_set import active_set_solve
+from .active_set import ContactStart, active_set_solve
 from .linear import solve_linear
 from .nested import nested_uzawa
 from .result import ConvergenceError, PhysicsWarning, Solution
@@ -87,7 +87,8 @@ def solve_scene(scene: Scene, level: int | None = None,
 def solve_on_mesh(scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes | None = None, *,
                   level: int | None = None, settings: Settings | None = None,
                   progress: Callable[[int, float], None] | None = None,
-                  status: Callable[[str], None] | None = None) -> Solution:
+                  status: Callable[[str], None] | None = None,
+                  start: ContactStart | None = None) -> Solution:
     """The SOLVE step on a given mesh: assemble (3.62) for a valid ``scene`` and solve it.
 
     The formulas are checked on the mesh's quadrature points before assembly
@@ -111,6 +112,10 @@ def solve_on_mesh(scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes | None = 
         Default :func:`~ngdual.solvers.settings.solver_settings` of ``scene``.
     progress, status : callable, optional
         As for :func:`solve_scene`.
+    start : ContactStart, optional
+        The contact multipliers of a solution on a coarser mesh (the adaptive loop's
+        previous step), to start the active-set method's contact iteration from; see
+        :func:`solve_problem`.
     """
     check_formulas(scene, mesh)
     if status is not None:
@@ -120,7 +125,7 @@ def solve_on_mesh(scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes | None = 
     check_unknowns(problem)
     if status is not None:
         status(f"factorising and solving, {problem.fes.ndof} unknowns")
-    return solve_problem(problem, settings, progress)
+    return solve_problem(problem, settings, progress, start)
 
 
 def check_unknowns(problem: DiscreteProblem) -> None:
@@ -145,18 +150,24 @@ def check_unknowns(problem: DiscreteProblem) -> None:
 
 
 def solve_problem(problem: DiscreteProblem, settings: Settings | None = None,
-                  progress: Callable[[int, float], None] | None = None) -> Solution:
+                  progress: Callable[[int, float], None] | None = None,
+                  start: ContactStart | None = None) -> Solution:
     """Run the algorithm ``settings`` describe on an assembled ``problem`` (any mesh).
 
     ``settings`` (:mod:`ngdual.solvers.settings`) defaults to those of the problem's scene,
     :func:`~ngdual.solvers.settings.solver_settings`: the one place where a solve reads
     the scene. A solution with a non-finite value or residual is never returned as a
     solution: it raises :class:`ngdual.solvers.result.ConvergenceError` with the history.
+    ``start`` warm-starts the active-set method (:class:`~.active_set.ContactStart`); the
+    Uzawa algorithms of the thesis start from zero and refuse it (ValueError).
     """
     if settings is None:
         settings = solver_settings(problem.scene)
+    if start is not None and not isinstance(settings, ActiveSetSettings):
+        raise ValueError(f"a warm start is for the active-set method, not "
+                         f"{type(settings).__name__}")
     if isinstance(settings, ActiveSetSettings):
-        solution = active_set_solve(problem, settings, progress=progress)
+        solution = active_set_solve(problem, settings, progress=progress, start=start)
     elif isinstance(settings, LinearSettings):
         solution = solve_linear(problem)
     elif isinstance(settings, UzawaSettings):
