@@ -52,15 +52,22 @@ THETA_TOL = 0.8
 # The number of solves: the thesis' runs take 5; a tolerance-driven run stops by its
 # tolerance (or the memory budget), and STEPS_TOL only bounds a tolerance it cannot reach.
 STEPS, STEPS_TOL = 5, 30
+# The initial level of a tolerance-driven run: the coarsest. On a finer start mesh the first
+# steps refine a band around the singularities or Gamma_C inside a mesh already fine
+# elsewhere and grow the unknowns by 1.01-1.2x (hertz-cylinder --goal pressure --tol 0.01:
+# 4.6 s from level 1, 12.5 s from level 2, 11.7 s from its level 3; docs/theory/estimator.md).
+LEVEL_TOL = 1
 
 
-def loop_defaults(tol: float | None, theta: float | None, steps: int | None
-                  ) -> tuple[float, int]:
-    """(theta, steps) of :func:`adapt`, the ones not given taking their defaults: THETA and
-    STEPS, or with a ``tol`` THETA_TOL and STEPS_TOL."""
+def loop_defaults(tol: float | None, theta: float | None, steps: int | None,
+                  level: int | None = None) -> tuple[float, int, int | None]:
+    """(theta, steps, level) of :func:`adapt`, the ones not given taking their defaults:
+    THETA, STEPS and the scene's level (None), or with a ``tol`` THETA_TOL, STEPS_TOL and
+    LEVEL_TOL."""
     theta = (THETA if tol is None else THETA_TOL) if theta is None else theta
     steps = (STEPS if tol is None else STEPS_TOL) if steps is None else steps
-    return theta, steps
+    level = (None if tol is None else LEVEL_TOL) if level is None else level
+    return theta, steps, level
 
 
 def refine(mesh: ngs.Mesh, marked: np.ndarray) -> ngs.Mesh:
@@ -122,7 +129,8 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
         Number of SOLVE-ESTIMATE steps (``steps - 1`` refinements); default :data:`STEPS`
         = 5; with ``tol`` the largest number of steps, default :data:`STEPS_TOL` = 30.
     level : int, optional
-        Level of the initial mesh (default: the scene's).
+        Level of the initial mesh; default the scene's, with ``tol`` :data:`LEVEL_TOL` = 1
+        (the coarsest: the first steps are not spent on a mesh fine everywhere).
     asymmetry : {"hdiv", "l2"}
         Norm of as(sigma_h) in the estimator (see :func:`ngdual.estimator.estimate`).
     reference : dict, optional
@@ -161,7 +169,7 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
     _check_adapt_arguments(scene, marking, theta, steps, level, asymmetry, reference, on_step,
                            allow_large, goal, tol, window)
     marking = MARKING if marking is None else marking
-    theta, steps = loop_defaults(tol, theta, steps)
+    theta, steps, level = loop_defaults(tol, theta, steps, level)
     budget.check(scene.geometry, level, "level", allow_large, method=scene.solver.method)
     start = time.perf_counter()
     mesh = build_mesh(scene.geometry, level)

@@ -6,7 +6,7 @@ import ngsolve as ngs
 import numpy as np
 import pytest
 
-from ngdual.afem import STEPS_TOL, THETA_TOL, adapt, loop_defaults
+from ngdual.afem import LEVEL_TOL, STEPS_TOL, THETA_TOL, adapt, loop_defaults
 from ngdual.cli import main
 from ngdual.scene import SceneError, SceneTypeError, load_scene
 from ngdual.verification.benchmark import center_coordinate, exact_solution
@@ -94,12 +94,12 @@ def test_the_default_loop_is_the_stress_goal_with_the_thesis_marking():
 
 
 def test_a_tolerance_run_takes_as_many_steps_as_it_needs_by_default():
-    """With a tol, steps only bounds the loop (STEPS_TOL), so the tol stops it; without, the
-    thesis' 5 solves with Doerfler 0.5."""
-    assert loop_defaults(None, None, None) == (0.5, 5)
-    assert loop_defaults(0.01, None, None) == (THETA_TOL, STEPS_TOL)
+    """With a tol, steps only bounds the loop (STEPS_TOL), so the tol stops it, from the
+    coarsest level; without, the thesis' 5 solves with Doerfler 0.5 from the scene's level."""
+    assert loop_defaults(None, None, None) == (0.5, 5, None)
+    assert loop_defaults(0.01, None, None) == (THETA_TOL, STEPS_TOL, LEVEL_TOL)
     assert STEPS_TOL > 5
-    assert loop_defaults(0.01, 0.3, 7) == (0.3, 7)
+    assert loop_defaults(0.01, 0.3, 7, 3) == (0.3, 7, 3)
 
 
 def test_ngdual_adapt_with_goal_and_tol_records_them_and_stops(tmp_path, capsys):

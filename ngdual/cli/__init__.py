@@ -121,7 +121,8 @@ def parser() -> argparse.ArgumentParser:
                          "Gamma_C with LO <= x <= HI only (default: all of Gamma_C), e.g. "
                          "--window -0.125 0.125 for the flat punch's core, whose pressure "
                          "is not in L2 at the punch edges")
-    ad.add_argument("--level", type=int, default=None, help="initial mesh level")
+    ad.add_argument("--level", type=int, default=None,
+                    help="initial mesh level (default: the scene's; with --tol 1)")
     ad.add_argument("--asymmetry", choices=["hdiv", "l2"], default="l2",
                     help="norm of as(sigma_h) in the estimator (default: L2; 'hdiv' as printed "
                          "in eq. 4.15 does not decrease for PEERS)")

@@ -147,11 +147,11 @@ def _adapt(args) -> int:
                                                    f"levels, got {args.reference_levels}")
     scene = load_scene(args.scene, args.set)
     out = check_output_dir(args.out, "--out")
+    theta, steps, level = loop_defaults(args.tol, args.theta, args.steps, level)
     budget.check(scene.geometry, level, "--level", args.allow_large, method=scene.solver.method)
     for reference in args.reference_levels or []:
         budget.check(scene.geometry, reference, "--reference-levels", args.allow_large,
                      method=scene.solver.method)
-    theta, steps = loop_defaults(args.tol, args.theta, args.steps)
     run = {"scene": scene.name, "marking": args.marking, "theta": theta,
            "steps": steps, "level": level, "asymmetry": args.asymmetry,
            "goal": args.goal, "tol": args.tol, "window": args.window,
