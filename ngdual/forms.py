@@ -171,6 +171,8 @@ class BrokenPeers:
     ----------
     fes : ngsolve.FESpace
         The broken product space, components :data:`ngdual.peers.PEERS`.
+    form : ngsolve.BilinearForm
+        The assembled form, which owns the arrays of ``matrix``.
     matrix : scipy.sparse.csr_matrix
         K_b, with NGSolve's sparsity pattern (every pair of unknowns of a triangle, explicit
         zeros included).
@@ -179,6 +181,7 @@ class BrokenPeers:
     """
 
     fes: ngs.FESpace
+    form: ngs.BilinearForm
     matrix: sp.csr_matrix
     conforming: np.ndarray
 
@@ -189,9 +192,18 @@ class BrokenPeers:
         Every entry is the sum of at most two element entries (an edge has two triangles),
         so it equals the conforming assembly's bit for bit, whatever the order of the sum.
         """
-        coo = self.matrix.tocoo()
+        K = self.matrix
+        nonzero = K.data != 0.0
+        rows = np.repeat(np.arange(K.shape[0]), np.diff(K.indptr))[nonzero]
         index = self.conforming
-        return sp.csr_matrix((coo.data, (index[coo.row], index[coo.col])), shape=(size, size))
+        return sp.csr_matrix((K.data[nonzero], (index[rows], index[K.indices[nonzero]])),
+                             shape=(size, size))
+
+    def to_conforming(self, values: np.ndarray) -> np.ndarray:
+        """The conforming PEERS coefficients of broken ones whose normal fluxes agree across
+        every edge (up to rounding): the mean of the two triangles' values."""
+        count = np.bincount(self.conforming)
+        return np.bincount(self.conforming, values, minlength=len(count)) / count
 
 
 def broken_peers(spaces: Spaces, lame: tuple[float, float]) -> BrokenPeers:
@@ -206,32 +218,37 @@ def broken_peers(spaces: Spaces, lame: tuple[float, float]) -> BrokenPeers:
                     dict(zip(peers.PEERS, fes.TestFunction())), lame)
     with parallel_tasks(mesh):
         a.Assemble()
-    # the continuous RT_0 function of an edge restricts to one broken function on each of its
-    # triangles, with the same orientation: every row of ConvertOperator's matrix (an L^2
-    # projection, exact up to rounding) is one 1
-    restrict = to_scipy(ngs.ConvertOperator(spaces.components["r1"], broken_rt))
-    edge = _unit_column(restrict)
+    edge = _edge_of_broken(spaces.components["r1"], broken_rt)
     conforming, offset = [], 0
     for name in peers.PEERS:
         own = edge if name in ("r1", "r2") else np.arange(comps[name].ndof)
         conforming.append(offset + own)
         offset += spaces.components[name].ndof
-    return BrokenPeers(fes, to_scipy(a.mat), np.concatenate(conforming))
+    return BrokenPeers(fes, a, to_scipy(a.mat, copy=False), np.concatenate(conforming))
 
 
-def _unit_column(matrix: sp.csr_matrix, tol: float = 1e-8) -> np.ndarray:
-    """The column of the one entry 1 in every row of ``matrix`` (the others zero, both up to
-    ``tol``)."""
-    dense_rows = np.repeat(np.arange(matrix.shape[0]), np.diff(matrix.indptr))
-    ones = np.abs(matrix.data - 1.0) <= tol
-    if not (np.all(ones | (np.abs(matrix.data) <= tol))
-            and np.array_equal(np.bincount(dense_rows[ones], minlength=matrix.shape[0]),
-                               np.ones(matrix.shape[0], dtype=int))):
+def _edge_of_broken(rt: ngs.FESpace, broken_rt: ngs.FESpace, tol: float = 1e-8) -> np.ndarray:
+    """The RT_0 function (of ``rt``) whose restriction to its triangle every broken one is.
+
+    Read from M[i, j] = sum_T int_{dT} (psi_j . n)(psi~_i . n) ds: the normal trace of an
+    RT_0 function vanishes on all edges but its own, so every row of M has one nonzero,
+    positive where the broken function has the continuous one's orientation.
+    """
+    n = ngs.specialcf.normal(2)
+    form = ngs.BilinearForm(trialspace=rt, testspace=broken_rt)
+    form += (rt.TrialFunction() * n) * (broken_rt.TestFunction() * n) * ngs.dx(
+        element_boundary=True, intrules={ngs.SEGM: ngs.IntegrationRule(ngs.SEGM, 0)})
+    form.Assemble()
+    M = to_scipy(form.mat, copy=False)
+    rows = np.repeat(np.arange(M.shape[0]), np.diff(M.indptr))
+    own = np.abs(M.data) > tol * np.abs(M.data).max(initial=0.0)
+    if not (np.array_equal(np.bincount(rows[own], minlength=M.shape[0]),
+                           np.ones(M.shape[0], dtype=int)) and np.all(M.data[own] > 0)):
         raise RuntimeError("NGSolve's broken Raviart-Thomas functions are not restrictions "
                            "of the continuous ones")
-    column = np.empty(matrix.shape[0], dtype=np.int64)
-    column[dense_rows[ones]] = matrix.indices[ones]
-    return column
+    edge = np.empty(M.shape[0], dtype=np.int64)
+    edge[rows[own]] = M.indices[own]
+    return edge
 
 
 @dataclass

@@ -146,7 +146,6 @@ class HybridSystem:
             broken.fes.Range(peers.PEERS.index("eta")).start
         self.n_interface = self.n_eta + 2 * facet.ndof
         self._elements(broken, _edge_coupling(broken.fes.components[0], facet), facet.ndof)
-        self._convert = _to_continuous(problem)
         self.assemble_seconds = time.perf_counter() - start
 
         start = time.perf_counter()
@@ -339,9 +338,8 @@ class HybridSystem:
         eta = self._ranges[peers.PEERS.index("eta")]
         values[eta.start:eta.stop] = interface[:self.n_eta]
         x = np.zeros(pb.K.shape[0])
-        for name, rg in zip(peers.PEERS, self._ranges):
-            part = values[rg.start:rg.stop]
-            x[pb.blocks[name]] = self._convert @ part if name in ("r1", "r2") else part
+        peers_part = pb.broken.to_conforming(values)
+        x[:len(peers_part)] = peers_part
         if "phi1" in pb.blocks:
             x[pb.index("phi1", "phi2")] = w[self.phi_index]
         if lam_t is not None:
@@ -360,8 +358,3 @@ def _edge_coupling(broken_rt: ngs.FESpace, facet: ngs.FESpace) -> sp.csr_matrix:
     form.Assemble()
     return to_scipy(form.mat)
 
-
-def _to_continuous(problem: DiscreteProblem) -> sp.csr_matrix:
-    """NGSolve's map from broken to continuous RT_0 coefficients (normal continuity holds)."""
-    rt = problem.broken.fes.components[0]
-    return to_scipy(ngs.ConvertOperator(rt, problem.spaces.components["r1"]))
