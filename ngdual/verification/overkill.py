@@ -212,8 +212,14 @@ def locate(samples: dict, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     tri = Triangulation(samples["vertices"][:, 0], samples["vertices"][:, 1],
                         samples["triangles"])
     k = tri.get_trifinder()(points[:, 0], points[:, 1])
-    if np.any(k < 0):
-        raise ValueError(f"{int(np.sum(k < 0))} points lie outside the candidate mesh")
+    outside = k < 0
+    if np.any(outside):
+        corners = samples["vertices"][samples["triangles"]]
+        distance, k[outside] = cKDTree(corners.mean(axis=1)).query(points[outside])
+        edges = np.linalg.norm(corners - np.roll(corners, 1, axis=1), axis=2).max(axis=1)
+        if np.any(distance > edges[k[outside]]):
+            raise ValueError(f"{int(np.sum(distance > edges[k[outside]]))} points lie "
+                             "outside the candidate mesh")
     tri_xy = samples["vertices"][samples["triangles"][k]]
     return k, _p2_basis(_barycentric(tri_xy, points))
 

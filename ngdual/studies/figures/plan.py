@@ -4,7 +4,7 @@
 tables below name the scenes and cases the studies solve: the two problems of Example
 3.46 (:data:`SCENES`), the gap cases of Figs. 3.24-3.28 (:data:`GAP_CASES`), the adaptive
 runs of Section 4.2 (:data:`ADAPTIVE_RUNS`) and the problems of the true-error studies
-(:data:`TRUTH_PROBLEMS`, :data:`TRUTH_ADAPTIVE`, :data:`PEER_ORDERS`).
+(:data:`TRUTH_PROBLEMS`, :data:`TRUTH_GOALS`, :data:`PEER_ORDERS`).
 """
 
 from __future__ import annotations
@@ -113,13 +113,17 @@ class Plan:
         return 2 * self.max_level
 
     def truth_levels(self, problem: str) -> list[int]:
-        """Uniform levels of the true-error studies (:data:`TRUTH_PROBLEMS`): up to K - 1, so
-        that the overkill (two levels finer, K + 1) stays affordable."""
-        return list(range(1, max(2, self.max_level - TRUTH_PROBLEMS[problem].coarser)))
+        """Uniform levels of the true-error studies (:data:`TRUTH_PROBLEMS`): 1 to K minus the
+        problem's ``coarser``, the memory and time budget of uniform refinement."""
+        return list(range(1, max(2, self.max_level - TRUTH_PROBLEMS[problem].coarser) + 1))
 
-    def overkill_level(self, problem: str) -> int:
-        """The reference of the true errors: two uniform levels beyond the finest studied."""
-        return self.truth_levels(problem)[-1] + 2
+    def reference_elements(self, problem: str) -> int:
+        """The budget of an adaptive run of the true-error studies: it stops after the first
+        step with this many triangles (those of one uniform level beyond the finest, at most
+        :data:`REFERENCE_ELEMENTS`), unless its tolerance :data:`REFERENCE_TOL` stops it
+        first."""
+        finest = self.truth_levels(problem)[-1]
+        return min(TRUTH_PROBLEMS[problem].level1_elements * 4 ** finest, REFERENCE_ELEMENTS)
 
     def describe(self) -> dict:
         names = ("max_level", "levels", "field_level", "reference_levels", "rho_level",
@@ -153,14 +157,21 @@ TRUTH_PROBLEMS = {
                             r"Example 3.46, $\mu_f = 0.5$"),
     # the punch pressure ~ (a - |x|)^(-1/2) is not in L2: its error on the core |x| < a/2
     # (as ngdual.verification.analytic); sigma (~ r^(-1/2)) is in L2 everywhere
-    "flat-punch": TruthProblem("flat-punch", (), 1, "flat punch", 206, 0.125),
+    "flat-punch": TruthProblem("flat-punch", (), 2, "flat punch", 206, 0.125),
+    "hertz-cylinder": TruthProblem("hertz-cylinder", (), 2, "Hertz cylinder", 226),
+    "cattaneo-mindlin": TruthProblem("cattaneo-mindlin", (), 2, "Cattaneo-Mindlin", 226),
+    "wedge": TruthProblem("wedge", (), 2, "wedge", 218),
 }
-TRUTH_ADAPTIVE = {
-    # key: (marking, theta); each run from level 1 until its mesh is as large as the finest
-    # uniform level's
-    "max 0.5": ("max", 0.5), "max 0.25": ("max", 0.25),
-    "dorfler 0.5": ("dorfler", 0.5), "dorfler 0.3": ("dorfler", 0.3),
-}
+# The adaptive runs of the true-error studies, one per goal of ngdual.afem.adapt (a
+# tolerance run: its Doerfler theta and initial level), each to REFERENCE_TOL or the budget
+# Plan.reference_elements; the last steps are the candidates for the references.
+TRUTH_GOALS = ("stress", "pressure")
+# growing about 2x per step, 12 steps pass any budget: a run that takes them all is stalled
+ADAPT_STEPS = 12
+REFERENCE_TOL = 0.001
+# a step grows the triangles by about 2.4x: the last step has at most ~200 000 triangles
+# (1.5 million unknowns), a few GB and about a minute on one core
+REFERENCE_ELEMENTS = 80_000
 PEER_ORDERS = (1, 2)
 
 

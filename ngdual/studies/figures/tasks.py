@@ -11,12 +11,14 @@ from __future__ import annotations
 from ..sweep import Task
 from ..variants import UZAWA, setting
 from .plan import (
+    ADAPT_STEPS,
     ADAPTIVE_RUNS,
     GAP_CASES,
     MANUFACTURED_CASES,
     PEER_ORDERS,
+    REFERENCE_TOL,
     SCENES,
-    TRUTH_ADAPTIVE,
+    TRUTH_GOALS,
     TRUTH_PROBLEMS,
     Plan,
 )
@@ -89,62 +91,55 @@ def adaptive_task(plan: Plan, problem: str, strategy: str) -> Task:
                 f"{scene} {marking} theta={theta}", 4.0 * refinements)
 
 
-def truth_solve(plan: Plan, problem: str, level: int, uzawa: bool = False) -> Task:
+def truth_solve(plan: Plan, problem: str, level: int) -> Task:
     """A uniform solve of a :data:`TRUTH_PROBLEMS` scene that keeps its sample arrays."""
     tp = TRUTH_PROBLEMS[problem]
-    overrides = [*tp.overrides, *([UZAWA] if uzawa else [])]
-    return Task("solve", {"scene": tp.scene, "level": level, "overrides": overrides,
-                          "fields": False, "samples": True},
-                f"{tp.scene} L{level} samples" + (" uzawa" if uzawa else ""),
+    return Task("solve", {"scene": tp.scene, "level": level, "overrides": list(tp.overrides),
+                          "fields": False, "samples": True}, f"{tp.scene} L{level} samples",
                 _cost(level + 1, problem == "coulomb"))
 
 
-def truth_adapt(plan: Plan, problem: str, strategy: str) -> Task:
-    """An adaptive run of a :data:`TRUTH_PROBLEMS` scene keeping every step's samples, up to
-    the triangles of its finest uniform level."""
+def truth_adapt(plan: Plan, problem: str, goal: str) -> Task:
+    """The adaptive run of a :data:`TRUTH_PROBLEMS` scene aiming at ``goal``
+    (:data:`TRUTH_GOALS`; the pressure goal on the problem's ``pressure_window``), keeping
+    every step's samples: a tolerance run of :func:`ngdual.afem.adapt` (its theta and
+    initial level) to :data:`REFERENCE_TOL` or the budget :meth:`Plan.reference_elements`,
+    at most :data:`ADAPT_STEPS` solves."""
+    from ...afem import THETA_TOL
+
     tp = TRUTH_PROBLEMS[problem]
-    marking, theta = TRUTH_ADAPTIVE[strategy]
-    finest = plan.truth_levels(problem)[-1]
-    return Task("adapt", {"scene": tp.scene, "marking": marking, "theta": theta, "steps": 60,
-                          "level": 1, "overrides": list(tp.overrides), "snapshots": [],
-                          "samples": True, "max_elements": tp.level1_elements * 4 ** (finest - 1)},
-                f"{tp.scene} {strategy} samples", 2.0 * finest)
+    window = tp.pressure_window
+    return Task("adapt", {"scene": tp.scene, "marking": "dorfler", "theta": THETA_TOL,
+                          "steps": ADAPT_STEPS, "level": None,
+                          "overrides": list(tp.overrides), "snapshots": [], "samples": True,
+                          "max_elements": plan.reference_elements(problem), "goal": goal,
+                          "tol": REFERENCE_TOL,
+                          "window": ([-window, window] if window and goal == "pressure"
+                                     else None)},
+                f"{tp.scene} {goal} goal samples", 2.0 * plan.truth_levels(problem)[-1])
 
 
 def peer_solve(plan: Plan, problem: str, level: int, order: int) -> Task:
-    """The primal peer on a :data:`TRUTH_PROBLEMS` scene, pressure samples fine enough for
-    the overkill's Gamma_C edges."""
+    """The primal peer on a :data:`TRUTH_PROBLEMS` scene, its pressure samples on Gamma_C
+    edges split as finely as the edges of the finest uniform level."""
     tp = TRUTH_PROBLEMS[problem]
+    finest = plan.truth_levels(problem)[-1]
     return Task("peer", {"scene": tp.scene, "level": level, "order": order,
                          "overrides": list(tp.overrides),
-                         "subdivisions": 2 ** max(plan.overkill_level(problem) - level, 0)},
+                         "subdivisions": 2 ** max(finest - level, 0)},
                 f"{tp.scene} L{level} peer P{order}", _cost(level, False))
 
 
-def peer_levels(plan: Plan, problem: str) -> list[int]:
-    """The peer's levels: those of ngdual and one beyond (an independent check of the
-    overkill)."""
-    levels = plan.truth_levels(problem)
-    return [*levels, levels[-1] + 1]
-
-
 def truth_tasks(plan: Plan, problem: str) -> dict[str, list[Task]]:
-    """Every task of the true-error study of one problem, by method."""
+    """Every task of the true-error study of one problem, by method: uniform refinement
+    (active set), one adaptive run per goal, the primal peers on the uniform levels."""
     levels = plan.truth_levels(problem)
-    out = {"uniform, active set": [truth_solve(plan, problem, lv) for lv in levels],
-           "uniform, Uzawa": [truth_solve(plan, problem, lv, True) for lv in levels]}
-    for strategy in TRUTH_ADAPTIVE:
-        out[f"adaptive {strategy}"] = [truth_adapt(plan, problem, strategy)]
+    out = {"uniform": [truth_solve(plan, problem, lv) for lv in levels]}
+    for goal in TRUTH_GOALS:
+        out[f"adaptive, {goal} goal"] = [truth_adapt(plan, problem, goal)]
     for order in PEER_ORDERS:
-        out[f"primal P{order}"] = [peer_solve(plan, problem, lv, order)
-                                   for lv in peer_levels(plan, problem)]
+        out[f"primal P{order}"] = [peer_solve(plan, problem, lv, order) for lv in levels]
     return out
-
-
-def reference_tasks(plan: Plan, problem: str) -> list[Task]:
-    """The overkill and the level below it (the Richardson check)."""
-    level = plan.overkill_level(problem)
-    return [truth_solve(plan, problem, level - 1), truth_solve(plan, problem, level)]
 
 
 def manufactured_tasks(plan: Plan) -> dict[str, Task]:
@@ -175,7 +170,6 @@ def studies(plan: Plan) -> dict[str, list[Task]]:
     for problem in SCENES:
         out[f"uniform-{problem}"] = [solve(plan, problem, lv) for lv in plan.levels]
     out["manufactured"] = list(manufactured_tasks(plan).values())
-    out["truth"] = [t for problem in TRUTH_PROBLEMS for t in
-                    [*reference_tasks(plan, problem),
-                     *(t for ts in truth_tasks(plan, problem).values() for t in ts)]]
+    out["truth"] = [t for problem in TRUTH_PROBLEMS
+                    for ts in truth_tasks(plan, problem).values() for t in ts]
     return out

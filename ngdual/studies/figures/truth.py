@@ -1,10 +1,20 @@
-"""The true-error studies: every method's solutions against an overkill solution.
+"""The true-error studies: every method's solutions against adaptive references.
 
-For each problem of :data:`~ngdual.studies.figures.plan.TRUTH_PROBLEMS`, the uniform
-solves (active set and Uzawa), the adaptive runs and the primal peer are compared with a
-solve two uniform levels finer than the finest studied (the overkill), whose own error is
-estimated from the two levels below it (:func:`~ngdual.studies.figures.numbers.
-richardson_check`). The errors are cached in the records folder.
+For each problem of :data:`~ngdual.studies.figures.plan.TRUTH_PROBLEMS` the uniform
+solves, the two adaptive runs (one per goal) and the primal peers are compared with a
+reference per measure: the last step of one of the adaptive runs.
+
+The own error of a run's last step is estimated per measure by Richardson
+(:func:`~ngdual.studies.figures.numbers.richardson_check`) from the distances of the two
+steps before it, each with about 2x the unknowns of the one before (a run that stalls,
+growing by less than :data:`STALLED` per step, has no estimate); the reference of a
+measure is the last step with the smallest such error, and it resolves the targets at
+least 1 / :data:`RESOLVES` times its error. The steps of a run are nested meshes
+(bisection), so their distances to its last step are exact integrals; every other
+candidate's mesh crosses the reference's triangles, and the quadrature error this costs
+(:mod:`ngdual.verification.overkill`) is measured by integrating the sigma error again on
+the reference's triangles split in four (:func:`split_samples`). The errors are cached in
+the records folder.
 """
 
 from __future__ import annotations
@@ -14,34 +24,75 @@ import json
 import math
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 from ...io import plain, versions, write_json
 from ..sweep import estimator
-from .numbers import require, richardson_check
+from .numbers import richardson_check
 from .plan import TRUTH_PROBLEMS
-from .tasks import reference_tasks, truth_tasks
+from .tasks import truth_tasks
 
 if TYPE_CHECKING:
     from .output import Context
 
 
-# measures of the true-error studies: key -> (what, how it is made relative)
+# measures of the true-error studies: key -> (what, how it is made relative), and the
+# adaptive run whose last step is the reference of each
 TRUE_MEASURES = {"pressure": "relative L2 error of the contact pressure on Gamma_C",
                  "sigma_energy": "relative compliance-norm error of sigma"}
+REFERENCE_RUNS = {"pressure": "adaptive, pressure goal", "sigma_energy": "adaptive, stress goal"}
+# a target is resolved when the reference's own error is at most this share of it
+RESOLVES = 1 / 3
+# an adaptive run whose steps grow the unknowns by less than this factor is stalled: its
+# estimate is held by a few triangles it cannot improve, and its steps are no sequence to
+# extrapolate from
+STALLED = 1.3
+# the P2 nodes of the four red children of the reference triangle, in barycentric
+# coordinates of the parent (vertices 0, 1, 2; midpoints m01, m12, m20)
+_V = np.eye(3)
+_M = {(0, 1): (_V[0] + _V[1]) / 2, (1, 2): (_V[1] + _V[2]) / 2, (2, 0): (_V[2] + _V[0]) / 2}
+CHILDREN = ((_V[0], _M[(0, 1)], _M[(2, 0)]), (_M[(0, 1)], _V[1], _M[(1, 2)]),
+            (_M[(2, 0)], _M[(1, 2)], _V[2]), (_M[(1, 2)], _M[(2, 0)], _M[(0, 1)]))
 
 
 def _measures(errors: dict) -> dict:
     """The relative errors plotted (:data:`TRUE_MEASURES`) and the absolute total error
     e = (||sigma - sigma_ref||^2 + ||u - u_ref||^2 + ||eta - eta_ref||^2)^(1/2) (L2; div sigma
     has no error when f = 0) that the estimator is compared with."""
-    out = {"pressure": errors.get("pressure_rel"),
-           "pressure_max": errors.get("pressure_max"),
-           "sigma_energy": errors["sigma_energy"] / errors["sigma_energy_norm"],
-           "e_true": math.sqrt(sum(errors.get(k, 0.0) ** 2 for k in ("sigma", "u", "eta")))}
+    return {"pressure": errors.get("pressure_rel"),
+            "pressure_max": errors.get("pressure_max"),
+            "pressure_l2": errors.get("pressure_l2"),
+            "sigma_energy": errors["sigma_energy"] / errors["sigma_energy_norm"],
+            "e_true": math.sqrt(sum(errors.get(k, 0.0) ** 2 for k in ("sigma", "u", "eta")))}
+
+
+def split_samples(samples: dict) -> dict:
+    """The same P2 fields on every triangle split into its four red children (midpoints):
+    a reference with four times the quadrature points, to measure the quadrature error of
+    a candidate whose edges cross the reference's triangles."""
+    from ...verification.overkill import P2_NODES
+    from ...verification.overkill import _p2_basis as p2_basis
+
+    tri_xy = samples["vertices"][samples["triangles"]]                 # (ne, 3, 2)
+    ne = len(tri_xy)
+    # barycentric coordinates (child, P2 node, parent vertex) of the children's P2 nodes
+    nodes = np.array([[a * x + b * y + (1 - x - y) * c for x, y in P2_NODES]
+                      for a, b, c in CHILDREN])
+    basis = p2_basis(nodes.reshape(-1, 3)).reshape(4, 6, 6)
+    xy = np.einsum("knv,evd->eknd", nodes, tri_xy)                     # (ne, 4, 6, 2)
+    vertices = xy[:, :, :3].reshape(-1, 2)
+    out = {"vertices": vertices, "triangles": np.arange(len(vertices)).reshape(-1, 3)}
+    for name in ("sigma", "u", "eta"):
+        if name in samples:
+            out[name] = np.einsum("knj,ejd->eknd", basis, samples[name]).reshape(
+                4 * ne, 6, -1)
     return out
 
 
 def _candidates(ctx: Context, problem: str) -> list[tuple[dict, dict]]:
-    """(row, sample arrays) of every solution of the true-error study of ``problem``."""
+    """(row, sample arrays) of every solution of the true-error study of ``problem``;
+    an adaptive step's row carries its goal's ``goal_estimate`` and ``relative_estimate``
+    and ``nested`` (its run's last step is the reference of its goal's measure)."""
     out = []
     for method, tasks in truth_tasks(ctx.plan, problem).items():
         for task, record in zip(tasks, ctx.compute(tasks)):
@@ -56,7 +107,9 @@ def _candidates(ctx: Context, problem: str) -> list[tuple[dict, dict]]:
                     prefix = f"s{r['step']}_"
                     out.append(({"method": method, "status": "ok", "level_or_step": r["step"],
                                  "ndof": r["dofs"]["total"], "elements": r["elements"],
-                                 "time_s": r["cumulative_s"], "estimator": estimator(r)},
+                                 "time_s": r["cumulative_s"], "estimator": estimator(r),
+                                 "goal_estimate": r["goal_estimate"],
+                                 "relative_estimate": r["relative_estimate"]},
                                 {k[len(prefix):]: v for k, v in arrays.items()
                                  if k.startswith(prefix)}))
             else:
@@ -67,45 +120,137 @@ def _candidates(ctx: Context, problem: str) -> list[tuple[dict, dict]]:
     return out
 
 
-def true_error_study(ctx: Context, problem: str) -> dict:
-    """True errors of every method of one problem against its overkill, cached in
-    ``DIR/records`` (the errors are recomputed only when a task id changes).
+def _pressure_l2(candidate: dict, reference: dict) -> float:
+    """||p_h - p_ref||_{L2(Gamma_C)} of an ngdual candidate on the whole of Gamma_C (the
+    norm the pressure goal estimates)."""
+    from ...verification.overkill import nodes_to_samples, pressure_error, pressure_of
 
-    Returns ``{"rows": [...], "reference": {...}}``: one row per solution (method,
-    level or adaptive step, DOFs, wall time, ``estimator``, ``pressure``, ``pressure_max``,
-    ``sigma_energy``, ``e_true``, :func:`_measures`), and the overkill's level, DOFs and its
-    Richardson check per measure.
+    ref = pressure_of(reference)
+    return pressure_error(*nodes_to_samples(candidate["p_nodes"], candidate["p"], ref,
+                                            candidate.get("p_edges")), ref)["l2"]
+
+
+def _run_check(run: list[tuple[dict, dict]], lam: float, mu: float, window) -> dict:
+    """How accurate an adaptive run's last step is, per measure: Richardson from the
+    distances of the two steps before it (nested meshes: exact integrals), ``None`` where
+    the run stalled (a step before the last grew the unknowns by less than
+    :data:`STALLED`) or the distances do not fall."""
+    from ...verification.overkill import true_errors
+
+    (last_row, last), before = run[-1], run[-3:-1]
+    out = {"method": last_row["method"], "step": last_row["level_or_step"],
+           "ndof": last_row["ndof"], "elements": last_row["elements"],
+           "time_s": last_row["time_s"], "relative_estimate": last_row["relative_estimate"]}
+    steps = [r["ndof"] for r, _ in run[-3:]]
+    stalled = len(steps) < 3 or min(b / a for a, b in zip(steps, steps[1:])) < STALLED
+    d = [_measures(true_errors(arrays, last, lam, mu, window)) for _, arrays in before]
+    for measure in TRUE_MEASURES:
+        check = ({"r": None, "rate": None, "overkill_error": None} if stalled
+                 else richardson_check(*(e[measure] for e in d)))
+        out[measure] = {"d_last-2": d[0][measure] if len(d) == 2 else None,
+                        "d_last-1": d[-1][measure] if d else None, **check}
+    out["stalled"] = stalled
+    return out
+
+
+def _choose(checks: list[dict], measure: str) -> dict:
+    """The reference of ``measure``: the run's last step whose own error (Richardson) is
+    smallest, or without any such estimate the largest last step; the targets it resolves."""
+    known = [c for c in checks if c[measure]["overkill_error"] is not None]
+    best = (min(known, key=lambda c: c[measure]["overkill_error"]) if known
+            else max(checks, key=lambda c: c["ndof"]))
+    error = best[measure]["overkill_error"]
+    return {**{k: v for k, v in best.items() if k not in TRUE_MEASURES}, **best[measure],
+            "resolves": [t for t in (0.05, 0.02, 0.01) if error is not None
+                         and error <= RESOLVES * t]}
+
+
+def analytic_check(scene, pressure: dict, window: float | None) -> dict | None:
+    """The half-plane formula of the scene's benchmark (:mod:`ngdual.verification.analytic`:
+    Hertz, Sadowsky's flat punch, the wedge; Cattaneo-Mindlin's pressure is Hertz's) with
+    the force and about the centroid of the reference pressure ``pressure`` (P1 in x, ds
+    taken as dx), against it: the relative L2 difference on Gamma_C (on |x| <= ``window``),
+    a cross-check of a reference on a finite body, not its error. None without a benchmark."""
+    from ...verification import analytic
+    from ...verification.overkill import gauss_samples, pressure_error
+
+    bench, mat = scene.benchmark, scene.material
+    x, p = np.asarray(pressure["p_nodes"]), np.asarray(pressure["p"])
+    force = float(np.trapezoid(p, x))
+    centre = float(np.trapezoid(x * p, x)) / force
+    exact = {"hertz": lambda: analytic.hertz(force, bench.radius, mat.E, mat.nu),
+             "cattaneo-mindlin": lambda: analytic.hertz(force, bench.radius, mat.E, mat.nu),
+             "flat-punch": lambda: analytic.flat_punch(force, bench.half_width),
+             "wedge": lambda: analytic.wedge(force, bench.slope, mat.E, mat.nu)}
+    if bench is None or bench.kind not in exact:
+        return None
+    formula = exact[bench.kind]()
+    points, weights = gauss_samples(x[:-1], x[1:])
+    diff = pressure_error(points, weights, formula.pressure(points - centre),
+                          {"x": x, "p": p}, window)
+    return {"kind": bench.kind, "force": force, "centre": centre, "relative_l2": diff["rel"]}
+
+
+def true_error_study(ctx: Context, problem: str) -> dict:
+    """True errors of every method of one problem against its references, cached in
+    ``DIR/records`` (recomputed only when a task id changes).
+
+    Returns ``{"rows": [...], "reference": {...}, "runs": [...]}``: one row per solution
+    (method, level or adaptive step, DOFs, wall time, ``estimator``, ``pressure``,
+    ``pressure_max``, ``pressure_l2``, ``sigma_energy``, ``e_true`` of :func:`_measures`; an
+    adaptive step of the pressure goal also ``effectivity`` = ``goal_estimate`` /
+    ||p - p_h||_{L2(Gamma_C)}; a reference has no error in its own measure); per measure
+    its reference (:func:`_choose`), the sigma one with ``quadrature``, the relative change
+    of the finest non-nested candidates' sigma errors when the reference's triangles are
+    split in four; and the check of both runs (:func:`_run_check`).
     """
     from ...scene import load_scene
     from ...verification.overkill import true_errors
 
     tp = TRUTH_PROBLEMS[problem]
-    below, top = reference_tasks(ctx.plan, problem)
-    ids = [below.id, top.id] + [t.id for ts in truth_tasks(ctx.plan, problem).values()
-                                for t in ts]
+    ids = [t.id for ts in truth_tasks(ctx.plan, problem).values() for t in ts]
     digest = hashlib.sha1(json.dumps(ids).encode()).hexdigest()[:12]
     cache = ctx.records_dir / f"true-errors-{problem}-{digest}.json"
     if cache.is_file():
         return json.loads(cache.read_text())
-    lam, mu = load_scene(tp.scene, list(tp.overrides)).material.lame
-    ref_record = require(ctx.record(top), top.label)
-    reference = ctx.arrays(top)
-    rows = []
-    for row, arrays in _candidates(ctx, problem):
+    scene = load_scene(tp.scene, list(tp.overrides))
+    lam, mu = scene.material.lame
+    candidates = _candidates(ctx, problem)
+    runs = {}
+    for row, arrays in candidates:
+        if row["method"].startswith("adaptive") and arrays:
+            runs.setdefault(row["method"], []).append((row, arrays))
+    checks = [_run_check(run, lam, mu, tp.pressure_window) for run in runs.values()]
+    chosen = {m: _choose(checks, m) for m in TRUE_MEASURES}
+    last = {m: runs[c["method"]][-1] for m, c in chosen.items()}
+    # sigma, u and the rotation from one run's last step, the pressure from one's
+    pressure = {k: last["pressure"][1][k] for k in ("p_nodes", "p")}
+    reference = {**{k: v for k, v in last["sigma_energy"][1].items() if not k.startswith("p")},
+                 **pressure}
+    rows, crossing = [], {}
+    for row, arrays in candidates:
         if arrays:
             row.update(_measures(true_errors(arrays, reference, lam, mu, tp.pressure_window)))
+            if row["method"] == "adaptive, pressure goal" and row is not last["pressure"][0]:
+                row["effectivity"] = row["goal_estimate"] / _pressure_l2(arrays, reference)
+            if row["method"] != chosen["sigma_energy"]["method"]:
+                crossing[row["method"]] = (row, arrays)     # the finest of each method
+        for measure, (ref_row, _) in last.items():
+            if row is ref_row:
+                row[measure] = None
         rows.append(row)
-    # Richardson: the two levels below the overkill against it
-    finest = next(r for r in rows if r["method"] == "uniform, active set"
-                  and r.get("level_or_step") == ctx.plan.truth_levels(problem)[-1])
-    below_errors = _measures(true_errors(ctx.arrays(below), reference, lam, mu,
-                                         tp.pressure_window))
-    check = {k: {"d_L-2": finest.get(k), "d_L-1": below_errors[k],
-                 **richardson_check(finest.get(k), below_errors[k])}
-             for k in ("pressure", "sigma_energy")}
-    data = plain({"rows": rows, "reference": {
-        "scene": tp.scene, "overrides": list(tp.overrides), "level": top.params["level"],
-        "ndof": ref_record["ndof"], "time_s": ref_record["timings_s"]["total"],
-        "richardson": check}, "versions": versions()})
+    # the quadrature error of non-nested candidates: their sigma errors again, on the
+    # reference's triangles split in four
+    split = {**split_samples(reference), **pressure}
+    changes = []
+    for row, arrays in crossing.values():
+        again = _measures(true_errors(arrays, split, lam, mu))["sigma_energy"]
+        changes.append({"method": row["method"], "level_or_step": row["level_or_step"],
+                        "sigma_energy": row["sigma_energy"], "sigma_energy_split": again,
+                        "relative_change": abs(again / row["sigma_energy"] - 1)})
+    chosen["sigma_energy"]["quadrature"] = changes
+    chosen["pressure"]["analytic"] = analytic_check(scene, pressure, tp.pressure_window)
+    data = plain({"rows": rows,
+                  "reference": chosen, "runs": checks, "versions": versions()})
     write_json(data, cache)
     return data

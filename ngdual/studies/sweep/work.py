@@ -90,8 +90,11 @@ class _Budget(Exception):
 
 def adapt_task(scene: str, marking: str, theta: float, steps: int, level: int,
                overrides: list[str] = (), snapshots: list[int] = (), samples: bool = False,
-               max_elements: int | None = None) -> tuple[dict, dict]:
-    """An adaptive run (:func:`ngdual.afem.adapt`): its history, with extras for Section 4.2.
+               max_elements: int | None = None, goal: str = "stress",
+               tol: float | None = None, window: list[float] | None = None
+               ) -> tuple[dict, dict]:
+    """An adaptive run (:func:`ngdual.afem.adapt` with its ``goal``, ``tol`` and ``window``):
+    its history, with extras for Section 4.2.
 
     Every step record of :func:`ngdual.afem.step_record` gets ``eta_as`` (the
     largest eta_{as,T} with as(sigma_h) in L^2 and in H(div), and the share
@@ -139,9 +142,10 @@ def adapt_task(scene: str, marking: str, theta: float, steps: int, level: int,
             raise _Budget
 
     run = {"scene": scene, "marking": marking, "theta": theta, "steps": steps, "level": level,
-           "overrides": list(overrides)}
+           "overrides": list(overrides), "goal": goal, "tol": tol, "window": window}
     try:
-        adapt(load_scene_with(scene, overrides), marking, theta, steps, level, on_step=on_step)
+        adapt(load_scene_with(scene, overrides), marking, theta, steps, level, on_step=on_step,
+              goal=goal, tol=tol, window=None if window is None else tuple(window))
         status = "ok" if all(r["converged"] for r in history) else "not-converged"
     except ConvergenceError as err:
         run.update(message=str(err))
