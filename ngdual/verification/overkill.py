@@ -206,8 +206,15 @@ def _barycentric(tri_xy: np.ndarray, points: np.ndarray) -> np.ndarray:
 
 
 def locate(samples: dict, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The triangle of ``samples`` holding each point (n, 2) and its P2 basis values there."""
+    """The triangle of ``samples`` holding each point (n, 2) and its P2 basis values there.
+
+    On a curved boundary the candidate's edges are chords of the finer reference's: a point
+    in the sliver between them takes the triangle with the nearest centroid (its polynomials
+    extended), a geometric error of the candidate like any other. A point farther from
+    every centroid than that triangle's longest edge lies outside the candidate's domain:
+    a ValueError."""
     from matplotlib.tri import Triangulation
+    from scipy.spatial import cKDTree
 
     tri = Triangulation(samples["vertices"][:, 0], samples["vertices"][:, 1],
                         samples["triangles"])
