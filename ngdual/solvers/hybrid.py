@@ -32,6 +32,7 @@ affine function t(zeta) = t_hat - S zeta of zeta (:class:`ContactSchur`).
 
 from __future__ import annotations
 
+import re
 import time
 from dataclasses import dataclass
 
@@ -78,14 +79,43 @@ def _boundary_edges(mesh: ngs.Mesh, facet: ngs.FESpace, hdiv: ngs.FESpace
                     ) -> dict[str, np.ndarray]:
     """Rows (facet dof, RT_0 dof, vertex a, vertex b) of every boundary segment, by label.
 
-    Dof numbers, not edge numbers: netgen keeps the edges of coarser levels after
+    Read from two forms on every labelled part of the boundary, int_e mu (psi . n) ds and
+    int_e mu v ds (mu the edge multipliers, psi the RT_0 functions, v the P1 hats): on a
+    segment e only its own mu and psi and the hats of its two vertices do not vanish. Dof
+    numbers, not edge numbers: netgen keeps the edges of coarser levels after
     ``mesh.Refine()``, and the facet space numbers only the edges in use.
     """
-    out: dict[str, list] = {}
-    for el in mesh.Elements(ngs.BND):
-        a, b = (v.nr for v in el.vertices)
-        out.setdefault(el.mat, []).append((facet.GetDofNrs(el)[0], hdiv.GetDofNrs(el)[0], a, b))
-    return {label: np.array(rows, dtype=int) for label, rows in out.items()}
+    hats = ngs.H1(mesh, order=1)
+    n = ngs.specialcf.normal(2)
+    out = {}
+    for label in dict.fromkeys(mesh.GetBoundaries()):
+        ds = ngs.ds(definedon=mesh.Boundaries(re.escape(label)))
+        flux = ngs.BilinearForm(trialspace=facet, testspace=hdiv)
+        flux += facet.TrialFunction() * (hdiv.TestFunction().Trace() * n) * ds
+        ends = ngs.BilinearForm(trialspace=facet, testspace=hats)
+        ends += facet.TrialFunction() * hats.TestFunction() * ds
+        rt, edges = _nonzeros(flux.Assemble().mat)
+        vertices, edges_v = _nonzeros(ends.Assemble().mat)
+        if not len(edges):
+            continue
+        order = np.argsort(edges_v, kind="stable")
+        pairs = vertices[order].reshape(-1, 2)
+        if not (np.array_equal(edges_v[order][::2], edges)
+                and np.array_equal(edges_v[order][1::2], edges)):
+            raise RuntimeError(f"the boundary segments of {label!r} are not edges with "
+                               "one RT_0 function and two vertices")
+        out[label] = np.column_stack([edges, rt, pairs])
+    return out
+
+
+def _nonzeros(matrix) -> tuple[np.ndarray, np.ndarray]:
+    """(row, column) of the entries of an assembled NGSolve matrix that do not vanish (up
+    to rounding), sorted by column."""
+    A = to_scipy(matrix, copy=False).tocsc()
+    rows = A.indices
+    cols = np.repeat(np.arange(A.shape[1]), np.diff(A.indptr))
+    keep = np.abs(A.data) > 1e-12 * np.abs(A.data).max(initial=0.0)
+    return rows[keep].astype(int), cols[keep]
 
 
 def _normal_fluxes(hdiv: ngs.FESpace, mesh: ngs.Mesh, labels: list[str]) -> np.ndarray:
