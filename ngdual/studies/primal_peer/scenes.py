@@ -23,27 +23,33 @@ def _scene_gap(contact):
     return partial(foundation_gap, contact)
 
 
-def solve_scene_primal(scene, level: int, order: int, **kw) -> tuple[PrimalResult, float]:
-    """Solve an ngdual scene (its mesh on ``level``, material, loads, gap, friction law) by
-    the peer with P``order`` elements; returns the result and the wall time, meshing
-    included. Tresca bounds and free ends are the scene's; "thesis" end values of Gamma_C
-    (lambda = 0 at a clamped end) have no primal counterpart and are refused."""
-    from ...mesh import build_mesh
-
+def primal_arguments(scene) -> dict:
+    """The scene as the keyword arguments of :func:`~.nitsche.solve_primal` (all but the
+    mesh and the order): material, boundary labels, loads, gap and friction law. Tresca
+    bounds and free ends are the scene's; "thesis" end values of Gamma_C (lambda = 0 at a
+    clamped end) have no primal counterpart and are refused."""
     if scene.contact.ends == "thesis":
         raise ValueError("the peer solves the consistent problem: set contact.ends = "
                          "\"consistent\" (the thesis' end values contradict u = u_D)")
-    start = time.perf_counter()
-    mesh = build_mesh(scene.geometry, level)
     law = scene.friction.law
-    result = solve_primal(
-        mesh, E=scene.material.E, nu=scene.material.nu, dirichlet=scene.labels("dirichlet"),
+    return dict(
+        E=scene.material.E, nu=scene.material.nu, dirichlet=scene.labels("dirichlet"),
         neumann=scene.labels("neumann"), contact=scene.labels("contact"),
         body_force=scene.loads.body_force, traction=scene.loads.traction,
-        displacement=scene.loads.displacement,
-        gap=_scene_gap(scene.contact), order=order,
-        law=law, mu_f=scene.friction.mu if law == "coulomb" else 0.0,
-        tresca_bound=scene.friction.bound if law == "tresca" else None, **kw)
+        displacement=scene.loads.displacement, gap=_scene_gap(scene.contact), law=law,
+        mu_f=scene.friction.mu if law == "coulomb" else 0.0,
+        tresca_bound=scene.friction.bound if law == "tresca" else None)
+
+
+def solve_scene_primal(scene, level: int, order: int, **kw) -> tuple[PrimalResult, float]:
+    """Solve an ngdual scene (its mesh on ``level``, :func:`primal_arguments`) by the peer
+    with P``order`` elements; returns the result and the wall time, meshing included."""
+    from ...mesh import build_mesh
+
+    arguments = primal_arguments(scene)
+    start = time.perf_counter()
+    mesh = build_mesh(scene.geometry, level)
+    result = solve_primal(mesh, **arguments, order=order, **kw)
     return result, time.perf_counter() - start
 
 
