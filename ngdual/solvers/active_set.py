@@ -154,17 +154,13 @@ class ContactStart:
         pb = solution.problem
         gamma_c = pb.spaces.gamma_c
         fine = pb.to_fine(solution.x)
-        points = np.vstack([chain.path_points for chain in gamma_c.coarse.chains])
-        starts, first = [], 0
-        for chain in gamma_c.coarse.chains:
-            starts.append(np.arange(first, first + chain.n_edges))
-            first += chain.n_edges + 1
-        ends = np.column_stack([np.concatenate(starts), np.concatenate(starts) + 1])
+        segments = np.concatenate([np.stack([chain.path_points[:-1], chain.path_points[1:]], 1)
+                                   for chain in gamma_c.coarse.chains])
         values = {}
         for name in ("lam_n", "lam_t"):
             rng = pb.fes.Range(pb.names.index(name))
-            values[name] = gamma_c.vertex_values(fine[rng.start:rng.stop])[ends]
-        return cls(points[ends], values["lam_n"], values["lam_t"])
+            values[name] = fine[rng.start:rng.stop][gamma_c.edge_dofs]
+        return cls(segments, values["lam_n"], values["lam_t"])
 
     def at(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """lambda_n, lambda_t at ``points`` of Gamma_C, linear along the nearest edge (a
