@@ -115,6 +115,11 @@ def stress(u, mu: float, lam: float):
     return 2 * mu * eps + lam * ngs.Trace(eps) * ngs.Id(2)
 
 
+def mixed_stress(u, p, mu: float):
+    """sigma = 2 mu eps(u) - p I with the pressure p = -lam div u as an unknown of its own."""
+    return 2 * mu * _strain(u) - p * ngs.Id(2)
+
+
 def facet_integral(cfs, mesh: ngs.Mesh, labels: list[str], bonus_intorder: int = 8) -> list:
     """int over the boundary ``labels`` of each CF, evaluated from the volume side.
 
@@ -148,8 +153,8 @@ def _project(x, s):
 def solve_primal(mesh: ngs.Mesh, *, E: float, nu: float, dirichlet, neumann=(), contact,
                  body_force=(0, 0), traction=(0, 0), displacement=(0, 0), gap,
                  order: int = 1, law: str = "none", mu_f: float = 0.0, tresca_bound=None,
-                 gamma0: float = 1.0, theta: float = -1.0, tol: float = 1e-10,
-                 max_newton: int = 50) -> PrimalResult:
+                 gamma0: float = 1.0, theta: float = -1.0, mixed: bool = False,
+                 tol: float = 1e-10, max_newton: int = 50) -> PrimalResult:
     """Solve the contact problem by P``order`` Lagrange elements, Nitsche contact, Newton.
 
     ``dirichlet``, ``neumann``, ``contact``: lists of boundary labels of ``mesh``
@@ -163,6 +168,14 @@ def solve_primal(mesh: ngs.Mesh, *, E: float, nu: float, dirichlet, neumann=(), 
     contact integrals and the normal of the edge a point lies on in :meth:`PrimalResult.
     pressure`. ``law``: "none", "tresca" (bound ``tresca_bound``) or "coulomb" (coefficient
     ``mu_f``).
+
+    ``mixed=True`` solves the displacement-pressure form with Taylor-Hood elements (P``order``
+    displacements, continuous P``order-1`` pressures, order >= 2): find (u, p) with
+    2 mu (eps(u), eps(v)) - (p, div v) - (q, div u) - (p, q) / lam plus the Nitsche terms of
+    sigma = 2 mu eps(u) - p I. For a nearly incompressible material the displacement form
+    locks in shear: lam div u_h, a large number times a small inexact one, pollutes sigma_n
+    and the contact pressure (cattaneo-mindlin, nu = 0.4999: P2 pressure errors of 30-48 %
+    on levels 1-5 that do not decrease), which the inf-sup stable pair avoids.
 
     Newton stops when the residual (on the free DOFs) is below ``tol`` times the initial one;
     otherwise :class:`NewtonError` is raised.
@@ -178,6 +191,8 @@ def solve_primal(mesh: ngs.Mesh, *, E: float, nu: float, dirichlet, neumann=(), 
         raise ValueError("mu_f must be >= 0")
     if gamma0 <= 0:
         raise ValueError("gamma0 must be > 0")
+    if mixed and order < 2:
+        raise ValueError("the Taylor-Hood form (mixed=True) needs order >= 2")
     dirichlet, neumann, contact = _labels(dirichlet), _labels(neumann), _labels(contact)
     known = set(mesh.GetBoundaries())
     for label in dirichlet + neumann + contact:
@@ -188,7 +203,13 @@ def solve_primal(mesh: ngs.Mesh, *, E: float, nu: float, dirichlet, neumann=(), 
 
     mu, lam = lame(E, nu)
     fes = ngs.VectorH1(mesh, order=order, dirichlet="|".join(dirichlet))
-    u, v = fes.TnT()
+    if mixed:
+        fes = fes * ngs.H1(mesh, order=order - 1)
+        (u, p_u), (v, p_v) = fes.TnT()
+        sigma_u, sigma_v = mixed_stress(u, p_u, mu), mixed_stress(v, p_v, mu)
+    else:
+        u, v = fes.TnT()
+        sigma_u, sigma_v = stress(u, mu, lam), stress(v, mu, lam)
     n = ngs.specialcf.normal(2)
     t = tangent(n)
     h = ngs.specialcf.mesh_size
@@ -196,12 +217,12 @@ def solve_primal(mesh: ngs.Mesh, *, E: float, nu: float, dirichlet, neumann=(), 
     g = gap(ngs.x, ngs.y, n[0], n[1]) if callable(gap) else scalar_cf(gap)
     dsc = ngs.ds(skeleton=True, definedon=mesh.Boundaries("|".join(contact)))
 
-    def parts(w):
-        sn = stress(w, mu, lam) * n
+    def parts(sigma, w):
+        sn = sigma * n
         return sn * n, sn * t, w * n, w * t
 
-    sn_u, st_u, un_u, ut_u = parts(u)
-    sn_v, st_v, un_v, ut_v = parts(v)
+    sn_u, st_u, un_u, ut_u = parts(sigma_u, u)
+    sn_v, st_v, un_v, ut_v = parts(sigma_v, v)
     pn = sn_u - beta * (un_u - g)
     pt = st_u - beta * ut_u
     if law == "none":
@@ -212,7 +233,11 @@ def solve_primal(mesh: ngs.Mesh, *, E: float, nu: float, dirichlet, neumann=(), 
         s = -mu_f * _minus(pn)
 
     a = ngs.BilinearForm(fes)
-    a += ngs.InnerProduct(stress(u, mu, lam), _strain(v)) * ngs.dx
+    if mixed:
+        a += (2 * mu * ngs.InnerProduct(_strain(u), _strain(v)) - p_u * ngs.Trace(ngs.Grad(v))
+              - p_v * ngs.Trace(ngs.Grad(u)) - p_u * p_v / lam) * ngs.dx
+    else:
+        a += ngs.InnerProduct(stress(u, mu, lam), _strain(v)) * ngs.dx
     form = 1 / beta * _minus(pn) * (theta * sn_v - beta * un_v)
     if theta != 0:
         form += -theta / beta * sn_u * sn_v
@@ -228,10 +253,14 @@ def solve_primal(mesh: ngs.Mesh, *, E: float, nu: float, dirichlet, neumann=(), 
         f += _vector(traction) * v * ngs.ds(definedon=mesh.Boundaries("|".join(neumann)))
     f.Assemble()
 
+    def displacement_of(gf):
+        return gf.components[0] if mixed else gf
+
     gfu = ngs.GridFunction(fes)
+    u_h = displacement_of(gfu)
+    sigma_h = mixed_stress(u_h, gfu.components[1], mu) if mixed else stress(gfu, mu, lam)
     if dirichlet:
-        gfu.Set(_vector(displacement), ngs.BND,
-                definedon=mesh.Boundaries("|".join(dirichlet)))
+        u_h.Set(_vector(displacement), ngs.BND, definedon=mesh.Boundaries("|".join(dirichlet)))
     free = fes.FreeDofs()
     res = gfu.vec.CreateVector()
     times = {"assemble": 0.0, "solve": 0.0}
@@ -282,11 +311,12 @@ def solve_primal(mesh: ngs.Mesh, *, E: float, nu: float, dirichlet, neumann=(), 
         w = ngs.GridFunction(fes)
         for i, unit in enumerate(((1, 0), (0, 1))):
             w.vec[:] = 0
-            w.Set(ngs.CF(unit), ngs.BND, definedon=mesh.Boundaries("|".join(dirichlet)))
+            displacement_of(w).Set(ngs.CF(unit), ngs.BND,
+                                   definedon=mesh.Boundaries("|".join(dirichlet)))
             support_force[i] = ngs.InnerProduct(res, w.vec)
 
     # Nitsche-consistent contact tractions of the discrete solution
-    sn_h, st_h, un_h, ut_h = parts(gfu)
+    sn_h, st_h, un_h, ut_h = parts(sigma_h, u_h)
     pn_h = sn_h - beta * (un_h - g)
     p_cf = -_minus(pn_h)
     if law == "none":
@@ -305,15 +335,14 @@ def solve_primal(mesh: ngs.Mesh, *, E: float, nu: float, dirichlet, neumann=(), 
         stick_length = 0.0
 
     edges = ContactEdges.of(mesh, contact)
-    sigma = stress(gfu, mu, lam)
 
     def pointwise(points: np.ndarray):
         k = edges.locate(points)
         nn, tt, hh = edges.normal[k], edges.tangent[k], edges.length[k]
         q = points - 1e-9 * hh[:, None] * nn  # nudge inside, so the point search succeeds
         mp = mesh(q[:, 0], q[:, 1])
-        sig = np.asarray(sigma(mp)).reshape(-1, 2, 2)
-        disp = np.asarray(gfu(mp)).reshape(-1, 2)
+        sig = np.asarray(sigma_h(mp)).reshape(-1, 2, 2)
+        disp = np.asarray(u_h(mp)).reshape(-1, 2)
         if callable(gap):
             # at the point the search found, as the formula gap g(mp) below
             xq, yq = np.asarray(ngs.CF((ngs.x, ngs.y))(mp)).reshape(-1, 2).T
@@ -338,7 +367,7 @@ def solve_primal(mesh: ngs.Mesh, *, E: float, nu: float, dirichlet, neumann=(), 
     mid = mid[order_x]
     p_mid, t_mid = pointwise(mid)
     times["total"] = time.perf_counter() - t_total
-    return PrimalResult(u=gfu, ndof=fes.ndof, newton_iterations=iterations,
+    return PrimalResult(u=u_h, sigma=sigma_h, ndof=fes.ndof, newton_iterations=iterations,
                         residuals=residuals, times=times, converged=converged,
                         x_mid=mid[:, 0], pressure_mid=p_mid, traction_mid=t_mid,
                         h_mid=edges.length[order_x], contact_force=contact_force,

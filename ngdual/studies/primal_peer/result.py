@@ -64,10 +64,13 @@ class PrimalResult:
     and Jacobians), "solve" (factorisations and solves), "total" (all of solve_primal).
     ``x_mid`` are the midpoints of the Gamma_C edges sorted by x; ``pressure_mid`` and
     ``traction_mid`` the Nitsche-consistent p = -[P_n(u_h)]_- and lambda_t = [P_t(u_h)]_s
-    there (tangent t = (n_y, -n_x), i.e. +x on a side with outward normal +y).
+    there (tangent t = (n_y, -n_x), i.e. +x on a side with outward normal +y). ``u`` is the
+    displacement and ``sigma`` the discrete stress (of u, or of u and the pressure in the
+    Taylor-Hood form).
     """
 
     u: ngs.GridFunction
+    sigma: ngs.CoefficientFunction = field(repr=False)
     ndof: int
     newton_iterations: int
     residuals: list[float]

@@ -7,8 +7,14 @@ from functools import partial
 
 import numpy as np
 
-from .nitsche import solve_primal, stress
+from .nitsche import solve_primal
 from .result import PrimalResult
+
+# from this Poisson ratio on (lam / mu >= 9) the P2 (and higher) peer solves the Taylor-Hood
+# displacement-pressure form: the displacement form's contact pressure degrades with lam / mu
+# (hertz-cylinder P2 level 3: 3.6 % at nu = 0.3, 5.2 % at nu = 0.4999) and with friction
+# and shear does not converge at all (cattaneo-mindlin, nu = 0.4999, see solve_primal)
+NEARLY_INCOMPRESSIBLE = 0.45
 
 
 def _scene_gap(contact):
@@ -43,13 +49,16 @@ def primal_arguments(scene) -> dict:
 
 def solve_scene_primal(scene, level: int, order: int, **kw) -> tuple[PrimalResult, float]:
     """Solve an ngdual scene (its mesh on ``level``, :func:`primal_arguments`) by the peer
-    with P``order`` elements; returns the result and the wall time, meshing included."""
+    with P``order`` elements, in the Taylor-Hood form (P``order`` - P``order-1``) for
+    order >= 2 and nu >= ``NEARLY_INCOMPRESSIBLE``; returns the result and the wall time,
+    meshing included."""
     from ...mesh import build_mesh
 
     arguments = primal_arguments(scene)
+    mixed = order >= 2 and scene.material.nu >= NEARLY_INCOMPRESSIBLE
     start = time.perf_counter()
     mesh = build_mesh(scene.geometry, level)
-    result = solve_primal(mesh, **arguments, order=order, **kw)
+    result = solve_primal(mesh, **arguments, order=order, mixed=mixed, **kw)
     return result, time.perf_counter() - start
 
 
@@ -64,9 +73,8 @@ def primal_samples(scene, result: PrimalResult, subdivisions: int = 1) -> dict:
     Gamma_C must be a graph over x (:func:`ngdual.verification.overkill.graph_over_x`)."""
     from ...verification.overkill import edge_samples, element_samples
 
-    lam, mu = scene.material.lame
     mesh = result.u.space.mesh
-    out = element_samples(mesh, {"sigma": stress(result.u, mu, lam), "u": result.u})
+    out = element_samples(mesh, {"sigma": result.sigma, "u": result.u})
     edges = result._edges
     xy, w = edge_samples(np.stack([edges.p0, edges.p1], axis=1), subdivisions)
     out.update(p_x=xy[:, 0], p_w=w, p=result.pressure(xy))
