@@ -192,12 +192,10 @@ class BrokenPeers:
         Every entry is the sum of at most two element entries (an edge has two triangles),
         so it equals the conforming assembly's bit for bit, whatever the order of the sum.
         """
-        K = self.matrix
-        nonzero = K.data != 0.0
-        rows = np.repeat(np.arange(K.shape[0]), np.diff(K.indptr))[nonzero]
-        index = self.conforming
-        return sp.csr_matrix((K.data[nonzero], (index[rows], index[K.indices[nonzero]])),
-                             shape=(size, size))
+        n_broken = self.matrix.shape[0]
+        E = sp.csr_matrix((np.ones(n_broken), self.conforming, np.arange(n_broken + 1)),
+                          shape=(n_broken, size))
+        return E.T.tocsr() @ (self.matrix @ E)
 
     def to_conforming(self, values: np.ndarray) -> np.ndarray:
         """The conforming PEERS coefficients of broken ones whose normal fluxes agree across
