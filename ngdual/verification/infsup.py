@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import ngsolve as ngs
 import numpy as np
+import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
@@ -116,3 +117,36 @@ def largest_singular_value(X: sp.spmatrix, B: sp.spmatrix, Y: sp.spmatrix) -> fl
     largest = spla.eigsh(_schur(X, B), k=1, M=Y.tocsc(), which="LA",
                          return_eigenvectors=False).max()
     return float(np.sqrt(largest))
+
+
+def half_norm(mass: np.ndarray, stiff: np.ndarray) -> np.ndarray:
+    """The discrete H^{1/2} norm matrix M V diag((1 + k^2)^{1/2}) V^T M of a boundary space.
+
+    The interpolation norm between L^2 (the mass matrix ``mass``) and H^1 (``mass`` plus the
+    arc-length stiffness ``stiff``), from the eigenpairs (k^2, V) of ``stiff`` against
+    ``mass``, V normalised in ``mass``.
+    """
+    vals, vecs = sla.eigh(stiff, mass)
+    mv = mass @ vecs
+    return (mv * np.sqrt(1.0 + np.maximum(vals, 0.0))) @ mv.T
+
+
+def dense_singular_values(X: sp.spmatrix, B: np.ndarray, Y: np.ndarray,
+                          indices=(0,)) -> list[float]:
+    """Singular values of the dense ``B`` from the X-norm to the Y-norm, by position.
+
+    The square roots of the eigenvalues of the pencil (B^T X^{-1} B, Y) at the positions
+    ``indices`` (ascending; -1 the largest), with B^T X^{-1} B formed densely column by
+    column from one factorisation of X: for the few hundred columns of boundary multipliers,
+    where Y (:func:`half_norm`) is dense anyway. Position 0 is the inf-sup constant beta_h,
+    position -1 the continuity constant.
+    """
+    solve = spla.factorized(X.tocsc())
+    XinvB = np.column_stack([solve(B[:, j]) for j in range(B.shape[1])])
+    S = B.T @ XinvB
+    out = []
+    for index in indices:
+        i = index % B.shape[1]
+        value = sla.eigh(0.5 * (S + S.T), Y, eigvals_only=True, subset_by_index=[i, i])[0]
+        out.append(float(np.sqrt(max(value, 0.0))))
+    return out
