@@ -187,3 +187,16 @@ def test_a_one_percent_pressure_tolerance_on_hertz_stops_below_one_percent_true_
           f"{np.round(effectivity, 2).tolist()}")
     assert errors[stop] < 0.01
     assert 0.3 <= min(effectivity) and max(effectivity) <= 3
+
+
+def test_ngdual_adapt_with_a_window_records_it_and_aims_at_the_core(tmp_path):
+    """--window puts the goal on the punch's core: its size is ||p_h|| there, smaller than
+    on all of Gamma_C, where p ~ (a - |x|)^(-1/2)."""
+    runs = {}
+    for name, window in (("core", ["-0.125", "0.125"]), ("all", [])):
+        flags = ["--window", *window] if window else []
+        assert main(["adapt", "flat-punch", "--goal", "pressure", *flags, "--level", "1",
+                     "--steps", "1", "--out", str(tmp_path / name)]) == 0
+        runs[name] = json.loads((tmp_path / name / "history.json").read_text())
+    assert runs["core"]["window"] == [-0.125, 0.125] and runs["all"]["window"] is None
+    assert runs["core"]["history"][0]["goal_size"] < runs["all"]["history"][0]["goal_size"]
