@@ -272,8 +272,9 @@ class HybridSystem:
             return np.vstack(rows) if rows else np.zeros((0, 4), dtype=int)
 
         dirichlet, neumann = edges_of("dirichlet"), edges_of("neumann")
-        interior = np.setdiff1d(np.arange(facet.ndof),
-                                np.concatenate([e[:, 0] for e in labelled.values()]))
+        on_boundary = np.zeros(facet.ndof, dtype=bool)
+        on_boundary[np.concatenate([e[:, 0] for e in labelled.values()])] = True
+        interior = np.flatnonzero(~on_boundary)
         self.contact = self._contact_edges(model, labelled, fluxes, F1, F2)
         n_int, n_v = len(interior), self.n_eta
         n_phi = pb.spaces.coarse_ndof("phi1") if "phi1" in pb.blocks else 0
