@@ -58,6 +58,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
+from scipy.spatial import cKDTree
 from threadpoolctl import threadpool_limits
 
 from ..forms import DiscreteProblem
@@ -74,6 +75,7 @@ from .uzawa import contact_residuals
 
 RELAXATION_MIN = 1.0 / 64  # smallest relaxation of the Coulomb fixed point
 PROBE_SEED = 20110501      # the random signs of the round-off estimate (reproducible)
+CANDIDATE_EDGES = 4        # a warm start's edges searched per point, by midpoint distance
 INFORMATIVE = ("qp_fallback", "roundoff_level")  # reported, not checked
 
 
@@ -166,14 +168,17 @@ class ContactStart:
         """lambda_n, lambda_t at ``points`` of Gamma_C, linear along the nearest edge (a
         refined mesh's vertices on a curved Gamma_C lie off the coarser mesh's chords)."""
         a, b = self.segments[:, 0], self.segments[:, 1]
-        d = b - a
-        t = np.clip(np.einsum("qsk,sk->qs", points[:, None, :] - a[None], d)
-                    / np.einsum("sk,sk->s", d, d), 0.0, 1.0)
-        foot = a[None] + t[..., None] * d[None]
-        nearest = np.argmin(np.linalg.norm(points[:, None, :] - foot, axis=2), axis=1)
-        w = t[np.arange(len(points)), nearest]
-        return tuple((1 - w) * v[nearest, 0] + w * v[nearest, 1]
-                     for v in (self.lam_n, self.lam_t))
+        # the edge holding a point is among the few whose midpoints are nearest
+        _, near = cKDTree(0.5 * (a + b)).query(points, k=min(CANDIDATE_EDGES, len(a)))
+        near = near.reshape(len(points), -1)
+        d = (b - a)[near]
+        t = np.clip(np.einsum("qck,qck->qc", points[:, None, :] - a[near], d)
+                    / np.einsum("qck,qck->qc", d, d), 0.0, 1.0)
+        foot = a[near] + t[..., None] * d
+        best = np.argmin(np.linalg.norm(points[:, None, :] - foot, axis=2), axis=1)
+        rows = np.arange(len(points))
+        edge, w = near[rows, best], t[rows, best]
+        return tuple((1 - w) * v[edge, 0] + w * v[edge, 1] for v in (self.lam_n, self.lam_t))
 
 
 def _first_state(problem: DiscreteProblem, start: ContactStart | None, n_c: int,
