@@ -161,15 +161,11 @@ def test_ngdual_adapt_refuses_a_window_without_the_pressure_goal(tmp_path, capsy
     assert "--window" in capsys.readouterr().err
 
 
-@pytest.mark.slow
-def test_a_one_percent_pressure_tolerance_on_hertz_stops_below_one_percent_true_error():
-    """adapt(hertz, goal="pressure", tol=0.01) stops at a pressure within 1 % (relative L2
-    on Gamma_C) of the overkill, the same loop on to tol = 0.004 (about 570 000 unknowns,
-    whose own error is about 0.05 %), and the estimate stays within a factor 3 of that error
-    on the way. The truth is the overkill, not Hertz's formula: the block's pressure is the
-    ellipse of a half-width 0.5 % narrower than the half-space's for the same force, 1.2 %
-    away in L2, which the discrete pressure converges to (docs/theory/estimator.md)."""
-    scene = load_scene("hertz-cylinder")
+def _tolerance_run_against_an_overkill(name: str) -> tuple[int, list, list]:
+    """The pressure goal's tolerance run on to tol = 0.004 (about 500 000 unknowns, whose own
+    error is about 0.1 %): the step where tol = 0.01 stops, and of every step but the last two
+    the true relative L2 pressure error against the last one and the effectivity."""
+    scene = load_scene(name)
     steps = []
 
     def keep(record, solution, estimated, marked):
@@ -183,9 +179,29 @@ def test_a_one_percent_pressure_tolerance_on_hertz_stops_below_one_percent_true_
               for _, x, p in steps[:-2]]
     stop = next(k for k, (estimate, _, _) in enumerate(steps) if estimate <= 0.01)
     effectivity = [estimate / error for (estimate, _, _), error in zip(steps, errors)]
-    print(f"stops at step {stop}: true error {errors[stop]:.4f}; effectivity "
-          f"{np.round(effectivity, 2).tolist()}")
+    print(f"{name}: tol 0.01 stops at step {stop}, true error {errors[stop]:.4f}; "
+          f"effectivity {np.round(effectivity, 2).tolist()}")
+    return stop, errors, effectivity
+
+
+@pytest.mark.slow
+def test_a_one_percent_pressure_tolerance_on_hertz_stops_below_one_percent_true_error():
+    """adapt(hertz, goal="pressure", tol=0.01) stops at a pressure within 1 % (relative L2
+    on Gamma_C) of the overkill (measured: 0.72 %), and the estimate stays within a factor 3
+    of that error on the way. The truth is the overkill, not Hertz's formula: the block's
+    pressure is the ellipse of a half-width 0.5 % narrower than the half-space's for the
+    same force, 1.2 % away in L2, which the discrete pressure converges to
+    (docs/theory/estimator.md)."""
+    stop, errors, effectivity = _tolerance_run_against_an_overkill("hertz-cylinder")
     assert errors[stop] < 0.01
+    assert 0.3 <= min(effectivity) and max(effectivity) <= 3
+
+
+@pytest.mark.slow
+def test_the_pressure_estimate_with_friction_is_within_a_factor_3_of_the_overkill_error():
+    """Cattaneo-Mindlin: the analytic pressure is 1.95 % from the block's (a half-space's,
+    centred), so the effectivity below 2 % is measured against the overkill."""
+    _, _, effectivity = _tolerance_run_against_an_overkill("cattaneo-mindlin")
     assert 0.3 <= min(effectivity) and max(effectivity) <= 3
 
 
