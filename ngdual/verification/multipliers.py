@@ -57,6 +57,7 @@ from .. import peers
 from ..boundary import CoarseMesh, EndRule, end_rule
 from ..geometry import tangent
 from ..mesh import build_mesh
+from ..scene import SceneError
 from ..sparse import to_scipy
 from .infsup import dense_singular_values, gram_matrix, half_norm
 from .order import unit_square
@@ -327,9 +328,11 @@ def multiplier_basis(mesh: ngs.Mesh, part: Part, multipliers: str, order: int,
     """The scalar basis of ``multipliers`` (one of :data:`FAMILIES`) of order k on ``part``:
     ``coarse`` on h~ = ``ratio`` h, ``facet`` on the fine edges (``ratio`` must be 1)."""
     if multipliers not in FAMILIES:
-        raise ValueError(f"unknown multipliers {multipliers!r}; choose one of {FAMILIES}")
+        raise SceneError("contact.multipliers", f"unknown multipliers {multipliers!r}; "
+                         f"choose one of {', '.join(FAMILIES)}")
     if multipliers == "facet" and ratio != 1:
-        raise ValueError("facet multipliers live on the fine edges: ratio 1")
+        raise SceneError("contact.htilde_factor",
+                         f"facet multipliers live on the fine edges (ratio 1), not {ratio}")
     coarse = CoarseMesh.from_fine(mesh, list(part.labels), ratio, part.ends)
     return (coarse_basis if multipliers == "coarse" else facet_basis)(coarse, order)
 
@@ -386,15 +389,19 @@ def table(orders=(0, 1, 2), levels=(1, 2, 3, 4), choices=CHOICES, family: str = 
 
 
 def format_table(rows: list[dict]) -> str:
-    """The table as Markdown: one row per (multipliers, ratio, k), beta_h (gamma_h) per level."""
+    """The table as Markdown: one line per stress family, multipliers, h~/h and k; beta_h
+    (gamma_h) per level."""
     levels = sorted({r["level"] for r in rows})
-    keys = list(dict.fromkeys((r["multipliers"], r["ratio"], r["order"]) for r in rows))
-    cell = {(r["multipliers"], r["ratio"], r["order"], r["level"]): r for r in rows}
-    lines = ["| multipliers | h~/h | k | " + " | ".join(f"level {lv}" for lv in levels) + " |",
-             "|---|---|---|" + "---|" * len(levels)]
-    for m, ratio, k in keys:
-        cells = [f"{cell[m, ratio, k, lv]['beta']:.4f} ({cell[m, ratio, k, lv]['gamma']:.2f})"
-                 if (m, ratio, k, lv) in cell else "" for lv in levels]
-        lines.append(f"| {m} | {ratio} | {k} | " + " | ".join(cells) + " |")
+    keys = list(dict.fromkeys((r["family"], r["multipliers"], r["ratio"], r["order"])
+                              for r in rows))
+    cell = {(r["family"], r["multipliers"], r["ratio"], r["order"], r["level"]): r
+            for r in rows}
+    lines = ["| stresses | multipliers | h~/h | k | "
+             + " | ".join(f"level {lv}" for lv in levels) + " |",
+             "|---|---|---|---|" + "---|" * len(levels)]
+    for key in keys:
+        cells = [f"{cell[key + (lv,)]['beta']:.4f} ({cell[key + (lv,)]['gamma']:.2f})"
+                 if key + (lv,) in cell else "" for lv in levels]
+        lines.append(f"| {key[0].upper()} | {key[1]} | {key[2]} | {key[3]} | "
+                     + " | ".join(cells) + " |")
     return "\n".join(lines)
-
