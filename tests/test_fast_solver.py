@@ -224,6 +224,34 @@ def test_hybridisation_reproduces_the_rows_of_the_assembled_system():
                        atol=1e-10 * np.abs(t_f).max())
 
 
+@pytest.mark.parametrize("name", ["thesis-3.46-coulomb", "hertz-cylinder"])
+def test_peers_block_summed_from_the_element_matrices_is_the_conforming_assembly(name):
+    """K's PEERS block, summed from the broken element matrices (E^T K_b E), is the matrix
+    NGSolve assembles on the conforming space, bit for bit; and broken coefficients that
+    restrict a conforming field give that field back."""
+    import ngsolve as ngs
+
+    from ngdual import peers
+    from ngdual.forms import peers_form
+    from ngdual.sparse import to_scipy
+
+    pb = problem(name, 2)
+    spaces = [pb.spaces.components[c] for c in peers.PEERS]
+    fes = ngs.FESpace(spaces)
+    a = ngs.BilinearForm(fes)
+    a += peers_form(dict(zip(peers.PEERS, fes.TrialFunction())),
+                    dict(zip(peers.PEERS, fes.TestFunction())), pb.scene.material.lame)
+    a.Assemble()
+    conforming = to_scipy(a.mat)
+    conforming.eliminate_zeros()
+    n = fes.ndof
+    summed = pb.broken.summed(n)
+    summed.eliminate_zeros()
+    assert (summed != conforming).nnz == 0
+    x = np.random.default_rng(3).normal(size=n)
+    assert np.array_equal(pb.broken.to_conforming(x[pb.broken.conforming]), x)
+
+
 @pytest.mark.parametrize("ordering", ["amd", "metis"])
 def test_cholesky_with_chosen_unknowns_last_gives_their_schur_complement(ordering):
     rng = np.random.default_rng(1)
