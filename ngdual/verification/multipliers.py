@@ -76,6 +76,11 @@ class Part:
     frame: str = "contact"
     ends: EndRule = EndRule()
 
+    def __post_init__(self):
+        if self.frame not in FRAMES:
+            raise SceneError("frame", f"unknown frame {self.frame!r}; choose one of "
+                             f"{', '.join(FRAMES)}")
+
 
 def model_parts() -> list[Part]:
     """Gamma_C = the bottom of the unit square, both ends fixed (clamped sides)."""
@@ -98,13 +103,13 @@ def scene_parts(scene, mesh: ngs.Mesh) -> list[Part]:
 class Basis:
     """A scalar multiplier space on the fine edges of one part, edge by edge.
 
-    ``dofs[e]`` are the dofs living on fine edge e (chain order of ``mesh``, a
-    :class:`CoarseMesh`) and ``coefficients[e]`` their polynomials in the edge's own
-    parameter t in [0, 1] (running along the chain), Legendre coefficients in 2t - 1,
-    one row per dof.
+    ``dofs[e]`` are the dofs living on fine edge e (in the chain order of ``coarse``, the
+    :class:`CoarseMesh` the space is built on) and ``coefficients[e]`` their polynomials in
+    the edge's own parameter t in [0, 1] (running along the chain), Legendre coefficients
+    in 2t - 1, one row per dof.
     """
 
-    mesh: CoarseMesh
+    coarse: CoarseMesh
     n_dofs: int
     dofs: tuple[np.ndarray, ...]
     coefficients: tuple[np.ndarray, ...]
@@ -144,8 +149,7 @@ def coarse_basis(coarse: CoarseMesh, order: int) -> Basis:
     parameter tau."""
     degree = order + 1
     dofs, coefficients, offset = [], [], 0
-    n_hats = coarse.n_p1_dofs
-    bubble = n_hats
+    bubble = coarse.n_p1_dofs                      # the bubbles' dofs follow the hats'
     for c, chain in enumerate(coarse.chains):
         carriers = coarse.dof_positions(c)
         hat = {int(p): offset + i for i, p in enumerate(carriers)}
@@ -199,6 +203,28 @@ def _boundary_elements(mesh: ngs.Mesh, labels) -> dict[tuple[int, int], int]:
             for el in mesh.Elements(ngs.BND) if el.mat in labels}
 
 
+def _host_shapes(host: ngs.FESpace, labels, rule: ngs.IntegrationRule):
+    """NGSolve's own quadrature points of ``rule`` on every boundary element (elements x
+    points x 2), the shape functions of the element-wise ``host`` there (elements x shapes x
+    points) and the host's dofs of the elements of ``labels``."""
+    mesh = host.mesh
+    points = mesh.MapToAllElements(rule, ngs.BND)
+    size = (mesh.GetNE(ngs.BND), len(rule.weights))
+    xy = np.stack([np.asarray(ngs.x(points)).reshape(size),
+                   np.asarray(ngs.y(points)).reshape(size)], axis=-1)
+    host_dofs = {el.nr: np.array(host.GetDofNrs(ngs.ElementId(ngs.BND, el.nr)))
+                 for el in mesh.Elements(ngs.BND) if el.mat in labels}
+    shape = ngs.GridFunction(host)
+    psi = []
+    # the i-th shape function of every element at once: the host is discontinuous
+    for i in range(len(next(iter(host_dofs.values())))):
+        shape.vec[:] = 0
+        for dofs in host_dofs.values():
+            shape.vec[int(dofs[i])] = 1
+        psi.append(np.asarray(shape(points)).reshape(size))
+    return xy, np.stack(psi, axis=1), host_dofs
+
+
 def pair(basis: Basis, part: Part, fes: ngs.FESpace, names: list[str], order: int
          ) -> PartPairing:
     """d(mu, tau) of (3.24) between ``basis`` (both components of ``part``) and the stresses
@@ -213,40 +239,26 @@ def pair(basis: Basis, part: Part, fes: ngs.FESpace, names: list[str], order: in
     degree = order + 1
     region = mesh.Boundaries("|".join(part.labels))
     host = ngs.Compress(ngs.SurfaceL2(mesh, order=degree, definedon=region))
-    trial = dict(zip(names, fes.TestFunction()))
-    traction = peers.stress_traction(trial["r1"], trial["r2"])
+    test = dict(zip(names, fes.TestFunction()))
+    traction = peers.stress_traction(test["r1"], test["r2"])
     n = ngs.specialcf.normal(2)
     components = ((traction[0], traction[1]) if part.frame == "cartesian"
                   else (tangent(n) * traction, n * traction))
-    rule = {ngs.SEGM: ngs.IntegrationRule(ngs.SEGM, 2 * degree + 2)}
+    rule = ngs.IntegrationRule(ngs.SEGM, 2 * degree + 2)
     D = []
     for component in components:
         form = ngs.BilinearForm(trialspace=host, testspace=fes)
-        form += host.TrialFunction() * component * ngs.ds(definedon=region, intrules=rule)
+        form += host.TrialFunction() * component * ngs.ds(definedon=region,
+                                                           intrules={ngs.SEGM: rule})
         form.Assemble()
         D.append(to_scipy(form.mat))
-    # the host's shape functions at NGSolve's own quadrature points of every edge
-    rule = ngs.IntegrationRule(ngs.SEGM, 2 * degree + 2)
-    points = mesh.MapToAllElements(rule, ngs.BND)
-    n_bnd = mesh.GetNE(ngs.BND)
-    xy = np.column_stack([np.asarray(ngs.x(points)).ravel(), np.asarray(ngs.y(points)).ravel()])
-    xy = xy.reshape(n_bnd, len(rule.weights), 2)
-    host_dofs = {el.nr: np.array(host.GetDofNrs(ngs.ElementId(ngs.BND, el.nr)))
-                 for el in mesh.Elements(ngs.BND) if el.mat in part.labels}
-    shape = ngs.GridFunction(host)
-    psi = []
-    for i in range(degree + 1):
-        shape.vec[:] = 0
-        for dofs in host_dofs.values():
-            shape.vec[int(dofs[i])] = 1
-        psi.append(np.asarray(shape(points)).reshape(n_bnd, len(rule.weights)))
-    psi = np.stack(psi, axis=1)                                    # elements x shapes x points
+    xy, psi, host_dofs = _host_shapes(host, part.labels, rule)
     element_of = _boundary_elements(mesh, part.labels)
-    pairs, _ = basis.mesh.fine_edges()
+    pairs, _ = basis.coarse.fine_edges()
     mass = np.zeros((basis.n_dofs, basis.n_dofs))
     stiff = np.zeros_like(mass)
     rows, cols, vals = [], [], []
-    ends = []                                                      # values at t = 0, 1
+    edge_ends = []                                            # values at t = 0, 1
     for e, (a, b) in enumerate(pairs):
         el = element_of[tuple(sorted((int(a), int(b))))]
         pa, pb = np.array(mesh[ngs.NodeId(ngs.VERTEX, int(a))].point), \
@@ -267,8 +279,8 @@ def pair(basis: Basis, part: Part, fes: ngs.FESpace, names: list[str], order: in
         rows.append(r.ravel())
         cols.append(c.ravel())
         vals.append(coefficients.ravel())
-        ends.append((dofs, basis.values(e, np.array([0.0, 1.0])), length))
-    stiff += _jump_penalty(basis, ends)
+        edge_ends.append((dofs, basis.values(e, np.array([0.0, 1.0])), length))
+    stiff += _jump_penalty(basis, edge_ends)
     P = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
                       shape=(host.ndof, basis.n_dofs))
     B = sp.hstack([d @ P for d in D], format="csr")
@@ -281,7 +293,7 @@ def _jump_penalty(basis: Basis, ends: list) -> np.ndarray:
     from the values of every edge's dofs at its two ends."""
     penalty = np.zeros((basis.n_dofs, basis.n_dofs))
     first = 0
-    for chain, (free_first, free_last) in zip(basis.mesh.chains, basis.mesh.free):
+    for chain, (free_first, free_last) in zip(basis.coarse.chains, basis.coarse.free):
         edges = list(range(first, first + chain.n_edges))
         first += chain.n_edges
         joints = list(zip(edges[:-1], edges[1:]))
