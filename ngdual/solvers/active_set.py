@@ -10,7 +10,7 @@
    solved by semismooth Newton (:mod:`ngdual.solvers.semismooth`). Coulomb friction is
    the fixed point F = mu_f |sigma_n| of (3.123) (Remark 3.45) on that small problem only:
    sigma_n per fine edge is t_f,n / |e|.
-4. One back substitution gives the remaining unknowns, NGSolve's local solves sigma and u.
+4. One back substitution gives the remaining unknowns, the element-local solves sigma and u.
 
 The result is the discrete solution of (3.62) itself (not an approximation of it): the
 residuals of every row of the assembled system and of the contact and friction conditions
@@ -253,7 +253,7 @@ def _active_set_solve(problem: DiscreteProblem, settings: ActiveSetSettings, tol
     timings["hybrid_assemble"] = hybrid.assemble_seconds
     chol = SchurCholesky(hybrid.H, hybrid.contact_index, ordering)             # step 2
     timings["cholesky"] = sum(chol.seconds.values())
-    # the hybridisation (assembly and static condensation) prepares the factorisation
+    # the hybridisation (edge coupling and static condensation) prepares the factorisation
     timings["factorize"] = timings["hybridize"] + timings["cholesky"]
     start = time.perf_counter()
     y = chol.forward(hybrid.r)
