@@ -23,7 +23,7 @@ import ngsolve as ngs
 import numpy as np
 import scipy.sparse as sp
 
-from .boundary import CoarseMesh, edge_normals
+from .boundary import CoarseMesh, FacetMesh, edge_normals
 from .expr import Expression
 from .geometry import tangent
 from .scene import Scene, gap_at
@@ -53,6 +53,17 @@ def _vertex_normals(chain) -> np.ndarray:
     return mean / np.linalg.norm(mean, axis=1)[:, None]
 
 
+def _means(space: ngs.FESpace, labels: list[str], bubble_dofs: np.ndarray,
+           lengths: np.ndarray) -> np.ndarray:
+    """The means over their fine edges of the functions ``bubble_dofs`` of ``space``."""
+    if not bubble_dofs.size:
+        return np.zeros(bubble_dofs.shape)
+    integrals = ngs.LinearForm(space)
+    integrals += space.TestFunction() * ngs.ds(definedon=space.mesh.Boundaries("|".join(labels)))
+    integrals.Assemble()
+    return integrals.vec.FV().NumPy()[bubble_dofs] / lengths[:, None]
+
+
 def gap_coefficient(scene: Scene) -> ngs.CoefficientFunction:
     """g on Gamma_C as an NGSolve coefficient (boundary integrals only: it may use n)."""
     contact = scene.contact
@@ -80,7 +91,12 @@ class ContactBoundary:
         (n, 2) dofs of the fine trace space of lambda at the start and end of every
         fine edge. That space is P1 on every fine edge and discontinuous from edge to
         edge (``Discontinuous(H1, BND=True)``): the coarse multipliers are continuous
-        along a chain but not across a kink, where two chains share a vertex.
+        along a chain but not across a kink, where two chains share a vertex. With the
+        facet multipliers of order k (``coarse`` a :class:`~ngdual.boundary.facet.FacetMesh`)
+        the space is P_max(k,1) on every fine edge and these are its vertex dofs.
+    bubble_dofs, bubble_means : numpy.ndarray
+        (n, k - 1) dofs of the edge bubbles of that space on every fine edge and the means
+        of their functions over it (none for the P1 trace space).
     """
 
     scene: Scene
@@ -93,20 +109,29 @@ class ContactBoundary:
     htilde_edge: np.ndarray
     hhat_edge: np.ndarray | None
     edge_dofs: np.ndarray
+    bubble_dofs: np.ndarray
+    bubble_means: np.ndarray
 
     @classmethod
     def build(cls, scene: Scene, coarse: CoarseMesh, friction: CoarseMesh | None,
               space: ngs.FESpace) -> ContactBoundary:
         """Gamma_C from its coarse meshes and the fine trace space (:func:`trace_space`)."""
         vertices, htilde_edge = coarse.fine_edges()
-        edge_dofs = coarse.fine_edge_dofs(space)
+        if isinstance(coarse, FacetMesh):
+            host = coarse.host_dofs(space)
+            edge_dofs, bubble_dofs = host[:, :2], host[:, 2:]
+        else:
+            edge_dofs = coarse.fine_edge_dofs(space)
+            bubble_dofs = np.zeros((len(edge_dofs), 0), dtype=int)
         pts = [ch.path_points for ch in coarse.chains]
         starts = np.vstack([p[:-1] for p in pts])
         ends = np.vstack([p[1:] for p in pts])
+        lengths = np.linalg.norm(ends - starts, axis=1)
         normals = np.vstack([edge_normals(ch) for ch in coarse.chains])
         hhat_edge = friction.fine_edges()[1] if friction is not None else None
-        return cls(scene, coarse, friction, vertices, np.linalg.norm(ends - starts, axis=1),
-                   0.5 * (starts + ends), normals, htilde_edge, hhat_edge, edge_dofs)
+        return cls(scene, coarse, friction, vertices, lengths, 0.5 * (starts + ends), normals,
+                   htilde_edge, hhat_edge, edge_dofs, bubble_dofs,
+                   _means(space, scene.labels("contact"), bubble_dofs, lengths))
 
     def __len__(self) -> int:
         return len(self.lengths)
@@ -121,9 +146,15 @@ class ContactBoundary:
         return self.coarse.p1_prolongation(self.edge_dofs, n_fine, ends)
 
     def hat_means(self, prolongation: sp.csr_matrix) -> sp.csr_matrix:
-        """M (n_edges x N_C): the mean of every coarse function on every fine edge."""
+        """M (n_edges x N_C): the mean of every coarse function on every fine edge.
+
+        The vertex functions of the trace space have the mean 1/2 on their edge, its bubbles
+        ``bubble_means`` (facet multipliers of order k >= 2)."""
         P = prolongation.tocsr()
-        return (0.5 * (P[self.edge_dofs[:, 0]] + P[self.edge_dofs[:, 1]])).tocsr()
+        means = 0.5 * (P[self.edge_dofs[:, 0]] + P[self.edge_dofs[:, 1]])
+        for j in range(self.bubble_dofs.shape[1]):
+            means = means + sp.diags(self.bubble_means[:, j]) @ P[self.bubble_dofs[:, j]]
+        return means.tocsr()
 
     def vertex_values(self, fine: np.ndarray) -> np.ndarray:
         """Fine trace values at the vertices of every chain (``path_points`` order)."""
@@ -184,6 +215,10 @@ class ContactBoundary:
         lambda_n = g_h, sigma = 0 solves (3.62) for any g >= 0 (g itself would prescribe
         u_n = g - lambda_n on the fine edges wherever g is not P1 on h~).
         """
+        if isinstance(self.coarse, FacetMesh):
+            # the facet multipliers: g interpolated on every fine edge (FacetMesh.interpolant)
+            return prolongation @ self.coarse.interpolant(
+                lambda points, edges: gap_at(self.scene.contact, points, self.normals[edges]))
         at_dofs, at_ends = self.gap_at_nodes()
         return prolongation @ at_dofs + end_hats @ at_ends
 

@@ -23,7 +23,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from . import peers
-from .boundary import BoundaryMeshes, CoarseMesh
+from .boundary import BoundaryMeshes, CoarseMesh, FacetMesh, end_rule, host_space
 from .contact import ContactBoundary, gap_coefficient, trace_space
 from .expr import Expression
 from .geometry import tangent
@@ -41,8 +41,17 @@ TRACE_RULES = {ngs.SEGM: ngs.IntegrationRule(ngs.SEGM, TRACE_ORDER)}
 # triangle: sigma, tau are RT_0 (degree 1) plus Curl of a cubic bubble (degree 2), u is
 # constant, eta linear. The 6-point rule of degree 4 integrates them exactly; NGSolve's
 # default (degree 6, twice the order 3 of the bubble space) gives the same matrix to
-# round-off with twice the points.
+# round-off with twice the points. At order k the stress has degree k + 2 (k + 1 for AFW)
+# and the compliance integrand twice that (:func:`volume_rules`).
 EXACT_VOLUME_RULES = {ngs.TRIG: ngs.IntegrationRule(ngs.TRIG, 4)}
+
+
+def volume_rules(order: int = 0, family: str = "peers") -> dict:
+    """The rule of degree 2 * :func:`ngdual.peers.stress_degree` on every triangle, which
+    integrates the PEERS form of order k exactly (:data:`EXACT_VOLUME_RULES` at k = 0)."""
+    degree = 2 * peers.stress_degree(family, order)
+    return EXACT_VOLUME_RULES if degree == 4 else {ngs.TRIG: ngs.IntegrationRule(ngs.TRIG,
+                                                                                 degree)}
 # NGSolve's task manager wakes and synchronises its threads in every parallel loop: on a
 # 2-core machine with the other core busy a loop waits up to ~0.1 s for the descheduled
 # worker whatever its size (d.Assemble of hertz-cylinder, 28 000 unknowns: 0.11 s in the
@@ -58,9 +67,9 @@ def parallel_tasks(mesh: ngs.Mesh):
     return ngs.TaskManager() if mesh.ne >= PARALLEL_ELEMENTS else contextlib.nullcontext()
 
 
-def peers_form(trial: dict, test: dict, lame: tuple[float, float]
-               ) -> ngs.comp.SumOfIntegrals:
-    """The PEERS block of (3.62) on T_h, with its exact volume rule:
+def peers_form(trial: dict, test: dict, lame: tuple[float, float], order: int = 0,
+               family: str = "peers") -> ngs.comp.SumOfIntegrals:
+    """The PEERS block of (3.62) on T_h, with its exact volume rule (:func:`volume_rules`):
 
         a~(sigma, tau) + b(u, tau) + b(v, sigma) + s(eta, tau) + s(xi, sigma),
 
@@ -75,11 +84,14 @@ def peers_form(trial: dict, test: dict, lame: tuple[float, float]
         :func:`broken_peers`, the conforming one of :mod:`ngdual.verification`).
     lame : tuple of float
         Lame's constants (lambda, mu).
+    order, family : int, str
+        The order k and the family of the spaces (:func:`ngdual.peers.family_spaces`), which
+        fix the degree of the rule.
     """
     lam, mu = lame
     sig, div_sig, u, eta = peers.triple(trial)
     tau, div_tau, v, xi = peers.triple(test)
-    dx = ngs.dx(intrules=EXACT_VOLUME_RULES)
+    dx = ngs.dx(intrules=volume_rules(order, family))
     # three integrals, each compiled on its own: the element matrices of a~, b, s are summed
     # in this order in every assembly
     return (ngs.InnerProduct(peers.compliance(sig, lam, mu), tau).Compile() * dx  # a~
@@ -98,9 +110,12 @@ def _trace_space(mesh: ngs.Mesh, labels: list[str]) -> ngs.FESpace:
 
 @dataclass
 class Spaces:
-    """Fine component spaces, the coarse boundary meshes and their prolongations.
+    """Fine component spaces, the boundary meshes of the multipliers and their prolongations.
 
-    Building this object assembles nothing: it is all that DOF counting needs.
+    Building this object assembles nothing: it is all that DOF counting needs. ``order`` is
+    the order k of PEERS_k, ``family`` that of the multipliers (``discretisation``: the
+    thesis' P1 on h~, ``"coarse"``, or P_k on the fine edges in the Bernstein basis,
+    ``"facet"``, :mod:`ngdual.boundary.facet`).
     """
 
     mesh: ngs.Mesh
@@ -111,10 +126,15 @@ class Spaces:
     prolongations: dict[str, sp.csr_matrix] = field(default_factory=dict)
     end_hats: dict[str, sp.csr_matrix] = field(default_factory=dict)
     gamma_c: ContactBoundary | None = None
+    order: int = 0
+    family: str = "coarse"
 
     @classmethod
     def build(cls, scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes | None = None) -> Spaces:
-        """Spaces on ``mesh``; ``coarse`` carries coarse meshes over from an adaptive step."""
+        """Spaces on ``mesh``; ``coarse`` carries coarse meshes over from an adaptive step
+        (the facet multipliers live on the fine edges of ``mesh`` and need none)."""
+        if scene.discretisation.family == "facet":
+            return cls._facet(scene, mesh)
         comps = peers.peers_spaces(mesh)
         coarse = coarse or BoundaryMeshes.for_scene(scene, mesh)
         neumann = contact = friction = None
@@ -138,6 +158,28 @@ class Spaces:
             prolong["lam_t"] = prolong["lam_n"] = gamma_c.prolongation(space.ndof)
             end_hats["lam_t"] = end_hats["lam_n"] = gamma_c.prolongation(space.ndof, ends=True)
         return cls(mesh, comps, neumann, contact, friction, prolong, end_hats, gamma_c)
+
+    @classmethod
+    def _facet(cls, scene: Scene, mesh: ngs.Mesh) -> Spaces:
+        """PEERS_k with the facet P_k multipliers: no end is fixed, so nothing is lifted."""
+        order = scene.discretisation.order
+        comps = peers.peers_spaces(mesh, order)
+        meshes, prolong, end_hats = {}, {}, {}
+        for role, names in (("neumann", ("phi1", "phi2")), ("contact", ("lam_t", "lam_n"))):
+            labels = scene.labels(role)
+            if not labels:
+                continue
+            meshes[role] = FacetMesh.on_fine(mesh, labels, order, end_rule(scene, mesh, role))
+            space = host_space(mesh, labels, order)
+            p = meshes[role].prolongation(space, labels)
+            for name in names:
+                comps[name], prolong[name] = space, p
+                end_hats[name] = sp.csr_matrix((space.ndof, 0))
+        gamma_c = None
+        if "contact" in meshes:
+            gamma_c = ContactBoundary.build(scene, meshes["contact"], None, comps["lam_n"])
+        return cls(mesh, comps, meshes.get("neumann"), meshes.get("contact"), None, prolong,
+                   end_hats, gamma_c, order, "facet")
 
     def coarse_ndof(self, name: str) -> int:
         if name in self.prolongations:
@@ -225,6 +267,20 @@ def broken_peers(spaces: Spaces, lame: tuple[float, float]) -> BrokenPeers:
     return BrokenPeers(fes, a, to_scipy(a.mat, copy=False), np.concatenate(conforming))
 
 
+def conforming_peers(spaces: Spaces, lame: tuple[float, float], size: int) -> sp.csr_matrix:
+    """The PEERS block of (3.62) of order ``spaces.order``, assembled on the conforming
+    spaces, as the leading block of a ``size`` x ``size`` matrix."""
+    comps = [spaces.components[name] for name in peers.PEERS]
+    fes = ngs.FESpace(comps)
+    a = ngs.BilinearForm(fes)
+    a += peers_form(dict(zip(peers.PEERS, fes.TrialFunction())),
+                    dict(zip(peers.PEERS, fes.TestFunction())), lame, spaces.order)
+    with parallel_tasks(spaces.mesh):
+        a.Assemble()
+    K = to_scipy(a.mat).tocoo()
+    return sp.csr_matrix((K.data, (K.row, K.col)), shape=(size, size))
+
+
 def _edge_of_broken(rt: ngs.FESpace, broken_rt: ngs.FESpace, tol: float = 1e-8) -> np.ndarray:
     """The RT_0 function (of ``rt``) whose restriction to its triangle every broken one is.
 
@@ -264,8 +320,10 @@ class DiscreteProblem:
         Gamma_N (zero for the homogeneous Dirichlet data of the thesis).
     blocks : dict[str, slice]
         Position of every component in the unknown vector.
-    broken : BrokenPeers
-        The PEERS block element by element, from which K's PEERS block was summed.
+    broken : BrokenPeers or None
+        The PEERS block element by element, from which K's PEERS block was summed (the
+        hybridised solver's input); None at order k >= 1 or with the facet multipliers,
+        whose PEERS block is assembled on the conforming spaces (:func:`conforming_peers`).
     """
 
     scene: Scene
@@ -277,7 +335,7 @@ class DiscreteProblem:
     rhs: np.ndarray
     blocks: dict[str, slice]
     lift: np.ndarray
-    broken: BrokenPeers
+    broken: BrokenPeers | None
     assemble_seconds: float
     level: int | None = None
 
@@ -363,7 +421,8 @@ def assemble(scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes | None = None
     spaces = Spaces.build(scene, mesh, coarse)
     names = list(spaces.components)
     fes = ngs.FESpace([spaces.components[n] for n in names])
-    broken = broken_peers(spaces, scene.material.lame)
+    thesis = spaces.order == 0 and spaces.family == "coarse"
+    broken = broken_peers(spaces, scene.material.lame) if thesis else None
     d, rhs = _forms(scene, fes, names)
     for form in (d, rhs):
         if form is not None:
@@ -377,7 +436,8 @@ def assemble(scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes | None = None
         offset += p.shape[1]
     P = sp.block_diag(blocks_p, format="csr")
     # the PEERS unknowns come first and are not prolonged
-    volume = broken.summed(P.shape[1])
+    volume = broken.summed(P.shape[1]) if thesis else conforming_peers(
+        spaces, scene.material.lame, P.shape[1])
     lift = _end_lift(scene, spaces, fes, names)
     F = P.T @ rhs.vec.FV().NumPy()
     if d is not None:

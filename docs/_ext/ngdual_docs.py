@@ -200,6 +200,13 @@ MEANINGS = {
     "benchmark.slope": "Slope s of the wedge's flanks, cot of its semi-angle (`wedge`).",
     "benchmark.center": "Point [x, y] of the foundation line where the analytic solution "
                         "is centred.",
+    "discretisation.order": "Polynomial order k of PEERS_k (0, 1, 2): stress rows in RT_k "
+                            "plus Curl bubbles, u in P_k, the rotation in P_{k+1}; 0 is the "
+                            "thesis (see theory/order).",
+    "discretisation.multipliers": "Family of phi, lambda_n, lambda_t: `coarse` (P1 on h~, "
+                                  "order 0 only), `facet` (discontinuous P_k on the fine "
+                                  "edges, lambda_n >= 0 on its Bernstein coefficients, "
+                                  "frictionless) or `auto` (coarse at k = 0, facet above).",
 }
 
 # the module constant that lists the allowed values of a key
@@ -210,7 +217,8 @@ CHOICES = {
     "solver.method": "SOLVER_METHODS", "solver.metric": "METRICS",
     "solver.loop_order": "LOOP_ORDERS", "solver.friction_metric": "FRICTION_METRICS",
     "units.length": "LENGTH_UNITS", "units.stress": "STRESS_UNITS",
-    "benchmark.kind": "BENCHMARK_KINDS",
+    "benchmark.kind": "BENCHMARK_KINDS", "discretisation.order": "ORDERS",
+    "discretisation.multipliers": "MULTIPLIER_FAMILIES",
 }
 
 

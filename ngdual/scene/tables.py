@@ -37,6 +37,12 @@ LENGTH_UNITS = ("m", "cm", "mm", "um", "km", "in", "ft")
 STRESS_UNITS = ("Pa", "kPa", "MPa", "GPa", "N/mm^2", "psi", "ksi")
 
 
+ORDERS = (0, 1, 2)
+
+
+MULTIPLIER_FAMILIES = ("auto", "coarse", "facet")
+
+
 class SceneError(ValueError):
     """A scene that cannot be solved; ``field`` names the offending entry.
 
@@ -267,6 +273,33 @@ class Solver:
 
 
 @dataclass
+class Discretisation:
+    """The polynomial order k of the PEERS family and the family of the boundary multipliers.
+
+    ``order``: k = 0 (default) is the triple (3.61) of the thesis; k = 1, 2 take the stress
+    rows in RT_k plus the Curl of the element bubbles, u in discontinuous P_k and the
+    rotation in continuous P_{k+1} (:func:`ngdual.peers.peers_spaces`).
+
+    ``multipliers``: the space of phi on Gamma_N and of lambda_n, lambda_t on Gamma_C.
+    ``"coarse"``: continuous P1 on the h~ mesh (C_h~ of (3.61), order 0 only);
+    ``"facet"``: discontinuous P_k on the fine edges, the normal traces of RT_k (the
+    hybridisation pairing, inf-sup stable by construction, docs/theory/order.md), with the
+    sign condition lambda_n >= 0 on the Bernstein coefficients of every fine edge;
+    ``"auto"`` (default): ``"coarse"`` at k = 0 (the thesis), ``"facet"`` at k >= 1.
+    """
+
+    order: int = 0
+    multipliers: str = "auto"
+
+    @property
+    def family(self) -> str:
+        """The multiplier family ``multipliers`` stands for at this order."""
+        if self.multipliers != "auto":
+            return self.multipliers
+        return "coarse" if self.order == 0 else "facet"
+
+
+@dataclass
 class Units:
     """The units the numbers of the scene are in, for the labels of plots and records.
 
@@ -324,6 +357,7 @@ class Scene:
     solver: Solver = field(default_factory=Solver)
     units: Units = field(default_factory=Units)
     benchmark: Benchmark = field(default_factory=Benchmark)
+    discretisation: Discretisation = field(default_factory=Discretisation)
 
     @property
     def has_contact(self) -> bool:
@@ -344,7 +378,7 @@ class Scene:
 
 SECTIONS = {"geometry": Geometry, "material": Material, "loads": Loads,
              "contact": Contact, "friction": Friction, "solver": Solver, "units": Units,
-             "benchmark": Benchmark}
+             "benchmark": Benchmark, "discretisation": Discretisation}
 
 
 ROLES = ("dirichlet", "neumann", "contact")

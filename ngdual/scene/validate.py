@@ -17,7 +17,9 @@ from .tables import (
     LENGTH_UNITS,
     LOOP_ORDERS,
     METRICS,
+    MULTIPLIER_FAMILIES,
     NORMAL_STRESSES,
+    ORDERS,
     SECTIONS,
     SOLVER_METHODS,
     STRESS_UNITS,
@@ -97,6 +99,8 @@ def validate(scene: Scene) -> None:
         _validate_units(scene.units, problems)
     if ok["benchmark"] and ok["friction"]:
         problems.run(_validate_benchmark, scene)
+    if ok["discretisation"] and ok["friction"] and ok["solver"] and ok["contact"]:
+        problems.run(_validate_discretisation, scene)
     if ok["solver"] and ok["friction"] and scene.solver.method in SOLVER_METHODS:
         reported = {f for f, _ in problems.found}
         for f, m in _settings_without_effect(scene):
@@ -161,6 +165,32 @@ def _validate_friction_settings(scene: Scene) -> None:
                                                "one of " + ", ".join(NORMAL_STRESSES))
     with problems.check():
         expression(fr.bound, "friction.bound")
+    problems.raise_any()
+
+
+def _validate_discretisation(scene: Scene) -> None:
+    """The order k and the multiplier family, and what each family can solve."""
+    disc, problems = scene.discretisation, Problems()
+    if isinstance(disc.order, bool) or disc.order not in ORDERS:
+        problems.add("discretisation.order", f"the polynomial order k must be one of "
+                                             f"{', '.join(map(str, ORDERS))}, got "
+                                             f"{show(disc.order)}")
+    if disc.multipliers not in MULTIPLIER_FAMILIES:
+        problems.add("discretisation.multipliers", f"unknown family {show(disc.multipliers)}; "
+                                                   "use one of " + ", ".join(MULTIPLIER_FAMILIES))
+    problems.raise_any()
+    if disc.family == "coarse" and disc.order > 0:
+        problems.add("discretisation.multipliers", f"the coarse multipliers are the thesis' P1 "
+                     f"on h~, of order 0 only; at order {disc.order} use \"facet\" (or \"auto\")")
+    if disc.family == "facet":
+        if scene.has_friction:
+            problems.add("friction.law", f"{show(scene.friction.law)} friction is solved on "
+                         "the coarse multipliers only; the facet multipliers solve "
+                         "frictionless contact (friction.law = \"none\")")
+        if scene.solver.method == "uzawa":
+            problems.add("solver.method", "the Uzawa algorithms iterate in the metrics of the "
+                         "coarse h~ mesh; the facet multipliers are solved by \"active-set\" "
+                         "(or \"auto\")")
     problems.raise_any()
 
 

@@ -13,7 +13,10 @@ Tresca / Coulomb     -> Algorithm 3.41 / Remark 3.45 (nested Uzawa)
 ``solver.method = "active-set"`` or ``"auto"`` (default): the hybridised system, one
 Cholesky factorisation, and for contact the semismooth Newton method on Gamma_C
 (:mod:`ngdual.solvers.active_set`): the same discrete solution at about the cost of one linear
-solve.
+solve. The hybridisation is that of broken RT_0 rows and the P1 multipliers on h~; at order
+k >= 1 or with the facet multipliers (``discretisation``) the problem has no such system
+(``problem.broken`` is None) and the active-set method runs on the conforming K, one sparse
+LU per active set (:mod:`ngdual.solvers.conforming`).
 """
 
 from __future__ import annotations
@@ -32,6 +35,7 @@ from ..mesh import build_mesh
 from ..quadrature_check import check_formulas
 from ..scene import Scene, SceneError, SceneTypeError, check_level, ensure_valid
 from .active_set import ContactStart, active_set_solve
+from .conforming import conforming_active_set
 from .linear import solve_linear
 from .nested import nested_uzawa
 from .result import ConvergenceError, PhysicsWarning, Solution
@@ -166,7 +170,9 @@ def solve_problem(problem: DiscreteProblem, settings: Settings | None = None,
     if start is not None and not isinstance(settings, ActiveSetSettings):
         raise ValueError(f"a warm start is for the active-set method, not "
                          f"{type(settings).__name__}")
-    if isinstance(settings, ActiveSetSettings):
+    if isinstance(settings, ActiveSetSettings) and problem.broken is None:
+        solution = conforming_active_set(problem, settings, start=start)
+    elif isinstance(settings, ActiveSetSettings):
         solution = active_set_solve(problem, settings, progress=progress, start=start)
     elif isinstance(settings, LinearSettings):
         solution = solve_linear(problem)
