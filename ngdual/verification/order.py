@@ -11,8 +11,8 @@ the triple (X_h, M_h, S_h) of :mod:`ngdual.peers` alone. The system is the PEERS
     -f(v) + <u_D, tau n>_{Gamma_D},
 
 the Dirichlet datum entering naturally as in (3.62). At order k the PEERS stress has degree
-k + 2, so that the compliance integrand has degree 2k + 4; the form is integrated with the
-rule of that degree (:func:`exact_rule`; ``peers_form``'s own rule is that of k = 0).
+k + 2, so that the compliance integrand has degree 2k + 4; ``peers_form`` integrates it with
+the rule of that degree (:func:`ngdual.forms.volume_rules`).
 
 A priori (Arnold, Brezzi, Douglas 1984; Stenberg 1988; Arnold, Falk, Winther 2007) sigma, u
 and the rotation converge like h^{k+1} in L^2 for both families; :func:`convergence_study`
@@ -25,10 +25,8 @@ square with the machinery of :mod:`ngdual.verification.infsup`.
 from __future__ import annotations
 
 import math
-import operator
 import time
 from dataclasses import dataclass
-from functools import reduce
 
 import ngsolve as ngs
 import numpy as np
@@ -46,12 +44,6 @@ E, NU = 1.0, 0.3
 LAME = (E * NU / ((1 + NU) * (1 - 2 * NU)), E / (2 * (1 + NU)))    # plane strain (lambda, mu)
 DIRICHLET, NEUMANN = "left|bottom", "right|top"
 QUANTITIES = ("sigma", "u", "eta")
-
-
-def exact_rule(form: ngs.comp.SumOfIntegrals, degree: int) -> ngs.comp.SumOfIntegrals:
-    """``form`` (volume integrals) with the Gauss rule of ``degree`` on every triangle."""
-    rules = {ngs.TRIG: ngs.IntegrationRule(ngs.TRIG, degree)}
-    return reduce(operator.add, (integral.coef * ngs.dx(intrules=rules) for integral in form))
 
 
 def unit_square(level: int) -> ngs.Mesh:
@@ -165,9 +157,8 @@ def assemble_elasticity(mesh: ngs.Mesh, family: str = "peers", order: int = 0,
     fes = ngs.FESpace([spaces[n] for n in names])
     trial = dict(zip(names, fes.TrialFunction()))
     test = dict(zip(names, fes.TestFunction()))
-    degree = 2 * peers.stress_degree(family, order)
     a = ngs.BilinearForm(fes)
-    a += exact_rule(peers_form(trial, test, exact.lame), degree)
+    a += peers_form(trial, test, exact.lame, order, family)
     a.Assemble()
     v = peers.triple(test)[2]
     trac_tau = peers.stress_traction(test["r1"], test["r2"])
