@@ -172,19 +172,22 @@ class HybridSystem:
         self.mesh = mesh
         broken = problem.broken
         facet = ngs.FacetFESpace(mesh, order=0)
-        self.n_eta = broken.fes.Range(peers.PEERS.index("eta")).stop - \
-            broken.fes.Range(peers.PEERS.index("eta")).start
+        eta = broken.fes.Range(peers.PEERS.index("eta"))
+        self.n_eta = eta.stop - eta.start
         self.n_interface = self.n_eta + 2 * facet.ndof
-        self._elements(broken, _edge_coupling(broken.fes.components[0], facet), facet.ndof)
+        broken_rt = broken.fes.components[peers.PEERS.index("r1")]
+        blocks = self._elements(broken, _edge_coupling(broken_rt, facet), facet.ndof)
         self.assemble_seconds = time.perf_counter() - start
 
         start = time.perf_counter()
-        S, g = self._condense(broken)
+        S, g = self._condense(*blocks, broken.matrix[eta.start:eta.stop][:, eta.start:eta.stop])
         self._reduction(model, facet, S, g)
         self.reduce_seconds = time.perf_counter() - start
 
-    def _elements(self, broken, coupling: sp.csr_matrix, n_facets: int) -> None:
-        """Every triangle's local unknowns, its interface unknowns and its blocks B_T, C_T.
+    def _elements(self, broken, coupling: sp.csr_matrix, n_facets: int
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """B_T, C_T and f_T of every triangle (stacked); its local unknowns (``local``) and
+        its interface unknowns (``interface``: eta, then mu_1, mu_2 after them).
 
         Read from NGSolve's sparsity pattern: a row of an element-local unknown holds
         exactly the unknowns of its triangle, sorted, the local ones (the broken sigma rows,
@@ -220,39 +223,36 @@ class HybridSystem:
             raise RuntimeError("the edge coupling does not have one block per triangle")
         facets = coupling.indices[at[:, 0, :]]
         flux = coupling.data[at]
-        n_eta = width - n_local
+        n_vertices = width - n_local
         self.interface = np.concatenate([dofs[:, n_local:] - eta.start,
                                          self.n_eta + facets,
                                          self.n_eta + n_facets + facets], axis=1)
-        C = np.zeros((len(local), n_local, n_eta + 2 * n_edges))
-        C[:, :, :n_eta] = values[:, :, n_local:]
+        C = np.zeros((len(local), n_local, n_vertices + 2 * n_edges))
+        C[:, :, :n_vertices] = values[:, :, n_local:]
         for k, (pos, _) in enumerate(rt_rows):
-            C[:, pos[:, None], n_eta + k * n_edges + np.arange(n_edges)] = flux
+            C[:, pos[:, None], n_vertices + k * n_edges + np.arange(n_edges)] = flux
         load = np.zeros(fes.ndof)
         for name in ("u1", "u2"):
             rg = ranges[peers.PEERS.index(name)]
             load[rg.start:rg.stop] = pb.rhs[pb.blocks[name]]
-        self.local, self._B, self._C, self._f = local, values[:, :, :n_local], C, load[local]
-        self._ranges = ranges
+        self.local, self._ranges = local, ranges
+        return values[:, :, :n_local], C, load[local]
 
-    def _condense(self, broken) -> tuple[sp.csr_matrix, np.ndarray]:
-        """S and g on the interface unknowns (eta, mu_1, mu_2); keeps B_T^{-1} C_T and
-        B_T^{-1} f_T for :meth:`unknowns`."""
-        C = self._C
-        solved = np.linalg.solve(self._B, np.concatenate([C, self._f[..., None]], axis=2))
+    def _condense(self, B: np.ndarray, C: np.ndarray, f: np.ndarray, K_eta: sp.csr_matrix
+                  ) -> tuple[sp.csr_matrix, np.ndarray]:
+        """S and g on the interface unknowns (eta, mu_1, mu_2), K_eta their block K_II;
+        keeps B_T^{-1} C_T and B_T^{-1} f_T for :meth:`unknowns`."""
+        solved = np.linalg.solve(B, np.concatenate([C, f[..., None]], axis=2))
         self._extension, self._inner = solved[..., :-1], solved[..., -1]
-        del self._B, self._f
         schur = -np.einsum("eki,ekj->eij", C, self._extension)
         iface, n = self.interface, self.n_interface
         g = -np.bincount(iface.ravel(), np.einsum("eki,ek->ei", C, self._inner).ravel(),
                          minlength=n)
-        del self._C
         width = iface.shape[1]
         S = sp.csr_matrix((schur.ravel(), (np.repeat(iface, width, axis=1).ravel(),
                                            np.tile(iface, (1, width)).ravel())), shape=(n, n))
-        eta = self._ranges[peers.PEERS.index("eta")]
-        K_eta = broken.matrix[eta.start:eta.stop][:, eta.start:eta.stop].tocoo()
-        if K_eta.nnz and np.any(K_eta.data):
+        K_eta = K_eta.tocoo()
+        if np.any(K_eta.data):  # a~ + b + s has no eta-eta term; kept for any volume form
             S = S + sp.csr_matrix((K_eta.data, (K_eta.row, K_eta.col)), shape=(n, n))
         return S, g
 
