@@ -7,8 +7,9 @@
   coarse P1 space of ngdual.boundary.
 * The chosen pairs -- continuous degree k + 1 on h~ = 2h and discontinuous P_k on the fine
   edges -- keep beta_h above a fixed bound and gamma_h below one, k = 0, 1, 2, over four
-  refinements (the table of docs/theory/order.md); on h~ = h the continuous multipliers
-  against PEERS_k lose stability like h.
+  refinements (the tables of docs/theory/order.md: the unit square, and Example 3.46 with
+  Gamma_N and Gamma_C); on h~ = h the continuous multipliers against PEERS_k lose
+  stability like h.
 """
 
 from pathlib import Path
@@ -81,6 +82,16 @@ def test_the_chosen_pairs_have_the_documented_constants_on_two_levels(multiplier
     assert [b for b, _ in found] == pytest.approx([b for b, _ in expected], abs=5e-5)
     assert [g for _, g in found] == pytest.approx([g for _, g in expected], abs=5e-3)
     assert min(b for b, _ in found) > BETA_MIN and max(g for _, g in found) < GAMMA_MAX
+
+
+@pytest.mark.parametrize("multipliers, ratio", CHOSEN)
+def test_the_chosen_pairs_of_order_1_on_example_3_46_have_the_documented_constants(
+        multipliers, ratio):
+    scene = load_scene("thesis-3.46-frictionless", [])
+    found = [m.scene_constants(scene, level, multipliers, 1, ratio)["beta"] for level in (1, 2)]
+    expected = [b for b, _ in documented("3.46", multipliers, ratio, 1)[:2]]
+    assert found == pytest.approx(expected, abs=5e-5)
+    assert min(found) > BETA_MIN
 
 
 @pytest.mark.parametrize("k", [0, 1])
