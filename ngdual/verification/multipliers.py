@@ -25,15 +25,17 @@ families: the interpolation norm between L^2(Gamma) and the broken H^1 norm
 
     |mu|_{1,h}^2 = sum_e ||d mu / ds||_{L^2(e)}^2 + sum_z [mu]_z^2 / h_z,
 
-the second sum over the interior vertices z of the fine edges of every chain (h_z the mean
-length of the two edges at z, [mu]_z the jump), computed by
-:func:`ngdual.verification.infsup.half_norm`. On continuous multipliers the jumps vanish and
-it is the discrete H^{1/2} norm of ``ngdual bench infsup``; on discontinuous ones it is the
-H^{1/2} norm of the DG literature, which grows like h^{-1/2} ||mu||_{L^2} on a multiplier
-that alternates from edge to edge exactly as sup_tau d(mu, tau) / ||tau||_{H(div)} does
-(a Curl-free RT_0 lifting through the boundary triangles), so that beta_h and gamma_h are
-both bounded iff the pairing is uniformly stable and continuous in the norms of the
-analysis (Lemma 3.28: H(div) on the stresses). docs/theory/order.md derives it.
+the second sum over the interior vertices z of the fine edges of every chain and its fixed
+ends, where mu jumps to the zero outside the part (H^{1/2}_00; h_z the mean length of the
+edges at z, [mu]_z the jump); :func:`ngdual.verification.infsup.half_norm` interpolates. On
+continuous multipliers that vanish at the fixed ends the jumps vanish and it is the discrete
+H^{1/2} norm of ``ngdual bench infsup``; on discontinuous ones it is the H^{1/2}_00 norm of
+the DG literature, which grows like h^{-1/2} ||mu||_{L^2} on a multiplier that alternates
+from edge to edge, as sup_tau d(mu, tau) / ||tau||_{H(div)} does (a divergence-free RT_0
+field through the boundary triangles). beta_h and gamma_h both bounded say that this
+discrete dual norm is uniformly equivalent to |.|_{1/2,h}: the pairing is stable in the
+norms of the analysis (Lemma 3.28: H(div) on the stresses), not in a weaker mesh-dependent
+one. docs/theory/order.md derives it.
 
 The matrix of d is assembled by NGSolve between the stresses and a host space of
 discontinuous P_{k+1} on the fine edges (``SurfaceL2``) and restricted to a family by the
