@@ -5,6 +5,8 @@
   inf-sup constants of ``ngdual bench infsup`` (assembled by ngdual.forms from the coarse
   P1 prolongation) on the shipped scenes, and the mass and arc-length stiffness of the
   coarse P1 space of ngdual.boundary.
+* The facet P_k multipliers of the contact solver (ngdual.boundary.facet, Bernstein basis,
+  d assembled by ngdual.forms) have the constants of this module's facet family, k = 1, 2.
 * The chosen pairs -- continuous degree k + 1 on h~ = 2h and discontinuous P_k on the fine
   edges -- keep beta_h above a fixed bound and gamma_h below one, k = 0, 1, 2, over four
   refinements (the tables of docs/theory/order.md: the unit square, and Example 3.46 with
@@ -16,12 +18,18 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import scipy.linalg as sla
+from numpy.polynomial import legendre
 
 from ngdual import peers
 from ngdual.boundary import CoarseMesh
+from ngdual.boundary.facet import bernstein_values
+from ngdual.forms import assemble
+from ngdual.mesh import build_mesh
 from ngdual.scene import SceneError, load_scene
 from ngdual.studies.bench.infsup import infsup
 from ngdual.verification import multipliers as m
+from ngdual.verification.infsup import dense_singular_values, gram_matrix
 
 DOCS = Path(__file__).resolve().parents[1] / "docs" / "theory" / "order.md"
 CHOSEN = (("coarse", 2), ("facet", 1))
@@ -49,6 +57,29 @@ def test_the_coarse_p1_pairing_gives_the_constants_of_ngdual_bench_infsup(name):
     for level in (1, 2):
         assert m.scene_constants(scene, level)["beta"] == pytest.approx(
             infsup(scene, level)["beta"], rel=1e-10)
+
+
+@pytest.mark.parametrize("k", [1, 2])
+def test_the_facet_multipliers_of_the_contact_solver_have_the_constants_of_the_facet_family(k):
+    """The solver's facet P_k (Bernstein coefficients on a Discontinuous H1 host, d assembled
+    by ngdual.forms) against this module's (Legendre on a SurfaceL2 host), in one norm."""
+    scene = load_scene("thesis-3.46-frictionless",
+                       [f"discretisation.order={k}", "discretisation.multipliers=facet"])
+    mesh = build_mesh(scene.geometry, 1)
+    problem = assemble(scene, mesh)
+    B = problem.block(problem.sigma, problem.index("phi1", "phi2", "lam_t", "lam_n")).toarray()
+    X = gram_matrix(problem)[problem.sigma][:, problem.sigma]
+    # the Legendre coefficients of the Bernstein polynomials of one edge
+    t = (legendre.leggauss(k + 1)[0] + 1) / 2
+    to_legendre = legendre.legfit(2 * t - 1, bernstein_values(k, t), k)
+    stresses, norms = m.Stresses.of(mesh, "peers", k), []
+    for part in m.scene_parts(scene, mesh):
+        basis = m.multiplier_basis(mesh, part, "facet", k, ratio=1)
+        T = sla.block_diag(*[to_legendre] * (2 * basis.n_dofs // (k + 1)))
+        norms.append(T.T @ m.pair(basis, part, stresses.fes, stresses.names, k).norm @ T)
+    solver = dense_singular_values(X, B, sla.block_diag(*norms), indices=(0, -1))
+    mine = m.scene_constants(load_scene("thesis-3.46-frictionless", []), 1, "facet", k, 1)
+    assert solver == pytest.approx([mine["beta"], mine["gamma"]], rel=1e-10)
 
 
 def test_the_coarse_p1_basis_has_the_mass_and_stiffness_of_the_coarse_p1_space():
