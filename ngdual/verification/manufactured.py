@@ -51,7 +51,17 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from functools import cached_property
 
-from ..scene import Contact, Friction, Geometry, Loads, Material, Scene, Solver, validate
+from ..scene import (
+    Contact,
+    Discretisation,
+    Friction,
+    Geometry,
+    Loads,
+    Material,
+    Scene,
+    Solver,
+    validate,
+)
 from .piecewise import Piecewise
 
 Y0 = -1.0                       # Gamma_C is the side y = Y0
@@ -177,11 +187,13 @@ class ManufacturedCase:
         return ExactSolution(u, sigma, div_sigma, eta, self.u_n + self.lam_n, self.lam_n,
                              self.lam_t, self.sigma_n, self.sigma_t, bound)
 
-    def scene(self, method: str = "auto", level: int = 1, ends: str = "consistent") -> Scene:
+    def scene(self, method: str = "auto", level: int = 1, ends: str = "consistent",
+              order: int = 0) -> Scene:
         """The validated scene: f = -div sigma, t0 = sigma n on the top, u_D = u on the sides.
 
         ``method``: ``solver.method``; ``ends``: ``contact.ends`` (the exact multipliers
-        vanish at the ends of Gamma_C, so "consistent" and "thesis" pose the same problem).
+        vanish at the ends of Gamma_C, so "consistent" and "thesis" pose the same problem);
+        ``order``: ``discretisation.order`` k, with the multipliers of its default family.
         """
         ex = self.exact
         traction = [ex.sigma[0][1].text(), ex.sigma[1][1].text()]   # n = (0, 1) on the top
@@ -198,7 +210,8 @@ class ManufacturedCase:
                    contact=Contact(gap=f"max(0, {ex.gap.text()})", ends=ends),
                    friction=Friction(law=self.law, mu=self.mu_f,
                                      bound=self.tresca_bound.text()),
-                   solver=Solver(method=method))
+                   solver=Solver(method=method),
+                   discretisation=Discretisation(order=order))
         validate(sc)
         return sc
 
