@@ -23,6 +23,15 @@ hats sum to one along Gamma_C, every tensile moment is a sign condition of (3.62
 the solve violated, and the force balance holds exactly; at a fixed end the end hat
 carries the force the prescribed end value causes.
 
+With the facet multipliers of order k (``discretisation.multipliers = "facet"``) the "hats"
+are the k + 1 Bernstein functions B_i of every fine edge and the "nodes" their control
+points. The moments are read, as for the hats, through the means of the B_i on their edge
+(1 / (k + 1)) against int_e sigma n ds: each is the mean of the edge's moments
+d_C(B_i, sigma) (the B_i sum to one), so a moment that (3.62) keeps compressive stays
+compressive and the force balance is exact, while the tension check sees the edge's
+average rather than each B_i alone. No end is fixed (the multipliers are discontinuous),
+so no clamped-end check applies.
+
 Sizes are relative to the force scale F_ref = max(sum_i |t_i|, |Gamma_C| sigma_rms,
 NOISE E U): the total force on the h~ hats, or, where that is smaller (always when nothing
 touches), the force Gamma_C would carry at the body's RMS stress sigma_rms =
