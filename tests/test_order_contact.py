@@ -7,10 +7,13 @@ for the same discrete problem. Fast: k = 1 on levels 1-3; slow: k = 1 on levels 
 on levels 1-3.
 """
 
+import json
+
 import ngsolve as ngs
 import numpy as np
 import pytest
 
+from ngdual.cli import main
 from ngdual.forms import assemble
 from ngdual.mesh import build_mesh
 from ngdual.rates import observed_rates
@@ -40,6 +43,19 @@ def test_a_bad_order_or_family_is_a_scene_error_naming_its_field(overrides, fiel
     with pytest.raises(SceneError) as err:
         load_scene("thesis-3.46-frictionless", overrides)
     assert err.value.field == field
+
+
+def test_the_command_line_sets_the_order_and_balances_the_contact_force(tmp_path):
+    """``--set discretisation.order=1`` through the override machinery: the stresses of
+    PEERS_1 (two rows of RT_1 plus the Curls of three bubbles per triangle: X = 552 on
+    level 1 against 180 for PEERS_0), and a multiplier force equal to the resultant of the
+    traction on Gamma_C."""
+    assert main(["solve", "thesis-3.46-frictionless", "--level", "1", "--set",
+                 "discretisation.order=1", "--out", str(tmp_path)]) == 0
+    record = json.loads((tmp_path / "result.json").read_text())
+    assert record["converged"] is True and record["dofs"]["X"] == 552
+    assert record["contact"]["force_mismatch"] < 1e-12
+    assert record["contact"]["nodes_in_contact"] > 0
 
 
 def test_friction_on_the_facet_multipliers_is_refused_naming_the_law():
