@@ -23,7 +23,7 @@ import ngsolve as ngs
 import numpy as np
 import scipy.sparse as sp
 
-from .boundary import CoarseMesh, FacetMesh, edge_normals
+from .boundary import CoarseMesh, FacetMesh, edge_normals, host_space
 from .expr import Expression
 from .geometry import tangent
 from .scene import Scene, gap_at
@@ -32,15 +32,9 @@ from .scene.contact import foundation_gap
 
 def trace_space(mesh: ngs.Mesh, labels: list[str]) -> ngs.FESpace:
     """The fine trace space of lambda_n, lambda_t: P1 on every fine edge of Gamma_C,
-    discontinuous between edges (see :class:`ContactBoundary`)."""
-    h1 = ngs.H1(mesh, order=1, definedon=mesh.Boundaries("|".join(labels)))
-    # BND=True (discontinuous across boundary elements) works but is missing from the
-    # flag list NGSolve checks keywords against, which would print a warning
-    level, ngs.ngsglobals.msg_level = ngs.ngsglobals.msg_level, 0
-    try:
-        return ngs.Compress(ngs.Discontinuous(h1, BND=True))
-    finally:
-        ngs.ngsglobals.msg_level = level
+    discontinuous between edges (see :class:`ContactBoundary`), the host of the facet
+    multipliers of order 1 (:func:`ngdual.boundary.host_space`)."""
+    return host_space(mesh, labels, 1)
 
 
 def _vertex_normals(chain) -> np.ndarray:

@@ -40,7 +40,8 @@ def host_space(mesh: ngs.Mesh, labels: list[str], order: int) -> ngs.FESpace:
     """The host of the facet P_k multipliers: P_max(k,1) on every fine edge of ``labels``,
     discontinuous from edge to edge (compressed)."""
     h1 = ngs.H1(mesh, order=max(order, 1), definedon=mesh.Boundaries("|".join(labels)))
-    # BND=True is missing from the flag list NGSolve checks keywords against (a warning)
+    # BND=True (discontinuous across boundary elements) works but is missing from the flag
+    # list NGSolve checks keywords against, which would print a warning
     level, ngs.ngsglobals.msg_level = ngs.ngsglobals.msg_level, 0
     try:
         return ngs.Compress(ngs.Discontinuous(h1, BND=True))
