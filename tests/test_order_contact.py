@@ -88,7 +88,7 @@ def test_bernstein_coefficients_of_one_are_the_function_one_with_means_one_over_
     assert np.all(np.count_nonzero(means, axis=1) == order + 1)
 
 
-@pytest.mark.parametrize("order", [0, 1])
+@pytest.mark.parametrize("order", [0, 1, 2])
 def test_the_active_set_method_at_order_k_gives_the_qp_solution(order):
     """The condensed semismooth Newton method and Clarabel's QP solve the same problem."""
     scene = _scene(order, "discretisation.multipliers='facet'")
