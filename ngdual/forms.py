@@ -3,7 +3,9 @@
 All forms are NGSolve integrals on the fine mesh T_h; the multipliers phi,
 lambda_t, lambda_n are assembled in the fine P1 trace spaces and restricted to
 their coarse meshes by the prolongation of :mod:`ngdual.boundary`
-(``K = P^T K_fine P``). The unknown vector is ordered
+(``K = P^T K_fine P``); at order k (``[discretisation]``) the facet P_k multipliers are
+assembled in the same way on their host space and mapped from their Bernstein
+coefficients (:mod:`ngdual.boundary.facet`). The unknown vector is ordered
 
     [sigma | u, eta, phi, lambda_t | lambda_n]
 
