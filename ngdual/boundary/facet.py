@@ -99,6 +99,25 @@ class FacetMesh(CoarseMesh):
                        .reshape(-1, 2))
         return np.vstack(out) if out else np.zeros((0, 2))
 
+    def dof_positions(self, c: int) -> np.ndarray:
+        """For every Bernstein coefficient of chain c (unknown order) the chain vertex its
+        control point lies at or after, the end vertex past the middle of the edge: the node
+        views of Gamma_C (post-processing, the checks) read the coefficients there."""
+        t = control_parameters(self.order)
+        edges = np.arange(self.chains[c].n_edges)
+        return (edges[:, None] + (t > 0.5)[None, :]).ravel()
+
+    @property
+    def n_p1_dofs(self) -> int:
+        raise TypeError("the facet multipliers have no coarse P1 space (FacetMesh)")
+
+    def p1_prolongation(self, edge_dofs, n_fine, ends=False):
+        raise TypeError("the facet multipliers have no coarse P1 hats; use "
+                        "FacetMesh.prolongation")
+
+    def p1_mass_stiffness(self):
+        raise TypeError("the facet multipliers have no coarse P1 space (FacetMesh)")
+
     def host_dofs(self, space: ngs.FESpace) -> np.ndarray:
         """(n_edges, max(k, 1) + 1) dofs of the host ``space`` on every fine edge, in the order
         of :meth:`fine_edges`: the start vertex's, the end vertex's, then the bubbles."""
