@@ -48,14 +48,17 @@ def test_a_bad_order_or_family_is_a_scene_error_naming_its_field(overrides, fiel
 def test_the_command_line_sets_the_order_and_balances_the_contact_force(tmp_path):
     """``--set discretisation.order=1`` through the override machinery: the stresses of
     PEERS_1 (two rows of RT_1 plus the Curls of three bubbles per triangle: X = 552 on
-    level 1 against 180 for PEERS_0), and a multiplier force equal to the resultant of the
-    traction on Gamma_C."""
+    level 1 against 180 for PEERS_0), a multiplier force equal to the resultant of the
+    traction on Gamma_C, and the contact edges read from the Bernstein coefficients."""
     assert main(["solve", "thesis-3.46-frictionless", "--level", "1", "--set",
                  "discretisation.order=1", "--out", str(tmp_path)]) == 0
     record = json.loads((tmp_path / "result.json").read_text())
     assert record["converged"] is True and record["dofs"]["X"] == 552
     assert record["contact"]["force_mismatch"] < 1e-12
     assert record["contact"]["nodes_in_contact"] > 0
+    # frictionless and compressive: int |sigma_n| over the active edges is the whole force
+    assert record["contact"]["F_abs"] == pytest.approx(record["contact"]["resultant"][1],
+                                                       rel=1e-9)
 
 
 def test_friction_on_the_facet_multipliers_is_refused_naming_the_law():
