@@ -70,3 +70,19 @@ def richardson_check(d_coarse: float, d_fine: float) -> dict:
     if r >= 1:
         return {"r": r, "rate": -math.log2(r), "overkill_error": None}
     return {"r": r, "rate": -math.log2(r), "overkill_error": d_fine * r / math.sqrt(1 - r * r)}
+
+
+def aligned_richardson_check(d_coarse: float, d_fine: float) -> dict:
+    """The overkill's own error as :func:`richardson_check` does, for errors e_k = C q^k
+    that are not orthogonal but, worst case, aligned (d_k = e_k - e_L; a pressure on
+    Gamma_C): d_{L-2} / d_{L-1} = 1 + 1 / q, e_L = d_{L-1} q / (1 - q). Same keys; None
+    where the distances fall by less than 2x (q >= 1: no geometric sequence).
+
+    >>> round(aligned_richardson_check(3.0, 1.0)["overkill_error"], 12)  # q = 1/2
+    1.0
+    """
+    if not (d_coarse and d_fine) or d_coarse <= 2 * d_fine:
+        return {"r": None, "rate": None, "overkill_error": None}
+    q = 1 / (d_coarse / d_fine - 1)
+    return {"r": q, "rate": -math.log2(q), "overkill_error": d_fine * q / (1 - q)}
+
