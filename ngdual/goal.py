@@ -144,7 +144,8 @@ def goal_estimate(solution: Solution, estimated: Estimate,
 
     on_edges = {
         "residual": length * (sigma_n + p_mean)**2,
-        "complementarity": e_star * length * np.maximum(p_mean, 0) * lam_mean / htilde,
+        "complementarity": _complementarity(length, np.maximum(p_mean, 0), lam_mean,
+                                            e_star / htilde),
         "kink": _kinks(gamma_c, gap - lam_n, lam_n, starts, e_star * e_star * htilde),
     }
     terms = {k: np.bincount(element, inside * values, mesh.ne)
@@ -169,6 +170,20 @@ def _in_window(x: np.ndarray, window: tuple[float, float] | None) -> np.ndarray:
         raise SceneError("window", f"[{window[0]:g}, {window[1]:g}] holds no edge of Gamma_C "
                                    f"(its midpoints lie in [{x.min():g}, {x.max():g}])")
     return inside
+
+
+def _complementarity(length: np.ndarray, pressure: np.ndarray, lam_mean: np.ndarray,
+                     stiffness: np.ndarray) -> np.ndarray:
+    """|e| min(p_h k_e lambda_n, p_h^2) per fine edge, k_e = E* / h~_e: the defect of
+    p_h lambda_n = 0 (3.62), capped by the whole pressure on the edge.
+
+    A gap lambda_n opened on an edge leaves a pressure p_h k_e lambda_n there
+    (a stiffness E* / h~ times the opening); the exact pressure of an open edge vanishes,
+    so its error on the edge is at most p_h itself. The cap matters where lambda_n is
+    data (a clamped end's lambda_n = g - u_D.n, 'consistent' ends) and p_h is singular:
+    there k_e lambda_n grows without bound as h~ shrinks while |e| p_h^2 falls.
+    """
+    return length * pressure * np.minimum(stiffness * lam_mean, pressure)
 
 
 def _edge_starts(gamma_c) -> np.ndarray:
