@@ -131,6 +131,8 @@ def goal_estimate(solution: Solution, estimated: Estimate,
         means = gamma_c.hat_means(hats)
         if means.shape[1]:
             p_mean += means @ -hat_projection(means, length, sigma_n)
+    # the edges under a fixed end's hat, where lambda_n is data, not an unknown of (3.62)
+    fixed = np.asarray(abs(gamma_c.hat_means(spaces.end_hats["lam_n"])).sum(axis=1)).ravel() > 0
     size = float(np.sqrt(np.sum(inside * length * p_mean**2)))
 
     # lambda_n and g_h at the fine vertices, chain by chain (n_edges + 1 per chain)
@@ -145,7 +147,7 @@ def goal_estimate(solution: Solution, estimated: Estimate,
     on_edges = {
         "residual": length * (sigma_n + p_mean)**2,
         "complementarity": _complementarity(length, np.maximum(p_mean, 0), lam_mean,
-                                            e_star / htilde),
+                                            e_star / htilde, fixed),
         "kink": _kinks(gamma_c, gap - lam_n, lam_n, starts, e_star * e_star * htilde),
     }
     terms = {k: np.bincount(element, inside * values, mesh.ne)
@@ -173,17 +175,18 @@ def _in_window(x: np.ndarray, window: tuple[float, float] | None) -> np.ndarray:
 
 
 def _complementarity(length: np.ndarray, pressure: np.ndarray, lam_mean: np.ndarray,
-                     stiffness: np.ndarray) -> np.ndarray:
-    """|e| min(p_h k_e lambda_n, p_h^2) per fine edge, k_e = E* / h~_e: the defect of
-    p_h lambda_n = 0 (3.62), capped by the whole pressure on the edge.
+                     stiffness: np.ndarray, fixed: np.ndarray) -> np.ndarray:
+    """|e| p_h k_e lambda_n per fine edge, k_e = E* / h~_e, the defect of p_h lambda_n = 0
+    (3.62); on the ``fixed`` edges (under a fixed end's hat) at most |e| p_h^2.
 
-    A gap lambda_n opened on an edge leaves a pressure p_h k_e lambda_n there
-    (a stiffness E* / h~ times the opening); the exact pressure of an open edge vanishes,
-    so its error on the edge is at most p_h itself. The cap matters where lambda_n is
-    data (a clamped end's lambda_n = g - u_D.n, 'consistent' ends) and p_h is singular:
-    there k_e lambda_n grows without bound as h~ shrinks while |e| p_h^2 falls.
+    A gap lambda_n left open on an edge by the contact conditions costs a pressure
+    p_h k_e lambda_n there (a stiffness E* / h~ times the opening). Where lambda_n is data
+    (a clamped end's lambda_n = g - u_D.n, 'consistent' ends) no contact condition sets it
+    and p_h is singular at the clamped corner: k_e lambda_n grows without bound as h~ shrinks.
+    The exact pressure of an open edge vanishes, so the error there is at most p_h itself.
     """
-    return length * pressure * np.minimum(stiffness * lam_mean, pressure)
+    defect = stiffness * lam_mean
+    return length * pressure * np.where(fixed, np.minimum(defect, pressure), defect)
 
 
 def _edge_starts(gamma_c) -> np.ndarray:
