@@ -137,15 +137,15 @@ def test_ngdual_adapt_refuses_a_bad_tol_naming_the_flag(tmp_path, capsys, flag, 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name, window, measure", [
-    ("hertz-cylinder", None, "l2"), ("cattaneo-mindlin", None, "l2"),
-    ("flat-punch", (-0.125, 0.125), "l2_core")])
+    ("hertz-cylinder", None, "l2"), ("cattaneo-mindlin", None, "l2")])
 def test_the_pressure_estimate_is_within_a_factor_3_of_the_true_pressure_error(
         name, window, measure):
     """Effectivity = relative estimate / true relative L2 pressure error stays in [0.3, 3]
     over five pressure-driven steps: against the analytic pressure (Hertz, Cattaneo-Mindlin's
-    Hertz pressure) on all of Gamma_C, the flat punch's (Sadowsky) on its core |x| < a/2,
-    where the goal's window puts it. Five steps end near 1 % on Hertz: below, the half-space
-    pressure is no longer the block's (docs/theory/estimator.md)."""
+    Hertz pressure) on all of Gamma_C. Five steps end near 1 % on Hertz: below, the
+    half-space pressure is no longer the block's (docs/theory/estimator.md). Not the flat
+    punch: Sadowsky's core pressure for each step's own force carries the force deficit
+    of the unresolved punch edges (2.6 % at the third step); its truth is an overkill."""
     scene = load_scene(name)
     effectivity = []
 
@@ -236,3 +236,40 @@ def test_refining_a_clamped_end_does_not_raise_its_complementarity_term():
         pressure = goal_estimate(solution, estimate(solution, "l2"))
         complementarity.append(pressure.summed()["complementarity"])
     assert complementarity[1] <= 1.01 * complementarity[0]
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="the far field overestimates the punch core's error "
+                   "3-8 times from the third step on (docs/theory/estimator.md)")
+def test_the_punch_core_estimate_is_within_a_factor_3_of_the_overkill_error():
+    """The flat punch's goal on its core |x| < a/2 against the same loop run on to
+    tol = 0.003 (the study's reference, 1.15 million unknowns, is 0.06 % from it there)."""
+    scene, window = load_scene("flat-punch"), (-0.125, 0.125)
+    steps = []
+
+    def keep(record, solution, estimated, marked):
+        profile = traction_profile(solution)
+        order = np.argsort(profile.x)
+        steps.append((record["relative_estimate"], profile.x[order], profile.pressure[order]))
+
+    adapt(scene, goal="pressure", tol=0.003, window=window, on_step=keep)
+    reference = {"x": steps[-1][1], "p": steps[-1][2]}
+    errors = [pressure_error(*nodes_to_samples(x, p, reference), reference, window[1])["rel"]
+              for _, x, p in steps[:-2]]
+    effectivity = [estimate / error for (estimate, _, _), error in zip(steps, errors)]
+    print(f"flat-punch core: effectivity {np.round(effectivity, 2).tolist()}")
+    assert 0.3 <= min(effectivity) and max(effectivity) <= 3
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["thesis-3.46-frictionless", "thesis-3.46-coulomb"])
+def test_a_one_percent_pressure_tolerance_with_clamped_ends_stops_by_itself(name):
+    """Example 3.46 with consistent ends: lambda_n is data at the clamped ends, where p_h is
+    singular; the loop refines there without stalling (every step grows the unknowns by
+    at least 1.2 times) and stops by its tolerance (13 and 12 solves measured, 0.57 % and
+    0.36 % from the study's reference, docs/theory/estimator.md)."""
+    scene = load_scene(name, ["contact.ends=consistent"])
+    history = adapt(scene, goal="pressure", tol=0.01, steps=16)
+    assert history[-1]["stopped_by"] == "tol"
+    dofs = [r["dofs"]["total"] for r in history]
+    assert all(b >= 1.2 * a for a, b in zip(dofs, dofs[1:]))
