@@ -10,6 +10,7 @@ units of pressure^2 x length, per fine edge e of Gamma_C (its element T)::
     ``residual``         |e| (sigma_n^h + p_h)^2                 the part of sigma_n^h
                                                                  p_h does not represent
     ``complementarity``  E* |e| p_h lambda_n / h~_e              p_h lambda_n = 0 violated
+                         (at most |e| p_h^2 where lambda_n is a fixed end's data)
     ``kink``             (E* [d(g_h - lambda_n)/dt])^2 h~ / 2    at the last contact node,
                                                                  on each of its two edges
     ``far``              eta_{sigma,T}^2 h~_C / (h~_C + dist(T, Gamma_C))^2   every element
