@@ -296,8 +296,13 @@ def _edge_of_broken(rt: ngs.FESpace, broken_rt: ngs.FESpace, tol: float = 1e-8) 
         element_boundary=True, intrules={ngs.SEGM: ngs.IntegrationRule(ngs.SEGM, 0)})
     form.Assemble()
     M = to_scipy(form.mat, copy=False)
-    rows = np.repeat(np.arange(M.shape[0]), np.diff(M.indptr))
-    own = np.abs(M.data) > tol * np.abs(M.data).max(initial=0.0)
+    counts = np.diff(M.indptr)
+    rows = np.repeat(np.arange(M.shape[0]), counts)
+    # relative to each row's largest entry: M[i, j] ~ 1/|e|, which spans the mesh's grading
+    magnitude = np.abs(M.data)
+    row_max = np.zeros(M.shape[0])
+    np.maximum.at(row_max, rows, magnitude)
+    own = magnitude > tol * row_max[rows]
     if not (np.array_equal(np.bincount(rows[own], minlength=M.shape[0]),
                            np.ones(M.shape[0], dtype=int)) and np.all(M.data[own] > 0)):
         raise RuntimeError("NGSolve's broken Raviart-Thomas functions are not restrictions "
