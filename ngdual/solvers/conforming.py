@@ -8,8 +8,8 @@ the problem (3.103) is solved on the assembled K itself, with one sparse LU fact
 
 The contact conditions of (3.103) act on the unknowns of lambda_n (the Bernstein
 coefficients of the facet multipliers, the hat values of the coarse ones) and on their
-moments t_n = C_n^T sigma; without friction lambda_t is free and its moments t_t vanish.
-Without friction lambda_t is free and t_t = 0 is one more equation of the sparse system.
+moments t_n = C_n^T sigma; without friction lambda_t is free, and its moments t_t = 0 are
+one more equation of the sparse system.
 The problem is condensed onto lambda_n, as in :mod:`ngdual.solvers.active_set`: with S all
 other unknowns (sigma, u, eta, phi, lambda_t), one factorisation of K_SS and N_C solves give
 

@@ -15,8 +15,8 @@ Cholesky factorisation, and for contact the semismooth Newton method on Gamma_C
 (:mod:`ngdual.solvers.active_set`): the same discrete solution at about the cost of one linear
 solve. The hybridisation is that of broken RT_0 rows and the P1 multipliers on h~; at order
 k >= 1 or with the facet multipliers (``discretisation``) the problem has no such system
-(``problem.broken`` is None) and the active-set method runs on the conforming K, one sparse
-LU per active set (:mod:`ngdual.solvers.conforming`).
+(``problem.broken`` is None) and the semismooth Newton method runs on the conforming K
+condensed onto lambda_n: one sparse LU and N_C substitutions (:mod:`ngdual.solvers.conforming`).
 """
 
 from __future__ import annotations
