@@ -35,7 +35,7 @@ import numpy as np
 from ..forms import DiscreteProblem
 from .active_set import ContactStart
 from .linear import Factorization
-from .qp import _residuals
+from .qp import contact_problem_residuals
 from .result import ConvergenceError, Solution
 from .semismooth import BoundarySolution, semismooth_newton
 from .settings import ActiveSetSettings
@@ -73,9 +73,10 @@ def conforming_active_set(problem: DiscreteProblem, settings: ActiveSetSettings,
         first = start.at(problem.spaces.contact.node_points())
     x, iterations, factor_s = _condensed(problem, first)
     i_sigma, i_mult, i_lam, rhs = problem.sigma, problem.mult, problem.lam_n, problem.rhs
-    residuals = _residuals(problem.block(i_sigma, i_sigma), problem.block(i_sigma, i_mult),
-                           problem.block(i_sigma, i_lam), rhs[i_sigma], rhs[i_mult],
-                           x[i_sigma], x[i_mult], x[i_lam])
+    residuals = contact_problem_residuals(problem.block(i_sigma, i_sigma),
+                                          problem.block(i_sigma, i_mult),
+                                          problem.block(i_sigma, i_lam), rhs[i_sigma],
+                                          rhs[i_mult], x[i_sigma], x[i_mult], x[i_lam])
     bad = {k: v for k, v in residuals.items() if not v <= TOLERANCE}
     if bad:
         raise ConvergenceError("the active-set solution does not satisfy (3.103) to round-off: "

@@ -112,7 +112,8 @@ def _solve_qp(problem: DiscreteProblem, modulus: float,
     x[i_lam] = stress / modulus * lam_v
     nu_v = None if nu is None else np.clip(nu.value, -1.0, 1.0)
     b_nu = b if nu is None else b + inject @ (Q.T @ nu_v)  # the lambda_t rows carry Q_F^T nu
-    residuals = {**_residuals(A, B, C_n, g, b_nu, x[i_sigma], x[i_mult], x[i_lam]),
+    residuals = {**contact_problem_residuals(A, B, C_n, g, b_nu, x[i_sigma], x[i_mult],
+                                             x[i_lam]),
                  "polished": float(polished is not None)}
     converged = polished is not None or qp.status == cp.OPTIMAL
     return Solution(problem, x, converged, "qp", iterations={"outer": 0, "inner": 0},
@@ -194,7 +195,7 @@ def _polish(A, B, C_n, g, b, z, y, lam):
     return z_p, y_p, np.maximum(lam_p, 0.0)
 
 
-def _residuals(A, B, C_n, g, b, sigma, y, lam) -> dict:
+def contact_problem_residuals(A, B, C_n, g, b, sigma, y, lam) -> dict:
     """Relative residuals of (3.103): stationarity, equalities, sign conditions, complementarity."""
     traction = C_n.T @ sigma
     a_sigma = A @ sigma

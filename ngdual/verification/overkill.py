@@ -190,7 +190,7 @@ def pressure_error(x, w, p, reference: dict, window: float | None = None) -> dic
             "max": float(np.abs(diff).max()) / scale}
 
 
-def _p2_basis(bary: np.ndarray) -> np.ndarray:
+def p2_basis(bary: np.ndarray) -> np.ndarray:
     """The P2 Lagrange basis at barycentric points (..., 3), in the order of P2_NODES."""
     l0, l1, l2 = bary[..., 0], bary[..., 1], bary[..., 2]
     return np.stack([l0 * (2 * l0 - 1), l1 * (2 * l1 - 1), l2 * (2 * l2 - 1),
@@ -228,7 +228,7 @@ def locate(samples: dict, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             raise ValueError(f"{int(np.sum(distance > edges[k[outside]]))} points lie "
                              "outside the candidate mesh")
     tri_xy = samples["vertices"][samples["triangles"][k]]
-    return k, _p2_basis(_barycentric(tri_xy, points))
+    return k, p2_basis(_barycentric(tri_xy, points))
 
 
 def evaluate(samples: dict, name: str, located: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
@@ -247,7 +247,7 @@ def quadrature(samples: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     area = 0.5 * np.abs((b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1])
                         - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]))
     points = np.einsum("qi,nid->nqd", bary, tri_xy).reshape(-1, 2)
-    return points, (area[:, None] * weights).ravel(), _p2_basis(bary)
+    return points, (area[:, None] * weights).ravel(), p2_basis(bary)
 
 
 def field_errors(candidate: dict, reference: dict, lam: float, mu: float,

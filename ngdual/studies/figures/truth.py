@@ -72,8 +72,7 @@ def split_samples(samples: dict) -> dict:
     """The same P2 fields on every triangle split into its four red children (midpoints):
     a reference with four times the quadrature points, to measure the quadrature error of
     a candidate whose edges cross the reference's triangles."""
-    from ...verification.overkill import P2_NODES
-    from ...verification.overkill import _p2_basis as p2_basis
+    from ...verification.overkill import P2_NODES, p2_basis
 
     tri_xy = samples["vertices"][samples["triangles"]]                 # (ne, 3, 2)
     ne = len(tri_xy)
