@@ -17,7 +17,7 @@ squared, per element T, are::
         ``jump_contact``    sum_{e in E^T on Gamma_C}
                             h_e ||w_h t + dlam_t/dt t + d(lam_n-g)/dt n||^2
     eta_{u,T}^2 (4.31)
-        ``u_volume``        h_T^2 ||w_h||_T^2
+        ``u_volume``        h_T^2 ||w_h - grad_h u_h||_T^2  (grad_h u_h = 0 at k = 0)
         ``u_dirichlet``     sum h_e ||u_Gamma - u_D||_e^2
         ``u_neumann``       sum h_e ||phi + u_Gamma||_e^2
         ``u_contact``       sum h_e ||lam_t t + (lam_n - g) n + u_Gamma||_e^2
@@ -36,6 +36,18 @@ integrals for the interior jumps, and ``ds`` integrals tested with the
 piecewise constants on the boundary edges, each edge added to its element.
 Every array holds squared contributions per element, so that
 eta_{tot,T}^2 = the sum of all terms (4.50).
+
+At order k (PEERS_k, :mod:`ngdual.peers`) the terms are the same. sigma_h has degree
+k + 2 and eta_h degree k + 1, so w_h and as(sigma_h) are projected element-wise onto
+P_{k+2} (exactly) before they are differentiated, and every integral takes the rule of
+:func:`quadrature_bonus`, exact for the squares of the discrete fields (degree 2k + 4).
+One term changes form: (4.39) bounds ||u - u_h|| through int w_h : (E_h r - r) with the
+equilibrium interpolant E_h onto RT_k, and at k >= 1 int grad_h u_h : (E_h r - r) = 0 too
+(integrate by parts on every triangle: div(E_h r - r) is orthogonal to P_k and so are the
+normal moments on every edge), so ``u_volume`` is h_T^2 ||w_h - grad_h u_h||^2, the
+element residual of C^{-1} sigma + eta = grad u; the thesis' h_T^2 ||w_h||^2 at k = 0.
+With h_T^2 ||w_h||^2 the term would stay O(h) at every order (it is the largest term of
+the manufactured contact case at k = 2, docs/theory/estimator.md).
 """
 
 from __future__ import annotations
@@ -62,9 +74,6 @@ U_TERMS = ("u_volume", "u_dirichlet", "u_neumann", "u_contact")
 OTHER_TERMS = ("friction", "neumann")
 TERMS = SIGMA_TERMS + U_TERMS + OTHER_TERMS
 ASYMMETRY_NORMS = ("hdiv", "l2")
-# w_h, as(sigma_h) are polynomials of degree <= 2 per element (RT_0 plus Curl of cubic bubbles)
-W_ORDER = 2
-BONUS_ORDER = 4
 
 
 @dataclass
@@ -118,9 +127,21 @@ class Estimate:
         return {k: float(np.sum(v)) for k, v in self.terms.items()}
 
 
-def _interpolate(mesh: ngs.Mesh, cfs) -> list[ngs.GridFunction]:
-    """Element-wise L2 projections onto P2 (exact for the PEERS fields), to differentiate them."""
-    space = ngs.L2(mesh, order=W_ORDER)
+def quadrature_bonus(order: int = 0) -> int:
+    """The ``bonus_intorder`` of every integral of the estimator at order k: 2 (k + 2).
+
+    The squares of w_h and as(sigma_h) have degree 2 (k + 2) (:func:`ngdual.peers.stress_degree`).
+    NGSolve integrates ``Integrate(cf * dx(bonus_intorder=b))`` (also on the element
+    boundaries) exactly to degree 5 + b and a ``ds`` linear form tested with the edge
+    constants to degree b + 1, so the bonus 2 (k + 2) is exact for the discrete fields on
+    both and leaves degree 5 for the data (f, u_D, t0, g)."""
+    return 2 * peers.stress_degree("peers", order)
+
+
+def _interpolate(mesh: ngs.Mesh, cfs, order: int = 0) -> list[ngs.GridFunction]:
+    """Element-wise L2 projections onto P_{k+2} (exact for the fields of PEERS_k), to
+    differentiate them."""
+    space = ngs.L2(mesh, order=peers.stress_degree("peers", order))
     out = []
     with parallel_tasks(mesh):
         for cf in cfs:
@@ -130,17 +151,19 @@ def _interpolate(mesh: ngs.Mesh, cfs) -> list[ngs.GridFunction]:
     return out
 
 
-def _element_integrals(cf, mesh: ngs.Mesh) -> np.ndarray:
+def _element_integrals(cf, mesh: ngs.Mesh, bonus: int) -> np.ndarray:
     with parallel_tasks(mesh):
-        return ngs.Integrate(cf.Compile() * ngs.dx(bonus_intorder=BONUS_ORDER), mesh,
+        return ngs.Integrate(cf.Compile() * ngs.dx(bonus_intorder=bonus), mesh,
                              element_wise=True).NumPy().copy()
 
 
 class BoundaryEdges:
-    """Integrals over the boundary edges, each added to the one element that owns it."""
+    """Integrals over the boundary edges, each added to the one element that owns it, with
+    the rule of :func:`quadrature_bonus` for the fields of order ``order``."""
 
-    def __init__(self, mesh: ngs.Mesh):
+    def __init__(self, mesh: ngs.Mesh, order: int = 0):
         self.mesh = mesh
+        self.bonus = quadrature_bonus(order)
         self.space = ngs.SurfaceL2(mesh, order=0)
         self.test = self.space.TestFunction()
         self.element = np.zeros(self.space.ndof, dtype=int)
@@ -160,7 +183,7 @@ class BoundaryEdges:
             return np.zeros(self.space.ndof)
         form = ngs.LinearForm(self.space)
         form += cf * self.test * ngs.ds(definedon=self.mesh.Boundaries(boundary_regex(labels)),
-                                        bonus_intorder=BONUS_ORDER)
+                                        bonus_intorder=self.bonus)
         form.Assemble()
         return form.vec.FV().NumPy().copy()
 
@@ -224,16 +247,18 @@ def estimate(solution: Solution, asymmetry: str = "l2") -> Estimate:
     pb = solution.problem
     scene, spaces = pb.scene, pb.spaces
     mesh = pb.fes.mesh
+    order, bonus = spaces.order, quadrature_bonus(spaces.order)
     lam, mu = scene.material.lame
     f = fields(solution)
     h = element_diameters(mesh)
     n = ngs.specialcf.normal(2)
     t = tangent(n)
 
-    # w_h = C^{-1} sigma_h + eta_h and a_h = (sigma_12 - sigma_21) / 2, as P2 functions per element
+    # w_h = C^{-1} sigma_h + eta_h and a_h = (sigma_12 - sigma_21) / 2, as P_{k+2} functions
+    # per element
     w_cf = peers.compliance(f.sigma, lam, mu) + ngs.CF((0, f.eta, -f.eta, 0), dims=(2, 2))
     *w_parts, a = _interpolate(mesh, [w_cf[0, 0], w_cf[0, 1], w_cf[1, 0], w_cf[1, 1],
-                                      0.5 * peers.asym(f.sigma)])
+                                      0.5 * peers.asym(f.sigma)], order)
     w = ngs.CF(tuple(w_parts), dims=(2, 2))
     curl_w = ngs.CF((ngs.grad(w_parts[1])[0] - ngs.grad(w_parts[0])[1],
                      ngs.grad(w_parts[3])[0] - ngs.grad(w_parts[2])[1]))
@@ -241,23 +266,26 @@ def estimate(solution: Solution, asymmetry: str = "l2") -> Estimate:
     residual = body + f.div_sigma
 
     terms = dict.fromkeys(TERMS)
-    terms["residual"] = _element_integrals(residual * residual, mesh)
+    terms["residual"] = _element_integrals(residual * residual, mesh, bonus)
     as_l2 = 2 * a * a                           # |[[0, a], [-a, 0]]|^2
     as_div = ngs.grad(a) * ngs.grad(a)          # |div [[0, a], [-a, 0]]|^2 = |grad a|^2
     terms["asymmetry"] = _element_integrals(as_l2 + as_div if asymmetry == "hdiv" else as_l2,
-                                            mesh)
-    terms["curl"] = h**2 * _element_integrals(curl_w * curl_w, mesh)
-    terms["u_volume"] = h**2 * _element_integrals(ngs.InnerProduct(w, w), mesh)
+                                            mesh, bonus)
+    terms["curl"] = h**2 * _element_integrals(curl_w * curl_w, mesh, bonus)
+    components = dict(zip(pb.names, f.gf.components))
+    grad_u = ngs.CF((ngs.grad(components["u1"]), ngs.grad(components["u2"])), dims=(2, 2))
+    w_u = w - grad_u   # grad_h u_h = 0 at k = 0: the thesis' w_h, to the last bit
+    terms["u_volume"] = h**2 * _element_integrals(ngs.InnerProduct(w_u, w_u), mesh, bonus)
 
     h_int = _interior_edge_lengths(mesh)
     w_other = ngs.CF(tuple(p.Other() for p in w_parts), dims=(2, 2))
     jump = (w - w_other) * t
     terms["jump_interior"] = ngs.Integrate(
         (h_int * (jump * jump)).Compile()
-        * ngs.dx(element_boundary=True, bonus_intorder=BONUS_ORDER),
+        * ngs.dx(element_boundary=True, bonus_intorder=bonus),
         mesh, element_wise=True).NumPy().copy()
 
-    edges = BoundaryEdges(mesh)
+    edges = BoundaryEdges(mesh, order)
     he = edges.length
     w_t = ngs.BoundaryFromVolumeCF(w) * t
     u_gamma = ngs.BoundaryFromVolumeCF(f.u)
