@@ -25,8 +25,9 @@ heuristic. The estimate is ``CALIBRATION`` times the root of the sum.
 A pressure that is not in L2 (the flat punch's, p^2 ~ 1/(a - |x|)) has no finite L2 error;
 its goal is the error on a window W of Gamma_C away from the singular points (``window``,
 e.g. the core |x| < a/2 the true errors of :mod:`ngdual.verification.traction` use): the
-edge terms count on the edges in W only, and ``far`` takes dist(T, W) and the h~ of the
-nearest edge of W.
+edge terms count on the edges in W only, and ``far`` takes the decay of a dipole's traction
+on W, eta_{sigma,T}^2 h_T^2 / ((h_T + d)^2 (h~_W + d)) with d = dist(T, W), h_T the
+element's diameter and h~_W the h~ of the nearest edge of W.
 """
 
 from __future__ import annotations
@@ -99,8 +100,8 @@ def goal_estimate(solution: Solution, estimated: Estimate,
         W = the fine edges of Gamma_C whose midpoint's x lies in [lo, hi] (default: all of
         Gamma_C). A pressure that is not in L2 (the flat punch's, ~ (a - |x|)^{-1/2}) has an
         L2 error on a window away from its singular points only: the residual, complementarity
-        and kink terms are those of the edges in W, the far field is weighted by the distance
-        to W, and ``size`` is ||p_h||_{L2(W)}.
+        and kink terms are those of the edges in W, the far field is a dipole's traction on
+        W (:func:`_dipole_weight`), and ``size`` is ||p_h||_{L2(W)}.
 
     Returns
     -------
@@ -157,10 +158,13 @@ def goal_estimate(solution: Solution, estimated: Estimate,
     eta_sigma = (sum(estimated.terms[k] for k in STRESS_TERMS)
                  + (2 * mu)**2 * sum(estimated.terms[k] for k in STRAIN_TERMS))
     points, triangles = mesh_arrays(mesh)
-    centres = points[triangles].mean(axis=1)
-    distance, nearest = cKDTree(gamma_c.midpoints[inside]).query(centres)
+    corners = points[triangles]
+    distance, nearest = cKDTree(gamma_c.midpoints[inside]).query(corners.mean(axis=1))
     h_near = htilde[inside][nearest]
-    terms["far"] = eta_sigma * h_near / (h_near + distance)**2
+    if window is None:
+        terms["far"] = eta_sigma * h_near / (h_near + distance)**2
+    else:
+        terms["far"] = eta_sigma * _dipole_weight(corners, distance, h_near)
     return PressureEstimate(terms, size)
 
 
@@ -178,6 +182,17 @@ def _in_window(x: np.ndarray, window: tuple[float, float] | None) -> np.ndarray:
 def _complementarity(length: np.ndarray, pressure: np.ndarray, lam_mean: np.ndarray,
                      stiffness: np.ndarray, fixed: np.ndarray) -> np.ndarray:
     """|e| p_h k_e lambda_n per fine edge, k_e = E* / h~_e, the defect of p_h lambda_n = 0
+def _dipole_weight(corners: np.ndarray, distance: np.ndarray, h_near: np.ndarray
+                   ) -> np.ndarray:
+    """h_T^2 / ((h_T + d)^2 (h~_W + d)) per element (``corners``: ne x 3 x 2), d its
+    distance to the window W: the L2(W) norm^2 of a dipole's traction, (eta_T h_T)^2 d^-3,
+    for an element of diameter h_T far from W; 1 / h~_W on W, as the weight without a
+    window. Outside a window lie singular points of Gamma_C (the punch edges), whose tiny
+    elements the weight h~_W / (h~_W + d)^2 counted as if as large as W's edges."""
+    h_t = np.max(np.linalg.norm(corners - np.roll(corners, 1, axis=1), axis=2), axis=1)
+    return h_t**2 / ((h_t + distance)**2 * (h_near + distance))
+
+
     (3.62); on the ``fixed`` edges (under a fixed end's hat) at most |e| p_h^2.
 
     A gap lambda_n left open on an edge by the contact conditions costs a pressure
