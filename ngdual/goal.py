@@ -168,6 +168,17 @@ def goal_estimate(solution: Solution, estimated: Estimate,
     return PressureEstimate(terms, size)
 
 
+def _dipole_weight(corners: np.ndarray, distance: np.ndarray, h_near: np.ndarray
+                   ) -> np.ndarray:
+    """h_T^2 / ((h_T + d)^2 (h~_W + d)) per element (``corners``: ne x 3 x 2), d its
+    distance to the window W: the L2(W) norm^2 of a dipole's traction, (eta_T h_T)^2 d^-3,
+    for an element of diameter h_T far from W; 1 / h~_W on W, as the weight without a
+    window. Outside a window lie singular points of Gamma_C (the punch edges), whose tiny
+    elements the weight h~_W / (h~_W + d)^2 counted as if as large as W's edges."""
+    h_t = np.max(np.linalg.norm(corners - np.roll(corners, 1, axis=1), axis=2), axis=1)
+    return h_t**2 / ((h_t + distance)**2 * (h_near + distance))
+
+
 def _in_window(x: np.ndarray, window: tuple[float, float] | None) -> np.ndarray:
     """Which of the fine Gamma_C edges (midpoint abscissae ``x``) belong to the goal's W."""
     if window is None:
@@ -182,17 +193,6 @@ def _in_window(x: np.ndarray, window: tuple[float, float] | None) -> np.ndarray:
 def _complementarity(length: np.ndarray, pressure: np.ndarray, lam_mean: np.ndarray,
                      stiffness: np.ndarray, fixed: np.ndarray) -> np.ndarray:
     """|e| p_h k_e lambda_n per fine edge, k_e = E* / h~_e, the defect of p_h lambda_n = 0
-def _dipole_weight(corners: np.ndarray, distance: np.ndarray, h_near: np.ndarray
-                   ) -> np.ndarray:
-    """h_T^2 / ((h_T + d)^2 (h~_W + d)) per element (``corners``: ne x 3 x 2), d its
-    distance to the window W: the L2(W) norm^2 of a dipole's traction, (eta_T h_T)^2 d^-3,
-    for an element of diameter h_T far from W; 1 / h~_W on W, as the weight without a
-    window. Outside a window lie singular points of Gamma_C (the punch edges), whose tiny
-    elements the weight h~_W / (h~_W + d)^2 counted as if as large as W's edges."""
-    h_t = np.max(np.linalg.norm(corners - np.roll(corners, 1, axis=1), axis=2), axis=1)
-    return h_t**2 / ((h_t + distance)**2 * (h_near + distance))
-
-
     (3.62); on the ``fixed`` edges (under a fixed end's hat) at most |e| p_h^2.
 
     A gap lambda_n left open on an edge by the contact conditions costs a pressure
