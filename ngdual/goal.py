@@ -22,6 +22,11 @@ the strain terms (w_h) scaled by (2 mu)^2 into stress. docs/theory/estimator.md 
 the contact pressure") derives each power of h~ and says what is proven and what is
 heuristic. The estimate is ``CALIBRATION`` times the root of the sum.
 
+At order k with the facet multipliers (:mod:`ngdual.boundary.facet`) the multipliers are
+the normal traces of RT_k, so p_h is the trace -sigma_n^h itself (P_k on every fine edge,
+h~_e = |e|) and ``residual`` becomes its tension ||min(p_h, 0)||_e^2: only the Bernstein
+moments are signed, and the exact pressure is >= 0 (:func:`_trace_pressure`).
+
 A pressure that is not in L2 (the flat punch's, p^2 ~ 1/(a - |x|)) has no finite L2 error;
 its goal is the error on a window W of Gamma_C away from the singular points (``window``,
 e.g. the core |x| < a/2 the true errors of :mod:`ngdual.verification.traction` use): the
@@ -34,6 +39,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import ngsolve as ngs  # the pressure of order k, a trace of sigma_h
 import numpy as np
 from scipy.spatial import cKDTree
 
@@ -41,6 +47,7 @@ from .checks import friction_forms_of
 from .estimator import BoundaryEdges, Estimate
 from .friction import hat_projection
 from .mesh import mesh_arrays
+from .quantities import fields  # the trace of sigma_h at order k
 from .scene import SceneError
 from .solvers.result import Solution
 
@@ -121,21 +128,26 @@ def goal_estimate(solution: Solution, estimated: Estimate,
     htilde = gamma_c.coarse.edge_lengths()[gamma_c.htilde_edge]
     inside = _in_window(gamma_c.midpoints[:, 0], window)
 
-    # sigma_n^h per fine edge (constant for RT_0), from the solver's fine-edge operators
+    # sigma_n^h per fine edge (its mean at order k), from the solver's fine-edge operators
     sigma_n = friction_forms_of(solution).T_n @ solution.x
-    edges = BoundaryEdges(mesh)
-    element = edges.element[[edges.dof_of_edge[frozenset(map(int, p))]
-                             for p in gamma_c.vertices]]
+    edges = BoundaryEdges(mesh, spaces.order)
+    on_gamma_c = [edges.dof_of_edge[frozenset(map(int, p))] for p in gamma_c.vertices]
+    element = edges.element[on_gamma_c]
 
-    # p_h = -(hat projection of sigma_n^h), as means over the fine edges
-    p_mean = np.zeros(len(length))
-    for hats in (spaces.prolongations["lam_n"], spaces.end_hats["lam_n"]):
-        means = gamma_c.hat_means(hats)
-        if means.shape[1]:
-            p_mean += means @ -hat_projection(means, length, sigma_n)
+    if spaces.family == "facet":
+        # the facet multipliers of order k are the traces of RT_k: p_h = -sigma_n^h
+        p_mean, residual, p_squared = _trace_pressure(solution, edges, on_gamma_c)
+    else:
+        # p_h = -(hat projection of sigma_n^h), as means over the fine edges
+        p_mean = np.zeros(len(length))
+        for hats in (spaces.prolongations["lam_n"], spaces.end_hats["lam_n"]):
+            means = gamma_c.hat_means(hats)
+            if means.shape[1]:
+                p_mean += means @ -hat_projection(means, length, sigma_n)
+        residual, p_squared = length * (sigma_n + p_mean)**2, length * p_mean**2
     # the edges under a fixed end's hat, where lambda_n is data, not an unknown of (3.62)
     fixed = np.asarray(abs(gamma_c.hat_means(spaces.end_hats["lam_n"])).sum(axis=1)).ravel() > 0
-    size = float(np.sqrt(np.sum(inside * length * p_mean**2)))
+    size = float(np.sqrt(np.sum(inside * p_squared)))   # ||p_h||, P_k at order k
 
     # lambda_n and g_h at the fine vertices, chain by chain (n_edges + 1 per chain)
     fine = pb.to_fine(solution.x)
@@ -145,9 +157,11 @@ def goal_estimate(solution: Solution, estimated: Estimate,
                                            spaces.end_hats["lam_n"])
     starts = _edge_starts(gamma_c)
     lam_mean = 0.5 * (lam_n[starts] + lam_n[starts + 1])
+    if spaces.family == "facet":   # lambda_n is P_k on every edge at order k: its own mean
+        lam_mean = gamma_c.hat_means(spaces.prolongations["lam_n"]) @ solution.x[pb.lam_n]
 
     on_edges = {
-        "residual": length * (sigma_n + p_mean)**2,
+        "residual": residual,   # the tension of p_h at order k
         "complementarity": _complementarity(length, np.maximum(p_mean, 0), lam_mean,
                                             e_star / htilde, fixed),
         "kink": _kinks(gamma_c, gap - lam_n, lam_n, starts, e_star * e_star * htilde),
@@ -188,6 +202,28 @@ def _in_window(x: np.ndarray, window: tuple[float, float] | None) -> np.ndarray:
         raise SceneError("window", f"[{window[0]:g}, {window[1]:g}] holds no edge of Gamma_C "
                                    f"(its midpoints lie in [{x.min():g}, {x.max():g}])")
     return inside
+
+
+def _trace_pressure(solution: Solution, edges: BoundaryEdges, on_gamma_c: list[int]
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """p_h = -sigma_n^h at order k with the facet multipliers: on every fine edge e of
+    Gamma_C (``on_gamma_c``: their dofs in ``edges``) its mean, its tension
+    ||min(p_h, 0)||_e^2 and ||p_h||_e^2.
+
+    The facet multipliers are the normal traces of RT_k (docs/theory/order.md), so the
+    pressure the contact conditions control is the trace itself and the residual of the
+    hat projection vanishes. What the conditions leave free is the trace's sign: only its
+    Bernstein moments are signed, and on an edge that straddles the end of the contact
+    zone the P_k trace goes tensile. The exact pressure is >= 0, so
+    |p - p_h| >= max(-p_h, 0) pointwise: the tension is part of the error.
+    """
+    n = ngs.specialcf.normal(2)
+    p = -(ngs.BoundaryFromVolumeCF(fields(solution).sigma) * n) * n
+    tension = ngs.IfPos(p, 0, p)
+    labels = solution.problem.scene.labels("contact")
+    integral, tension2, square = (edges.integrals(cf, labels)[on_gamma_c]
+                                  for cf in (p, tension * tension, p * p))
+    return integral / solution.problem.spaces.gamma_c.lengths, tension2, square
 
 
 def _complementarity(length: np.ndarray, pressure: np.ndarray, lam_mean: np.ndarray,
