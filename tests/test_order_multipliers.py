@@ -64,7 +64,8 @@ def test_the_facet_multipliers_of_the_contact_solver_have_the_constants_of_the_f
     """The solver's facet P_k (Bernstein coefficients on a Discontinuous H1 host, d assembled
     by ngdual.forms) against this module's (Legendre on a SurfaceL2 host), in one norm."""
     scene = load_scene("thesis-3.46-frictionless",
-                       [f"discretisation.order={k}", "discretisation.multipliers=facet"])
+                       [f"discretisation.order={k}", "discretisation.multipliers=facet",
+                        "contact.ends='consistent'"])
     mesh = build_mesh(scene.geometry, 1)
     problem = assemble(scene, mesh)
     B = problem.block(problem.sigma, problem.index("phi1", "phi2", "lam_t", "lam_n")).toarray()

@@ -191,7 +191,37 @@ def _validate_discretisation(scene: Scene) -> None:
             problems.add("solver.method", "the Uzawa algorithms iterate in the metrics of the "
                          "coarse h~ mesh; the facet multipliers are solved by \"active-set\" "
                          "(or \"auto\")")
+        for f, m in _facet_contact_settings(scene.contact):
+            problems.add(f, m)
     problems.raise_any()
+
+
+def _facet_contact_settings(con: Contact) -> list[tuple[str, str]]:
+    """``(field, message)`` for every contact setting of the coarse multipliers that the facet
+    multipliers would ignore.
+
+    The facet multipliers live on the fine edges, discontinuous from edge to edge: there is
+    no h~ or h^ mesh to size, and no value at an end of Gamma_C to prescribe, so the end
+    value of lambda_n = g - u_n is left to the solution, which is the physics of
+    ``"consistent"`` (``"thesis"``, zero at every end, is the inconsistency of (3.61) kept
+    to reproduce the thesis' tables at order 0). The defaults describe that; other values
+    would do nothing.
+    """
+    default, found = Contact(), []
+    for key, what in (("htilde_factor", "h~ = htilde_factor h"),
+                      ("hhat_factor", "h^ = hhat_factor h~")):
+        if getattr(con, key) != getattr(default, key):
+            found.append((f"contact.{key}", f"{what} sizes a coarse mesh of the thesis' "
+                          "multipliers; the facet multipliers live on the fine edges and have "
+                          "none, so it does nothing with discretisation.multipliers = "
+                          f"\"facet\"; remove it (default {getattr(default, key)})"))
+    if con.ends != default.ends:
+        found.append(("contact.ends", f"{show(con.ends)} prescribes the multipliers at the ends "
+                      "of Gamma_C, and the facet multipliers have no value there to prescribe: "
+                      "discontinuous from edge to edge, they leave lambda_n = g - u_n at an end "
+                      "to the solution, which is what \"consistent\" means; set "
+                      "contact.ends = \"consistent\""))
+    return found
 
 
 def _validate_solver(sol: Solver, problems: Problems) -> None:
