@@ -3,12 +3,16 @@
 A mesh is never built blind: :func:`estimate` predicts the number of triangles of a
 scene's geometry on a level (exactly for Example 3.46, ``32 * 4**(level-1)``; for a
 netgen polygon from its area and ``maxh``, plus the graded strips along sides with a
-smaller ``side_maxh``), the unknowns of (3.62) (about 7.5 per triangle: Table 3.1 has
-X = 680 + M = 256 + S = 81 + ... on 128 triangles) and the peak memory of a solve
-(about 2.5 kB per unknown: Example 3.46 with Coulomb friction on level 8, 3.9e6
-unknowns, peaks at 9 GB with the active-set solver; the Uzawa algorithms, with the
-saddle-point factorisation, need about 8.5 kB per unknown: 0.6 GB on level 5 and 2.2 GB on
-level 6 of Example 3.46 with Coulomb friction).
+smaller ``side_maxh``), the unknowns of (3.62) at the order k of PEERS_k
+(:func:`unknowns_per_element`: 7.5 per triangle at k = 0, Table 3.1 has X = 680 + M = 256
++ S = 81 + ... on 128 triangles; 24 at k = 1, 47.5 at k = 2) and the peak memory of a
+solve. The thesis' pairing (k = 0, coarse multipliers) peaks at about 2.5 kB per unknown
+with the active-set solver (Example 3.46 with Coulomb friction on level 8, 3.9e6 unknowns:
+9 GB) and 8.5 kB with the Uzawa algorithms and their saddle-point factorisation (0.6 GB on
+level 5 and 2.2 GB on level 6). The facet multipliers (every order k >= 1) are solved on
+the conforming K condensed onto Gamma_C (:mod:`ngdual.solvers.conforming`): a sparse LU of
+about :data:`BYTES_PER_UNKNOWN_CONFORMING` per unknown and two dense N x N_C arrays (C and
+K^-1 C), N_C = (k + 1) times the fine edges of Gamma_C (:func:`contact_edges`).
 :func:`check` refuses a run whose estimate exceeds the memory this process may use
 (:func:`available_memory`: the smallest of the machine's available memory, the address
 space left under ``ulimit -v`` and the room left in the process's cgroup), with the
@@ -32,9 +36,13 @@ import numpy as np
 from . import geometry
 from .scene import Geometry, SceneError
 
-UNKNOWNS_PER_ELEMENT = 7.5
+UNKNOWNS_PER_ELEMENT = 7.5    # PEERS_0 (3.61): unknowns_per_element(0)
 # peak of a solve per unknown (factorisation, condensation, records), by solver.method
 BYTES_PER_UNKNOWN = {"auto": 2500.0, "active-set": 2500.0, "uzawa": 8500.0}
+# the sparse LU of the conforming K and the records per unknown, by order k, beyond the
+# dense arrays of the condensation (Example 3.46 without friction, level 4: k = 1 8.2 kB,
+# k = 2 10.2 kB; tests/test_budget_order.py)
+BYTES_PER_UNKNOWN_CONFORMING = {0: 9000.0, 1: 9000.0, 2: 10500.0}
 BYTES_PER_ELEMENT_MESH = 2000.0  # mesh and spaces only (``ngdual dofs``)
 BASE_BYTES = 400e6              # Python, NGSolve, SciPy, cvxpy loaded
 
@@ -54,32 +62,81 @@ class Estimate:
                 f"{_gib(memory)} of memory")
 
 
-def estimate(geo: Geometry, level: int | None = None, method: str = "auto") -> Estimate:
+def unknowns_per_element(order: int = 0) -> float:
+    """Unknowns of PEERS_k per triangle on a large mesh (3 edges and 1/2 vertex each).
+
+    Per stress row RT_k, k + 1 dofs per edge and k (k + 1) inside, plus the 2k + 1 bubbles
+    of :func:`ngdual.peers.bubbles`; u in discontinuous P_k, (k + 1)(k + 2) / 2 per
+    component; the rotation in continuous P_{k+1}, one dof per vertex, k per edge and
+    k (k - 1) / 2 inside. The boundary multipliers grow like the square root of the
+    triangles and are left out.
+
+    >>> [unknowns_per_element(k) for k in (0, 1, 2)]
+    [7.5, 24.0, 47.5]
+    """
+    row = 1.5 * (order + 1) + order * (order + 1) + 2 * order + 1
+    displacement = (order + 1) * (order + 2)
+    rotation = 0.5 + 1.5 * order + order * (order - 1) / 2
+    return 2 * row + displacement + rotation
+
+
+def _mesh_lengths(geo: Geometry) -> dict[str, float]:
+    """Length of every side label of ``geo``."""
+    lengths: dict[str, float] = {}
+    for c in geo.curves():
+        xy = c.sample(65)[0] if c.is_arc else np.array([c.start, c.end])
+        lengths[c.label] = lengths.get(c.label, 0.0) + float(
+            np.linalg.norm(np.diff(xy, axis=0), axis=1).sum())
+    return lengths
+
+
+def contact_edges(geo: Geometry, labels, level: int | None = None) -> float:
+    """The number of fine edges on the sides ``labels`` (Gamma_C) on ``level``: their length
+    over the mesh size there (1 on level 1 of Example 3.46, else ``side_maxh`` or ``maxh``),
+    halved by every refinement."""
+    level = geo.level if level is None else level
+    lengths = _mesh_lengths(geo)
+    edges = 0.0
+    for label in labels:
+        h = 1.0 if geo.kind == "thesis-3.46" else min(geo.maxh,
+                                                       geo.side_maxh.get(label, geo.maxh))
+        edges += lengths.get(label, 0.0) / h
+    return edges * 2.0 ** min(level - 1, 400)
+
+
+def estimate(geo: Geometry, level: int | None = None, method: str = "auto", order: int = 0,
+             multipliers: str = "coarse", contact=()) -> Estimate:
     """The predicted size of the mesh of ``geo`` on ``level`` (default: its own level) and
-    of a solve with ``method`` (``solver.method``)."""
+    of a solve with ``method`` (``solver.method``) of PEERS_``order`` with the multiplier
+    family ``multipliers`` (``discretisation.family``: "coarse" or "facet") and Gamma_C on
+    the sides ``contact`` (labels)."""
     level = geo.level if level is None else level
     refinements = 4.0 ** min(level - 1, 400)  # beyond, the estimate is "too large" anyway
     if geo.kind == "thesis-3.46":
         elements = 32.0 * refinements
     else:
-        curves = geo.curves()
-        area = geometry.signed_area(geometry.outline(curves))
+        area = geometry.signed_area(geometry.outline(geo.curves()))
         elements = max(area / (math.sqrt(3) / 4 * geo.maxh ** 2), 2.0)
-        lengths = {c.label: 0.0 for c in curves}
-        for c in curves:
-            xy = c.sample(65)[0] if c.is_arc else np.array([c.start, c.end])
-            lengths[c.label] += float(np.linalg.norm(np.diff(xy, axis=0), axis=1).sum())
+        lengths = _mesh_lengths(geo)
         for label, h in geo.side_maxh.items():
             if h < geo.maxh:
                 # netgen grades from h to maxh: a strip of about log2(maxh/h) layers
                 elements += 4.0 * lengths[label] / h * max(1.0, math.log2(geo.maxh / h))
         elements *= refinements
-    return Estimate(elements, UNKNOWNS_PER_ELEMENT * elements, solve_memory(elements, method),
-                    BASE_BYTES + BYTES_PER_ELEMENT_MESH * elements)
+    unknowns = unknowns_per_element(order) * elements
+    if multipliers == "facet":
+        dense = 16.0 * unknowns * (order + 1) * contact_edges(geo, contact, level)
+        memory = BASE_BYTES + BYTES_PER_UNKNOWN_CONFORMING[order] * unknowns + dense
+    else:
+        memory = solve_memory(elements, method)
+    mesh_memory = BASE_BYTES + BYTES_PER_ELEMENT_MESH * elements * (
+        unknowns_per_element(order) / UNKNOWNS_PER_ELEMENT)
+    return Estimate(elements, unknowns, memory, mesh_memory)
 
 
 def solve_memory(elements: float, method: str = "auto") -> float:
-    """Predicted peak bytes of a solve with ``method`` on a mesh of ``elements`` triangles."""
+    """Predicted peak bytes of a solve of PEERS_0 with the coarse multipliers and ``method``
+    on a mesh of ``elements`` triangles."""
     per_unknown = BYTES_PER_UNKNOWN.get(method, max(BYTES_PER_UNKNOWN.values()))
     return BASE_BYTES + per_unknown * UNKNOWNS_PER_ELEMENT * elements
 
@@ -191,10 +248,12 @@ def describe_available(have: float | None = None) -> str:
 
 
 def check(geo: Geometry, level: int | None = None, field_name: str = "geometry.level",
-          allow_large: bool = False, mesh_only: bool = False, method: str = "auto") -> Estimate:
-    """The estimate of ``geo`` on ``level``; a SceneError naming ``field_name`` if it does
-    not fit in the available memory (unless ``allow_large``)."""
-    size = estimate(geo, level, method)
+          allow_large: bool = False, mesh_only: bool = False, method: str = "auto",
+          order: int = 0, multipliers: str = "coarse", contact=()) -> Estimate:
+    """The estimate of ``geo`` on ``level`` (:func:`estimate`, with ``method``, ``order``,
+    ``multipliers`` and ``contact``); a SceneError naming ``field_name`` if it does not fit
+    in the available memory (unless ``allow_large``)."""
+    size = estimate(geo, level, method, order, multipliers, contact)
     need = size.mesh_memory if mesh_only else size.memory
     have = available_memory()
     if need > have and not allow_large:
@@ -203,7 +262,7 @@ def check(geo: Geometry, level: int | None = None, field_name: str = "geometry.l
         if geo.kind == "polygon":
             where += f" with maxh = {geo.maxh:g}" + "".join(
                 f", side_maxh.{label} = {h:g}" for label, h in geo.side_maxh.items())
-            first = estimate(geo, 1, method)
+            first = estimate(geo, 1, method, order, multipliers, contact)
             if (first.mesh_memory if mesh_only else first.memory) > have:
                 # too fine before any refinement: blame the size that makes it so
                 field_name, remedy = _finest_size(geo)

@@ -21,6 +21,7 @@ condensed onto lambda_n: one sparse LU and N_C substitutions (:mod:`ngdual.solve
 
 from __future__ import annotations
 
+import dataclasses
 import time
 import warnings
 from collections.abc import Callable
@@ -33,7 +34,8 @@ from ..boundary import BoundaryMeshes
 from ..forms import DiscreteProblem, assemble
 from ..mesh import build_mesh
 from ..quadrature_check import check_formulas
-from ..scene import Scene, SceneError, SceneTypeError, check_level, ensure_valid
+from ..scene import Scene, SceneError, SceneTypeError, check_level, ensure_valid, validate
+from ..scene.values import show
 from .active_set import ContactStart, active_set_solve
 from .conforming import conforming_active_set
 from .linear import solve_linear
@@ -53,7 +55,8 @@ from .uzawa import uzawa
 def solve_scene(scene: Scene, level: int | None = None,
                 progress: Callable[[int, float], None] | None = None,
                 allow_large: bool = False,
-                status: Callable[[str], None] | None = None) -> Solution:
+                status: Callable[[str], None] | None = None, *,
+                order: int | None = None, multipliers: str | None = None) -> Solution:
     """Mesh ``scene`` on ``level`` (default: the scene's level) and solve it there.
 
     The scene is validated (once: a scene from :func:`ngdual.scene.load_scene` is not
@@ -67,16 +70,28 @@ def solve_scene(scene: Scene, level: int | None = None,
     progress display. Every failed physics check (``solution.warnings``,
     :mod:`ngdual.checks`) is also issued as a Python warning of category
     :class:`~ngdual.solvers.result.PhysicsWarning`, so a notebook shows it.
+
+    ``order`` and ``multipliers`` solve with the polynomial order k of PEERS_k and the
+    multiplier family in place of the scene's ``[discretisation]`` entries
+    (:func:`with_discretisation`; ``scene`` itself is not changed, ``solution.problem.scene``
+    is the scene solved).
+
+    >>> import ngdual as nd
+    >>> scene = nd.load_scene("thesis-3.46-frictionless", ["geometry.level=2"])
+    >>> nd.solve(scene, order=1).problem.scene.discretisation.family   # doctest: +SKIP
+    'facet'
     """
     start = time.perf_counter()
-    ensure_valid(scene)
+    scene = with_discretisation(scene, order, multipliers)
     level = check_level(level, "level", optional=True)
     if progress is not None and not callable(progress):
         raise SceneTypeError("progress", f"must be a callable progress(iteration, "
                                          f"increment), got {type(progress).__name__}")
     if not isinstance(allow_large, bool):
         raise SceneTypeError("allow_large", f"must be True or False, got {allow_large!r}")
-    budget.check(scene.geometry, level, "level", allow_large, method=scene.solver.method)
+    budget.check(scene.geometry, level, "level", allow_large, method=scene.solver.method,
+                 order=scene.discretisation.order, multipliers=scene.discretisation.family,
+                 contact=scene.labels("contact"))
     level = scene.geometry.level if level is None else level
     if status is not None:
         status(f"meshing level {level}")
@@ -86,6 +101,43 @@ def solve_scene(scene: Scene, level: int | None = None,
     for found in solution.warnings:
         warnings.warn(found.message, PhysicsWarning, stacklevel=2)
     return solution
+
+
+def with_discretisation(scene: Scene, order: int | None = None,
+                        multipliers: str | None = None) -> Scene:
+    """The valid ``scene`` with ``order`` and ``multipliers`` in place of its
+    ``[discretisation]`` entries (None keeps the scene's); ``scene`` itself is unchanged.
+
+    ``order`` is the k of PEERS_k (0, 1, 2; 0 is the thesis' triple (3.61)),
+    ``multipliers`` the family of phi, lambda_n, lambda_t (``"auto"``, ``"coarse"``,
+    ``"facet"``: :class:`ngdual.scene.Discretisation`). The changed scene is validated as a
+    whole; a problem of either entry raises a :class:`~ngdual.scene.SceneError` naming the
+    argument (``order``, ``multipliers``), one that the entries cause elsewhere (friction on
+    the facet multipliers) names the scene's field.
+    """
+    ensure_valid(scene)
+    given = {name: value for name, value in (("order", order), ("multipliers", multipliers))
+             if value is not None}
+    if not given:
+        return scene
+    if "order" in given and (isinstance(order, bool)
+                             or not isinstance(order, (int, np.integer))):
+        raise SceneTypeError("order", f"must be an integer k (0, 1 or 2) or None, got "
+                                      f"{show(order)}")
+    if "multipliers" in given and not isinstance(multipliers, str):
+        raise SceneTypeError("multipliers", f"must be a string (\"auto\", \"coarse\" or "
+                                            f"\"facet\") or None, got {show(multipliers)}")
+    if "order" in given:
+        given["order"] = int(order)
+    changed = dataclasses.replace(
+        scene, discretisation=dataclasses.replace(scene.discretisation, **given))
+    try:
+        validate(changed)
+    except SceneError as err:
+        renamed = {f"discretisation.{name}": name for name in given}
+        problems = [(renamed.get(f, f), m) for f, m in err.problems]
+        raise SceneError(problems[0][0], problems[0][1], problems) from None
+    return changed
 
 
 def solve_on_mesh(scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes | None = None, *,
