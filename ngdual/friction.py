@@ -13,6 +13,14 @@ exactly, mu_i the h~ hats and kappa_j the indicator of the h^ edge j.
 The normal and tangential stress per fine edge are linear maps of the unknown
 vector, assembled once by NGSolve against the fine trace space of Gamma_C
 (:class:`ngdual.contact.ContactBoundary`, the one home of Gamma_C).
+
+With the facet multipliers of order k (:mod:`ngdual.boundary.facet`) lambda_t has the
+Bernstein coefficients of lambda_n, and the friction law acts on every coefficient i with
+its moment t_t,i = d_Ct(B_i, sigma): |t_t,i| <= F_i, lambda_t,i = 0 where |t_t,i| < F_i and
+sign(lambda_t,i) = sign(t_t,i) where lambda_t,i != 0 -- (3.62)_5-7 with nu on the
+coefficients and Q_F = diag(F_i) (:class:`MomentFriction`). F_i = int F B_i ds for a given
+Tresca bound (:func:`tresca_moments`), F_i = mu_f (-t_n,i) for Coulomb, the weighted
+moments of the mortar methods (Hueber and Wohlmuth).
 """
 
 from __future__ import annotations
@@ -26,7 +34,7 @@ import scipy.sparse as sp
 from . import peers
 from .contact import ContactBoundary
 from .expr import Expression
-from .forms import DiscreteProblem, boundary_regex
+from .forms import TRACE_RULES, DiscreteProblem, boundary_regex
 from .geometry import tangent
 from .sparse import to_scipy
 from .tolerances import friction_vanishes
@@ -176,14 +184,73 @@ def _edge_functionals(problem: DiscreteProblem) -> tuple[sp.csr_matrix, sp.csr_m
     return mats[0], mats[1]
 
 
+class FacetFrictionForms(FrictionForms):
+    """:class:`FrictionForms` of the facet multipliers: every fine edge is its own h^ edge.
+
+    The friction law acts on the Bernstein coefficients (:class:`MomentFriction`); per fine
+    edge e it implies |int_e sigma_t ds| <= sum_{i in e} F_i, which is what the fine-edge
+    bound ``edge_bound(F)`` = sum_{i in e} F_i / |e| states in the terms of the thesis'
+    F per fine edge (the physics checks read it through :meth:`q_matrix`).
+    """
+
+    @property
+    def edge_of(self) -> np.ndarray:
+        return np.arange(len(self.lengths))
+
+    @property
+    def hat_lengths(self) -> np.ndarray:
+        return self.lengths
+
+    def edge_bound(self, coefficients: np.ndarray) -> np.ndarray:
+        """sum_{i in e} F_i / |e| on every fine edge e from F_i of the Bernstein coefficients
+        (the means of the B_i on their edge are all 1 / (k + 1))."""
+        per_edge = self.midpoint_hats.shape[1] / self.midpoint_hats.shape[0]
+        return per_edge * (self.midpoint_hats @ coefficients) / self.lengths
+
+
+@dataclass(frozen=True)
+class MomentFriction:
+    """The friction law on the Bernstein moments of the facet multipliers (module docstring).
+
+    Q_F = diag(F_i) in the conditions of :mod:`ngdual.solvers.semismooth`; for Coulomb
+    F_i = mu_f (-t_n,i) with t_n,i = d_Cn(B_i, sigma) <= 0 the normal moment of the same
+    coefficient. At k = 0 the B_0 are the indicators of the fine edges, and the law is the
+    thesis' on an h^ mesh equal to the fine mesh with F = mu_f |sigma_n| on every edge, the
+    normal stress itself rather than its hat projection p_h (which lives on the h~ hats,
+    absent here: the fine trace of sigma_n is the multipliers' own).
+    """
+
+    def q_matrix(self, bound: np.ndarray) -> sp.csr_matrix:
+        """Q_F = diag(F_i)."""
+        return sp.diags(np.asarray(bound, dtype=float)).tocsr()
+
+    def coulomb_bound_of(self, t_n: np.ndarray, mu_f: float) -> np.ndarray:
+        """F_i = mu_f max(-t_n,i, 0) from the normal moments t_n,i."""
+        return mu_f * np.maximum(-np.asarray(t_n, dtype=float), 0.0)
+
+
+def tresca_moments(problem: DiscreteProblem) -> np.ndarray:
+    """F_i = int_{Gamma_C} F B_i ds for the given Tresca bound F, one per Bernstein
+    coefficient of the facet multipliers (the rule of the traces, ``forms.TRACE_RULES``)."""
+    space = problem.spaces.components["lam_n"]
+    labels = problem.scene.labels("contact")
+    form = ngs.LinearForm(space)
+    form += Expression(problem.scene.friction.bound).coefficient() * space.TestFunction() * ngs.ds(
+        definedon=space.mesh.Boundaries(boundary_regex(labels)), intrules=TRACE_RULES)
+    form.Assemble()
+    return problem.spaces.prolongations["lam_n"].T @ form.vec.FV().NumPy()
+
+
 def build_friction_forms(problem: DiscreteProblem) -> FrictionForms:
-    """Fine-edge traces and hat means on Gamma_C (:class:`ngdual.contact.ContactBoundary`)."""
+    """Fine-edge traces and hat means on Gamma_C (:class:`ngdual.contact.ContactBoundary`);
+    :class:`FacetFrictionForms` with the facet multipliers."""
     gamma_c = problem.spaces.gamma_c
     int_n, int_t = _edge_functionals(problem)
     scale = sp.diags(1.0 / gamma_c.lengths)
-    return FrictionForms(gamma_c, T_n=(scale @ int_n).tocsr(), T_t=(scale @ int_t).tocsr(),
-                         midpoint_hats=gamma_c.hat_means(problem.spaces.prolongations["lam_n"]),
-                         normal_stress=problem.scene.friction.normal_stress)
+    kind = FacetFrictionForms if problem.spaces.family == "facet" else FrictionForms
+    return kind(gamma_c, T_n=(scale @ int_n).tocsr(), T_t=(scale @ int_t).tocsr(),
+                midpoint_hats=gamma_c.hat_means(problem.spaces.prolongations["lam_n"]),
+                normal_stress=problem.scene.friction.normal_stress)
 
 
 def tresca_bound(forms: FrictionForms, problem: DiscreteProblem) -> np.ndarray:

@@ -64,7 +64,9 @@ def test_the_command_line_sets_the_order_and_balances_the_contact_force(tmp_path
                                                        rel=1e-9)
 
 
-def test_friction_on_the_facet_multipliers_is_refused_naming_the_law():
+def test_the_thesis_coulomb_normal_stress_is_refused_with_the_facet_multipliers():
+    """The facet multipliers bound each Bernstein moment by its own normal moment: the
+    choice of |sigma_n| on the h^ edges does nothing there, so it is an error."""
     with pytest.raises(SceneError) as err:
         load_scene("thesis-3.46-tresca", ["discretisation.order=1"])
     assert err.value.field == "friction.law"

@@ -183,10 +183,11 @@ def _validate_discretisation(scene: Scene) -> None:
         problems.add("discretisation.multipliers", f"the coarse multipliers are the thesis' P1 "
                      f"on h~, of order 0 only; at order {disc.order} use \"facet\" (or \"auto\")")
     if disc.family == "facet":
-        if scene.has_friction:
-            problems.add("friction.law", f"{show(scene.friction.law)} friction is solved on "
-                         "the coarse multipliers only; the facet multipliers solve "
-                         "frictionless contact (friction.law = \"none\")")
+        if scene.friction.law == "coulomb" and "normal_stress" in _given(scene, "friction"):
+            problems.add("friction.normal_stress", "chooses the |sigma_n| of the thesis' "
+                         "Coulomb bound on the h^ edges; the facet multipliers bound every "
+                         "Bernstein coefficient by mu_f times its own normal moment, so it "
+                         "does nothing with discretisation.multipliers = \"facet\"; remove it")
         if scene.solver.method == "uzawa":
             problems.add("solver.method", "the Uzawa algorithms iterate in the metrics of the "
                          "coarse h~ mesh; the facet multipliers are solved by \"active-set\" "

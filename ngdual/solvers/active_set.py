@@ -279,7 +279,7 @@ def _active_set_solve(problem: DiscreteProblem, settings: ActiveSetSettings, tol
     forms = build_friction_forms(problem) if model.has_friction else None
     if law == "coulomb":                                                        # step 3
         noise = SAFETY * level * mu_f * boundary.stress_scale
-        state, bound, history, iterations = _coulomb_fixed_point(
+        state, bound, history, iterations = coulomb_fixed_point(
             boundary, forms, mu_f, tol, settings.max_iter, progress, noise,
             _first_state(problem, warm, boundary.n_c, 0))
     else:
@@ -354,7 +354,7 @@ class BoundaryProblem:
         return (self.a_f - self.B_f @ z)[:len(self.lengths)] / self.lengths
 
 
-def _coulomb_fixed_point(boundary: BoundaryProblem, forms: FrictionForms, mu_f: float,
+def coulomb_fixed_point(boundary: BoundaryProblem, forms: FrictionForms, mu_f: float,
                          tol: float, max_iter: int, progress, noise: float,
                          first: BoundarySolution | None = None):
     """Remark 3.45 on Gamma_C: F^0 from the frictionless solution, then Phi(F) = mu_f |sigma_n|

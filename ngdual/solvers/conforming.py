@@ -1,117 +1,374 @@
-"""The active-set method on the conforming system K: frictionless contact at every order k.
+"""The active-set method on the conforming system K: contact and friction at every order k.
 
 The hybridised solver of :mod:`ngdual.solvers.active_set` eliminates broken RT_0 rows and
 P1 traces on the h~ mesh (:class:`~ngdual.solvers.hybrid.HybridSystem`); at order k >= 1,
 or with the facet multipliers (:mod:`ngdual.boundary.facet`), there is no such system, and
-the problem (3.103) is solved on the assembled K itself, with one sparse LU factorisation
+the problem (3.62) is solved on the assembled K itself, with one sparse LU factorisation
 (UMFPACK, :class:`~ngdual.solvers.linear.Factorization`).
 
-The contact conditions of (3.103) act on the unknowns of lambda_n (the Bernstein
-coefficients of the facet multipliers, the hat values of the coarse ones) and on their
-moments t_n = C_n^T sigma; without friction lambda_t is free, and its moments t_t = 0 are
-one more equation of the sparse system.
-The problem is condensed onto lambda_n, as in :mod:`ngdual.solvers.active_set`: with S all
-other unknowns (sigma, u, eta, phi, lambda_t), one factorisation of K_SS and N_C solves give
+The contact and friction conditions act on the Bernstein coefficients of lambda_n and
+lambda_t and on their moments t = C^T sigma - r (C = K_sigma,lambda, r the lambda rows of
+the right-hand side; t_n,i = d_Cn(B_i, sigma_h) - g_i): lambda_n >= 0, t_n <= 0,
+lambda_n t_n = 0; without friction t_t = 0, with it the law of
+:class:`ngdual.friction.MomentFriction`, |t_t,i| <= F_i on every coefficient.
 
-    t_n(lambda_n) = b - G lambda_n,   G = C^T K_SS^{-1} C,   b = C^T K_SS^{-1} r_S - r_n,
+Condensation onto the candidates. One factorisation of the whole K -- every multiplier
+free: the linear problem in which Gamma_C carries no traction -- gives the free solution
+x_0 = K^{-1} rhs with multipliers a, and the columns K^{-1} e_j of the multipliers j of a
+set J of coefficients give the multipliers for tractions t_J on J (zero elsewhere):
 
-C = K_S,lambda_n (G is symmetric positive semidefinite: the sigma block of the inverse of a
-saddle-point matrix), and the damped semismooth Newton method of
-:mod:`ngdual.solvers.semismooth`, with its QP fallback, solves lambda_n >= 0, t_n <= 0,
-lambda_n . t_n = 0 (it is posed for z = (lambda_n, lambda_t), here with lambda_t = 0 and the
-identity as its block). One back substitution gives the rest. The primal-dual active-set
-method on the sparse K, one factorisation per set and no dense G, cycles on the
-manufactured case at k = 1 and on Example 3.46 at k = 0 with the facet multipliers (K is no
-M-matrix), so it is not used. The N_C solves dominate (manufactured case at k = 1, level 4,
-50 000 unknowns, 128 solves: about 15 s against 2 s for the factorisation).
+    K x = rhs + E_J t_J,    lambda = a + H t_J,    H = (K^{-1})_{lambda, J}.
+
+By the block inverse, H_JJ = -G^{-1} with G = C_J^T K_R^{-1} C_J (R: all unknowns but
+lambda_J; G symmetric positive definite), so on J the problem is that of
+:mod:`ngdual.solvers.semismooth`,
+
+    t_J(z) = b - G z,    G = -H_JJ^{-1},    b = G a_J,
+
+z = (lambda_n, lambda_t) on J (without friction lambda_t is free everywhere, t_t = 0: its
+block is the identity), and the damped semismooth Newton method with its QP fallback
+solves it; for Coulomb friction the fixed point F = mu_f (-t_n) of Remark 3.45 runs around
+it (:func:`ngdual.solvers.active_set.coulomb_fixed_point`). Off J the multipliers are free
+and their moments vanish, which satisfies the conditions exactly where lambda_n >= 0 (and,
+where a Tresca bound F_i > 0 holds, lambda_t,i = 0: stick). J starts with the coefficients
+the free solution pushes through the obstacle (a_n < 0) -- those in contact in a warm
+start, and every coefficient with F_i > 0 for Tresca -- and takes in every coefficient
+that violates a condition off J, until none does; each column is computed once. One more
+solve with the tractions t_J gives all unknowns. The cost: one factorisation and |J| + 2
+solves (|J| = 2 x 8 of 128 coefficients for Hertz at k = 1, level 2, against the N_C solves
+of condensing onto every coefficient).
+
+If K is singular (a body held by Gamma_C alone has rigid motions when nothing touches),
+every multiplier is eliminated instead: one factorisation of K without the multipliers
+(all clamped, lambda = 0) and a solve per coefficient, G = C^T K_SS^{-1} C and
+b = C^T K_SS^{-1} r_S - r on all of Gamma_C.
+
+The primal-dual active-set method on the sparse K (one factorisation per set) cycles on
+the manufactured case at k = 1 and on Example 3.46 at k = 0 with the facet multipliers
+(K is no M-matrix); the damped method on the condensed problem does not.
+The result is checked on K: the residuals of (3.103) (and of the friction law) are
+round-off, or a :class:`ConvergenceError` names every one that is not.
 """
 
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass
 
 import numpy as np
+import scipy.linalg as sla
 
 from ..forms import DiscreteProblem
-from .active_set import ContactStart
+from ..friction import MomentFriction, build_friction_forms, tresca_moments
+from ..tolerances import COULOMB_FIXED_POINT_TOL
+from .active_set import ContactStart, coulomb_fixed_point
 from .linear import Factorization
 from .qp import contact_problem_residuals
 from .result import ConvergenceError, Solution
-from .semismooth import BoundarySolution, semismooth_newton
+from .semismooth import EPS, SAFETY, BoundarySolution, condition_number, semismooth_newton
 from .settings import ActiveSetSettings
 
 TOLERANCE = 1e-9   # relative residuals of (3.103) accepted as round-off
+REGULAR = 1e-8     # the free solve of a regular K leaves relative residuals below this
+CONTACT_START = 1e-8  # a warm start's lambda_n in contact: below this of its largest value
+
+
+@dataclass
+class Condensed:
+    """The contact problem on the coefficients ``J``: t(z) = b - G z, z = (lambda_n,
+    lambda_t) on J, each of length ``n_c`` = |J| (module docstring)."""
+
+    G: np.ndarray
+    b: np.ndarray
+    J: np.ndarray
+
+    @property
+    def n_c(self) -> int:
+        return len(self.J)
+
+    @property
+    def roundoff(self) -> float:
+        """eps max(kappa_1(G), dim G): the relative accuracy of the small problem."""
+        return EPS * max(condition_number(self.G), float(len(self.b)), 1.0)
+
+    def traction(self, state: BoundarySolution) -> np.ndarray:
+        """t = b - G z for the state's multipliers."""
+        return self.b - self.G @ np.concatenate([state.lam_n, state.lam_t])
+
+    def normal_stress(self, state: BoundarySolution) -> np.ndarray:
+        """The normal moments t_n on J (what the Coulomb bound is made of)."""
+        return self.traction(state)[:self.n_c]
+
+
+class WholeFactorization:
+    """K factorised with every multiplier free, and the columns K^{-1} e_j of the multipliers
+    on demand, each computed once (rows: lambda_n, then lambda_t)."""
+
+    def __init__(self, problem: DiscreteProblem):
+        self.problem = problem
+        self.fact = Factorization(problem.K)
+        self.rows = np.concatenate([problem.lam_n, problem.index("lam_t")])
+        self.x0 = self.fact.solve(problem.rhs)
+        self.a = self.x0[self.rows]
+        self._columns: dict[int, np.ndarray] = {}
+        self.solves = 1
+
+    @property
+    def regular(self) -> bool:
+        """Whether the free solve is a solution (K is singular when the body floats)."""
+        K, rhs, x = self.problem.K, self.problem.rhs, self.x0
+        if not np.all(np.isfinite(x)):
+            return False
+        scale = max(float(np.max(abs(K) @ np.abs(x), initial=0.0)),
+                    float(np.max(np.abs(rhs), initial=0.0))) or 1.0
+        return float(np.max(np.abs(K @ x - rhs), initial=0.0)) <= REGULAR * scale
+
+    def columns(self, unknowns: np.ndarray) -> np.ndarray:
+        """(K^{-1})_{lambda, p} for the unknowns p (2 N_C x len(unknowns))."""
+        e = np.zeros(self.problem.K.shape[0])
+        for p in unknowns:
+            if p not in self._columns:
+                e[p] = 1.0
+                self._columns[p] = self.fact.solve(e)[self.rows]
+                e[p] = 0.0
+                self.solves += 1
+        return np.column_stack([self._columns[p] for p in unknowns]) if len(unknowns) \
+            else np.zeros((len(self.rows), 0))
+
+    def condensed(self, J: np.ndarray, friction: bool) -> tuple[Condensed, np.ndarray]:
+        """The problem on J and the columns H (all multipliers x the unknowns of J)."""
+        n_c = len(self.problem.lam_n)
+        own = np.concatenate([J, n_c + J]) if friction else J
+        H = self.columns(self.rows[own])
+        H_JJ = H[own]
+        G = -sla.inv(0.5 * (H_JJ + H_JJ.T))
+        G = 0.5 * (G + G.T)
+        b = G @ self.a[own]
+        if not friction:  # lambda_t free: the identity block of semismooth_newton
+            G = sla.block_diag(G, np.eye(len(J)))
+            b = np.concatenate([b, np.zeros(len(J))])
+        return Condensed(G, b, J), H
+
+    def solution(self, J: np.ndarray, t: np.ndarray, friction: bool) -> np.ndarray:
+        """All unknowns for the tractions t on J (one solve with K)."""
+        n_c = len(self.problem.lam_n)
+        own = np.concatenate([J, n_c + J]) if friction else J
+        rhs = self.problem.rhs.copy()
+        rhs[self.rows[own]] += t[:len(own)]
+        self.solves += 1
+        return self.fact.solve(rhs)
 
 
 def conforming_active_set(problem: DiscreteProblem, settings: ActiveSetSettings,
-                          start: ContactStart | None = None) -> Solution:
-    """Solve (3.103) on ``problem.K``: condensed onto Gamma_C, semismooth Newton there
-    (module docstring).
+                          start: ContactStart | None = None,
+                          tol: float = COULOMB_FIXED_POINT_TOL) -> Solution:
+    """Solve (3.62) on ``problem.K``: condensed onto the candidates on Gamma_C, semismooth
+    Newton there (module docstring).
 
     Parameters
     ----------
     problem : DiscreteProblem
-        Any assembled problem without friction (the scene's validation refuses friction
-        with the facet multipliers).
+        Any assembled problem with a contact boundary and the facet multipliers.
     settings : ActiveSetSettings
-        Read for its model only: the method iterates to round-off.
+        The model (friction law, mu_f) and ``max_iter`` (bound on the Coulomb fixed-point
+        steps); the method iterates to round-off.
     start : ContactStart, optional
         The multipliers of a coarser solution, at this problem's control points
         (``spaces.contact.node_points()``): the Newton method starts there.
+    tol : float
+        Relative change of F at which the Coulomb fixed point stops (or its round-off).
 
     Raises
     ------
     ConvergenceError
-        If the contact problem on Gamma_C is not solved (:func:`semismooth_newton`), or
-        the residuals of (3.103) exceed ``TOLERANCE``.
+        If the contact problem on Gamma_C is not solved (:func:`semismooth_newton`), the
+        Coulomb fixed point does not converge, or the residuals of (3.62) exceed
+        ``TOLERANCE``.
     """
-    if settings.model.has_friction:
-        raise ValueError("the conforming active-set method solves frictionless contact")
+    model = settings.model
     begin = time.perf_counter()
-    first = None
-    if start is not None:
-        first = start.at(problem.spaces.contact.node_points())
-    x, iterations, factor_s = _condensed(problem, first)
-    i_sigma, i_mult, i_lam, rhs = problem.sigma, problem.mult, problem.lam_n, problem.rhs
-    residuals = contact_problem_residuals(problem.block(i_sigma, i_sigma),
-                                          problem.block(i_sigma, i_mult),
-                                          problem.block(i_sigma, i_lam), rhs[i_sigma],
-                                          rhs[i_mult], x[i_sigma], x[i_mult], x[i_lam])
+    first = start.at(problem.spaces.contact.node_points()) if start is not None else None
+    law = model.law
+    bound = tresca_moments(problem) if law == "tresca" else None
+    whole = WholeFactorization(problem)
+    factor_s = whole.fact.seconds
+    friction = MomentFriction()
+    if whole.regular:
+        x, state, F, info = _on_candidates(whole, law, model.mu_f, bound, friction, first,
+                                           settings.max_iter, tol)
+    else:
+        x, state, F, info, factor_s = _on_every_coefficient(problem, law, model.mu_f, bound,
+                                                            friction, first,
+                                                            settings.max_iter, tol)
+    residuals = _residuals(problem, x, F)
+    if law == "coulomb":
+        t_n = _moments(problem, x)[0]
+        mapped = friction.coulomb_bound_of(t_n, model.mu_f)
+        residuals["coulomb_bound"] = float(np.max(np.abs(mapped - F), initial=0.0) / (
+            model.mu_f * np.max(np.abs(t_n), initial=0.0) or 1.0))
     bad = {k: v for k, v in residuals.items() if not v <= TOLERANCE}
     if bad:
-        raise ConvergenceError("the active-set solution does not satisfy (3.103) to round-off: "
+        raise ConvergenceError("the active-set solution does not satisfy (3.62) to round-off: "
                                + ", ".join(f"{k} = {v:.1e} > {TOLERANCE:.0e}"
-                                           for k, v in bad.items()), [])
-    return Solution(problem, x, True, "active-set-conforming", iterations=iterations,
-                    residuals=residuals,
+                                           for k, v in bad.items()), info["history"])
+    nu = forms = edge_bound = None
+    if F is not None:
+        forms = build_friction_forms(problem)
+        edge_bound = forms.edge_bound(F)
+        nu = _nu(problem, x, F)
+    return Solution(problem, x, True, "active-set-conforming" if law == "none"
+                    else f"active-set-conforming-{law}",
+                    iterations={**info["iterations"], "condensed": info["unknowns"],
+                                "solves": info["solves"]},
+                    residuals=residuals, history=info["history"], nu=nu,
+                    friction_bound=edge_bound, friction_forms=forms,
                     timings={"assemble": problem.assemble_seconds, "factorize": factor_s,
                              "solve": time.perf_counter() - begin})
 
 
-def _condensed(problem: DiscreteProblem, first) -> tuple:
-    """Semismooth Newton on the condensed problem t_n = b - G lambda_n (module docstring):
-    (x, iterations, seconds of the factorisation). ``first``: (lambda_n, lambda_t) of a
-    coarser solution at the control points."""
+def _start_state(first, J: np.ndarray, friction: bool, n_rows: int) -> BoundarySolution | None:
+    """The Newton start on J from a coarser solution's (lambda_n, lambda_t)."""
+    if first is None:
+        return None
+    lam_t = first[1][J] if friction else np.zeros(len(J))
+    return BoundarySolution(np.maximum(first[0][J], 0.0), lam_t, np.zeros(n_rows),
+                            np.zeros(len(J), dtype=bool), np.zeros(n_rows, dtype=bool), 0,
+                            False, {})
+
+
+def _solve_condensed(cond: Condensed, law: str, mu_f: float, bound: np.ndarray | None,
+                     friction: MomentFriction, first, max_iter: int, tol: float):
+    """The contact (and friction) problem on J: (state, F on J or None, history, iterations)."""
+    floor = SAFETY * cond.roundoff
+    if law == "coulomb":
+        noise = floor * mu_f * float(np.max(np.abs(cond.b), initial=0.0))
+        state, F, history, iterations = coulomb_fixed_point(
+            cond, friction, mu_f, tol, max_iter, None, noise,
+            _start_state(first, cond.J, True, 0))
+        return state, F, history, iterations
+    F = bound[cond.J] if law == "tresca" else None
+    Q = friction.q_matrix(F).toarray() if F is not None else None
+    state = semismooth_newton(cond.G, cond.b, cond.n_c, Q,
+                              _start_state(first, cond.J, F is not None,
+                                           0 if F is None else cond.n_c), tol=floor)
+    return state, F, [], {"outer": 1, "inner": int(state.iterations)}
+
+
+def _on_candidates(whole: WholeFactorization, law: str, mu_f: float, bound, friction, first,
+                   max_iter: int, tol: float):
+    """Condense onto the candidates J from the factorisation of the whole K, enlarging J
+    until no coefficient off J violates a condition (module docstring)."""
+    n_c = len(whole.problem.lam_n)
+    has_friction = law != "none"
+    candidate = whole.a[:n_c] < 0.0
+    if first is not None:
+        candidate |= first[0] <= CONTACT_START * (np.max(np.abs(first[0]), initial=0.0) or 1.0)
+    if law == "tresca":
+        candidate |= bound > 0.0
+    inner, history, rounds = 0, [], 0
+    while True:
+        rounds += 1
+        J = np.flatnonzero(candidate)
+        cond, H = whole.condensed(J, has_friction)
+        if len(J):
+            state, F_J, hist, its = _solve_condensed(cond, law, mu_f, bound, friction, first,
+                                                     max_iter, tol)
+            t = cond.traction(state)
+        else:
+            state, F_J, hist, its = None, None, [], {"outer": 0, "inner": 0}
+            t = np.zeros(0)
+        inner += its["inner"]
+        history += hist
+        own = 2 * len(J) if has_friction else len(J)
+        lam = whole.a + H @ t[:own]
+        scale = float(np.max(np.abs(lam), initial=0.0)) or 1.0
+        level = SAFETY * (cond.roundoff if len(J) else EPS) * scale
+        off = ~candidate
+        violated = off & (lam[:n_c] < -level)
+        if law == "tresca":
+            violated |= off & (bound > 0.0) & (np.abs(lam[n_c:]) > level)
+        if not violated.any():
+            break
+        candidate |= violated
+        if state is not None:
+            lam_t = lam[n_c:]
+            first = (lam[:n_c], lam_t)
+    x = whole.solution(J, t, has_friction)
+    F = None
+    if has_friction:
+        F = np.zeros(n_c)
+        if law == "tresca":
+            F = bound
+        elif F_J is not None:
+            F[J] = F_J
+    return x, state, F, {"iterations": {"outer": its["outer"], "inner": int(inner),
+                                        "candidate_rounds": rounds},
+                         "history": history, "unknowns": len(J), "solves": whole.solves}
+
+
+def _on_every_coefficient(problem: DiscreteProblem, law: str, mu_f: float, bound, friction,
+                          first, max_iter: int, tol: float):
+    """Eliminate every multiplier (all clamped) and condense onto all coefficients: for a
+    singular K (module docstring)."""
     K, rhs = problem.K.tocsr(), problem.rhs
-    contact = problem.lam_n
-    rest = np.setdiff1d(np.arange(K.shape[0]), contact)
+    has_friction = law != "none"
+    L = np.concatenate([problem.lam_n, problem.index("lam_t")]) if has_friction \
+        else problem.lam_n
+    n_c = len(problem.lam_n)
+    rest = np.setdiff1d(np.arange(K.shape[0]), L)
     fact = Factorization(K[rest][:, rest])
     x = np.zeros(K.shape[0])
     x[rest] = fact.solve(rhs[rest])
-    n_c = len(contact)
-    if not n_c:
-        return x, {"outer": 0, "inner": 0}, fact.seconds
-    C = K[rest][:, contact].toarray()
+    C = K[rest][:, L].toarray()
     W = fact.solve_many(C)
     G = C.T @ W
-    G = np.block([[0.5 * (G + G.T), np.zeros((n_c, n_c))], [np.zeros((n_c, n_c)), np.eye(n_c)]])
-    b = np.concatenate([C.T @ x[rest] - rhs[contact], np.zeros(n_c)])
-    state = None
-    if first is not None:
-        state = BoundarySolution(np.maximum(first[0], 0.0), np.zeros(n_c), np.zeros(0),
-                                 np.zeros(n_c, dtype=bool), np.zeros(0, dtype=bool), 0, False,
-                                 {})
-    state = semismooth_newton(G, b, n_c, start=state)
-    x[rest] -= W @ state.lam_n
-    x[contact] = state.lam_n
-    return x, {"outer": 0, "inner": int(state.iterations)}, fact.seconds
+    G = 0.5 * (G + G.T)
+    b = C.T @ x[rest] - rhs[L]
+    if not has_friction:
+        G = sla.block_diag(G, np.eye(n_c))
+        b = np.concatenate([b, np.zeros(n_c)])
+    cond = Condensed(G, b, np.arange(n_c))
+    state, F, history, its = _solve_condensed(cond, law, mu_f, bound, friction, first,
+                                              max_iter, tol)
+    z = np.concatenate([state.lam_n, state.lam_t])[:len(L)]
+    x[rest] -= W @ z
+    x[L] = z
+    return x, state, F, {"iterations": {**its, "candidate_rounds": 0}, "history": history,
+                         "unknowns": n_c, "solves": len(L) + 1}, fact.seconds
+
+
+def _moments(problem: DiscreteProblem, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """t_n, t_t = C^T sigma - r on every coefficient (the lambda rows of K x - rhs)."""
+    residual = problem.K @ x - problem.rhs
+    return residual[problem.lam_n], residual[problem.index("lam_t")]
+
+
+def _nu(problem: DiscreteProblem, x: np.ndarray, F: np.ndarray) -> np.ndarray:
+    """nu_i = t_t,i / F_i (zero where F_i = 0): in [-1, 1], +-1 where the coefficient slips."""
+    t_t = _moments(problem, x)[1]
+    return np.divide(t_t, F, out=np.zeros_like(t_t), where=F > 0)
+
+
+def _residuals(problem: DiscreteProblem, x: np.ndarray, F: np.ndarray | None) -> dict:
+    """Relative residuals of (3.103) and, with the bound F on the coefficients, of the
+    friction law: |t_t,i| <= F_i (``friction_bound``) and F_i |lambda_t,i| = lambda_t,i t_t,i
+    (``slip``: stick where |t_t,i| < F_i, slip along t_t,i)."""
+    i_sigma, i_mult, i_lam = problem.sigma, problem.mult, problem.lam_n
+    b = problem.rhs[i_mult].copy()
+    t_n, t_t = _moments(problem, x)
+    lam_t_rows = problem.index("lam_t") - len(i_sigma)
+    if F is not None:  # the lambda_t rows carry Q_F^T nu = t_t
+        b[lam_t_rows] += t_t
+    residuals = contact_problem_residuals(problem.block(i_sigma, i_sigma),
+                                          problem.block(i_sigma, i_mult),
+                                          problem.block(i_sigma, i_lam), problem.rhs[i_sigma],
+                                          b, x[i_sigma], x[i_mult], x[i_lam])
+    if F is not None:
+        lam_t = x[problem.index("lam_t")]
+        t_scale = max(float(np.max(np.abs(t_n), initial=0.0)),
+                      float(np.max(np.abs(t_t), initial=0.0))) or 1.0
+        work = float(np.max(F, initial=0.0) * np.max(np.abs(lam_t), initial=0.0)) or 1.0
+        residuals["friction_bound"] = float(np.max(np.abs(t_t) - F, initial=0.0)) / t_scale
+        residuals["slip"] = float(np.max(np.abs(F * np.abs(lam_t) - lam_t * t_t),
+                                         initial=0.0)) / work
+    return residuals

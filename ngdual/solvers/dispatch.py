@@ -200,7 +200,7 @@ def check_unknowns(problem: DiscreteProblem) -> None:
             raise SceneError("contact.htilde_factor", f"h~ = {factor} h leaves {name} without "
                              f"unknowns on {mesh}: Gamma_{role[0].upper()} has too few edges; "
                              "choose a smaller htilde_factor or a finer level or maxh")
-    if scene.has_friction and dofs["L"] == 0:
+    if scene.has_friction and problem.spaces.friction is not None and dofs["L"] == 0:
         raise SceneError("contact.hhat_factor", f"h^ leaves nu without unknowns on {mesh}; "
                                                 "choose hhat_factor = 1 or a finer level")
 

@@ -35,7 +35,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..forms import DiscreteProblem
-from ..friction import build_friction_forms, tresca_bound
+from ..friction import MomentFriction, build_friction_forms, tresca_bound, tresca_moments
 from ..tolerances import CLARABEL_TOLERANCES, CLARABEL_WHOLE_PROBLEM
 from .result import ConvergenceError, Solution
 from .settings import Model
@@ -131,7 +131,10 @@ def solve_qp_friction(problem: DiscreteProblem, model: Model, tol: float = 1e-10
     Tresca: one QP with the given bound. Coulomb: F^0 = mu_f |sigma_n| of the
     frictionless QP, then F^{k+1} = mu_f |sigma_n(sigma^k)| (3.123) until the
     relative change of F is <= ``tol`` (successive substitution: no Uzawa step,
-    no metric, no factorisation shared with :mod:`ngdual.solvers.nested`).
+    no metric, no factorisation shared with :mod:`ngdual.solvers.nested`). With the facet
+    multipliers of order k the law acts on the Bernstein moments
+    (:class:`ngdual.friction.MomentFriction`: Q_F = diag(F_i), F_i = int F B_i ds or
+    mu_f (-t_n,i)); ``friction_bound`` is then its bound per fine edge.
 
     Raises
     ------
@@ -142,17 +145,28 @@ def solve_qp_friction(problem: DiscreteProblem, model: Model, tol: float = 1e-10
     if law not in ("tresca", "coulomb"):
         raise ValueError(f"the friction QP solves Tresca or Coulomb friction, not law {law!r}")
     forms = build_friction_forms(problem)
+    facet = problem.spaces.family == "facet"
+    # the facet multipliers bound every Bernstein moment (ngdual.friction.MomentFriction)
+    friction_law = MomentFriction() if facet else forms
+
+    def coulomb(x):
+        if facet:
+            return friction_law.coulomb_bound_of((problem.K @ x - problem.rhs)[problem.lam_n],
+                                                 mu_f)
+        return forms.coulomb_bound(x, mu_f)
+
     start = time.perf_counter()
     if law == "tresca":
-        bound, history = tresca_bound(forms, problem), [0.0]
-        sol = _solve_qp(problem, modulus, forms.q_matrix(bound))
+        bound = tresca_moments(problem) if facet else tresca_bound(forms, problem)
+        history = [0.0]
+        sol = _solve_qp(problem, modulus, friction_law.q_matrix(bound))
     else:
         sol = _solve_qp(problem, modulus)
         history = []
         while len(history) < max_iter:
-            bound = forms.coulomb_bound(sol.x, mu_f)
-            sol = _solve_qp(problem, modulus, forms.q_matrix(bound))
-            mapped = forms.coulomb_bound(sol.x, mu_f)
+            bound = coulomb(sol.x)
+            sol = _solve_qp(problem, modulus, friction_law.q_matrix(bound))
+            mapped = coulomb(sol.x)
             history.append(float(np.linalg.norm(mapped - bound)
                                  / (np.linalg.norm(mapped) or 1.0)))
             if history[-1] <= tol:
@@ -160,7 +174,8 @@ def solve_qp_friction(problem: DiscreteProblem, model: Model, tol: float = 1e-10
         else:
             raise ConvergenceError(f"the fixed point on F did not converge in {max_iter} QPs",
                                    history)
-    sol.friction_bound, sol.friction_forms = bound, forms
+    sol.friction_bound = forms.edge_bound(bound) if facet else bound
+    sol.friction_forms = forms
     sol.method, sol.history = f"qp-{law}", history
     sol.iterations = {"outer": len(history), "inner": 0}
     sol.timings["solve"] = time.perf_counter() - start

@@ -1,0 +1,56 @@
+"""Friction at order k (issue 27, item 3): Tresca and Coulomb on the facet P_k multipliers.
+
+The law acts on every Bernstein coefficient, |t_t,i| <= F_i (:class:`ngdual.friction.
+MomentFriction`). Truth: the convex QP of :mod:`ngdual.solvers.qp` for the same discrete
+problem (Clarabel on the whole sparse system, nothing shared with the condensation or the
+semismooth Newton method; Coulomb as its fixed point of Tresca QPs), and the physics checks
+of :mod:`ngdual.checks` (friction bound, force balance, tension).
+"""
+
+import numpy as np
+import pytest
+
+from ngdual.forms import assemble
+from ngdual.mesh import build_mesh
+from ngdual.scene import load_scene
+from ngdual.solvers import solve_problem
+from ngdual.solvers.qp import solve_qp_friction
+from ngdual.solvers.settings import Model
+
+QP_AGREEMENT = 1e-8  # Clarabel's interior point, not polished with friction (measured <= 1.1e-9)
+
+
+def _problem(name: str, order: int, level: int):
+    scene = load_scene(name, [f"discretisation.order={order}", "contact.ends='consistent'"])
+    return assemble(scene, build_mesh(scene.geometry, level))
+
+
+def _relative(a: np.ndarray, b: np.ndarray) -> float:
+    return float(np.max(np.abs(a - b)) / np.max(np.abs(b)))
+
+
+@pytest.mark.parametrize("name, order", [("thesis-3.46-tresca", 1),
+                                         ("thesis-3.46-tresca", 2),
+                                         ("thesis-3.46-coulomb", 1)])
+def test_friction_at_order_k_is_the_solution_of_the_qp(name, order):
+    """The same stresses and multipliers as the QP (and for Coulomb its fixed point), with
+    stick and slip on the coefficients and the bound held to round-off."""
+    problem = _problem(name, order, 1)
+    solution = solve_problem(problem)
+    qp = solve_qp_friction(problem, Model.of(problem.scene), tol=1e-9)
+    for part in (problem.sigma, problem.lam_n, problem.index("lam_t")):
+        assert _relative(solution.x[part], qp.x[part]) < QP_AGREEMENT
+    assert solution.residuals["friction_bound"] < 1e-12
+    assert solution.residuals["slip"] < 1e-12
+    slipping = np.abs(np.abs(solution.nu) - 1.0) < 1e-9
+    assert slipping.any() and (~slipping).any()
+
+
+@pytest.mark.parametrize("order", [1, 2])
+def test_the_coulomb_solution_on_example_3_46_passes_every_physics_check(order):
+    """Consistent ends, mu_f = 0.5: no tension, the contact force balanced, the friction
+    bound |int_e sigma_t| <= sum F_i held on every fine edge."""
+    problem = _problem("thesis-3.46-coulomb", order, 2)
+    solution = solve_problem(problem)
+    assert solution.warnings == []
+    assert solution.residuals["coulomb_bound"] < 1e-10
