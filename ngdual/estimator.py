@@ -133,8 +133,9 @@ def quadrature_bonus(order: int = 0) -> int:
     The squares of w_h and as(sigma_h) have degree 2 (k + 2) (:func:`ngdual.peers.stress_degree`).
     NGSolve integrates ``Integrate(cf * dx(bonus_intorder=b))`` (also on the element
     boundaries) exactly to degree 5 + b and a ``ds`` linear form tested with the edge
-    constants to degree b + 1, so the bonus 2 (k + 2) is exact for the discrete fields on
-    both and leaves degree 5 for the data (f, u_D, t0, g)."""
+    constants to degree b + 1 (measured on monomials), so the bonus 2 (k + 2) is exact for
+    the squares of the discrete fields on both, with 5 degrees to spare for the data (f,
+    u_D, t0, g) in the volume and 1 on the edges; at k = 0 it is the thesis' rule."""
     return 2 * peers.stress_degree("peers", order)
 
 
