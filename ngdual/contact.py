@@ -210,11 +210,51 @@ class ContactBoundary:
         u_n = g - lambda_n on the fine edges wherever g is not P1 on h~).
         """
         if isinstance(self.coarse, FacetMesh):
-            # the facet multipliers: g interpolated on every fine edge (FacetMesh.interpolant)
+            # the facet multipliers: g of the boundary curve interpolated on every fine edge
             return prolongation @ self.coarse.interpolant(
-                lambda points, edges: gap_at(self.scene.contact, points, self.normals[edges]))
+                lambda points, edges: gap_at(self.scene.contact,
+                                             self.on_curve(points, edges), self.normals[edges]))
         at_dofs, at_ends = self.gap_at_nodes()
         return prolongation @ at_dofs + end_hats @ at_ends
+
+    def on_curve(self, points: np.ndarray, edges: np.ndarray) -> np.ndarray:
+        """``points`` of the fine ``edges`` moved along the edge normals onto the boundary
+        curve of Gamma_C that the edges approximate.
+
+        The fine edges are chords: where Gamma_C is an arc, a chord lies inside the body by
+        its sagitta, up to |e|^2 / (8 R). The gap at a point of the chord is that of the
+        arc's point on the same normal, g(x + s n) = g(x) - s for a foundation line: the
+        body is the arc, not the polygon of its chords. On the vertices (s = 0) and on
+        straight sides nothing moves, so the P1 interpolant of the gap is that of the
+        polygon; at k >= 2 the chords' gap would carry the kinks of the polygon at every
+        vertex, an O(h / R) jump of the slope of u_n, into the contact zone, where the
+        traces of RT_k resolve it as pressure peaks at the vertices
+        (docs/theory/order.md).
+        """
+        points = np.asarray(points, dtype=float)
+        arcs = [side for side in self.scene.geometry.curves()
+                if side.is_arc and side.label in self.scene.labels("contact")]
+        if not arcs:
+            return points
+        starts = np.vstack([chain.path_points[:-1] for chain in self.coarse.chains])
+        stops = np.vstack([chain.path_points[1:] for chain in self.coarse.chains])
+        n = self.normals[edges]
+        # the side of every edge: the arc through both its end points (a straight side,
+        # on which nothing moves, otherwise)
+        moved = points.copy()
+        for side in arcs:
+            r = np.linalg.norm(side.start - side.center)
+            on_arc = np.maximum(np.abs(np.linalg.norm(starts - side.center, axis=1) - r),
+                                np.abs(np.linalg.norm(stops - side.center, axis=1) - r))
+            mine = on_arc[edges] <= 1e-9 * r
+            d = points[mine] - side.center
+            b = np.sum(d * n[mine], axis=1)
+            # |x + s n - c| = r: the root of least |s| (s > 0 where the arc bulges out of
+            # the body, s < 0 where it bulges in)
+            s = -b + np.sign(b) * np.sqrt(np.maximum(b * b - (np.sum(d * d, axis=1) - r * r),
+                                                     0.0))
+            moved[mine] = points[mine] + s[:, None] * n[mine]
+        return moved
 
     def end_values(self, u_d: tuple[str, str]) -> tuple[np.ndarray, np.ndarray]:
         """(lambda_n, lambda_t) at the fixed ends (``coarse.end_points()``).

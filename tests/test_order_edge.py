@@ -6,9 +6,16 @@ h^ mesh, no value at an end of Gamma_C. ``contact.htilde_factor``, ``hhat_factor
 field; the defaults describe what the facet family does.
 """
 
+import numpy as np
 import pytest
 
-from ngdual.scene import SceneError, load_scene
+from ngdual.boundary.facet import bernstein_values
+from ngdual.forms import Spaces
+from ngdual.mesh import build_mesh
+from ngdual.post import contact_traces
+from ngdual.scene import SceneError, gap_at, load_scene
+from ngdual.solvers import solve_scene
+from ngdual.verification.analytic import hertz
 
 FACET = ["discretisation.order=1"]
 CONSISTENT = "contact.ends='consistent'"
@@ -42,3 +49,79 @@ def test_the_defaults_of_the_coarse_mesh_settings_are_accepted_with_facet_multip
 def test_the_coarse_mesh_settings_stay_free_with_the_thesis_multipliers():
     scene = load_scene("thesis-3.46-frictionless", ["contact.htilde_factor=4"])
     assert scene.discretisation.family == "coarse" and scene.contact.ends == "thesis"
+
+
+def _facet_gamma_c(name, order, level):
+    scene = load_scene(name, [f"discretisation.order={order}"])
+    return scene, Spaces.build(scene, build_mesh(scene.geometry, level)).gamma_c
+
+
+def test_the_gap_of_the_facet_multipliers_is_the_gap_of_the_arc_not_of_its_chords():
+    """hertz-cylinder's bottom is the arc |x - (0, 10)| = 10 above the plane y = 0: at every
+    control point x of a chord, g_h is the distance along the edge normal n from the arc's
+    point x + s n to the plane (truth: the circle), s the chord's sagitta there."""
+    scene, gamma_c = _facet_gamma_c("hertz-cylinder", 2, 1)
+    t = np.array([0.0, 0.5, 1.0])
+    starts = np.vstack([c.path_points[:-1] for c in gamma_c.coarse.chains])
+    stops = np.vstack([c.path_points[1:] for c in gamma_c.coarse.chains])
+    edges = np.repeat(np.arange(len(starts)), 3)
+    points = (starts[:, None] + t[None, :, None] * (stops - starts)[:, None]).reshape(-1, 2)
+    moved = gamma_c.on_curve(points, edges)
+    centre = np.array([0.0, 10.0])
+    assert np.allclose(np.linalg.norm(moved - centre, axis=1), 10.0, rtol=0, atol=1e-12)
+    s = np.sum((moved - points) * gamma_c.normals[edges], axis=1)
+    chord = gamma_c.lengths[edges]
+    # the sagitta of a chord of length |e| at its parameter t: t (1 - t) |e|^2 / (2 R)
+    assert s == pytest.approx(np.tile(t * (1 - t), len(starts)) * chord**2 / 20, rel=1e-3,
+                              abs=1e-12)
+    n = gamma_c.normals[edges]
+    exact = moved[:, 1] / -n[:, 1]
+    values = bernstein_values(2, t)
+    coefficients = gamma_c.coarse.interpolant(
+        lambda p, e: gap_at(scene.contact, gamma_c.on_curve(p, e), gamma_c.normals[e]))
+    interpolated = (coefficients.reshape(-1, 3) @ values.T).ravel()
+    assert interpolated == pytest.approx(exact, rel=1e-12)
+
+
+def test_on_straight_sides_the_gap_of_the_facet_multipliers_is_that_of_the_edges():
+    _, gamma_c = _facet_gamma_c("flat-punch", 2, 1)
+    points = gamma_c.midpoints
+    assert np.array_equal(gamma_c.on_curve(points, np.arange(len(points))), points)
+
+
+@pytest.mark.filterwarnings("ignore::ngdual.solvers.result.PhysicsWarning")
+def test_hertz_at_order_2_has_the_pressure_of_hertz_on_the_core_of_the_contact_zone():
+    """The P_2 trace -sigma_nn on |x| < a/2 against Hertz's p0 sqrt(1 - x^2 / a^2) for the
+    computed force (the block is finite: Hertz's half-plane differs by about 1 %). With the
+    gap of the chords instead of the arc the core error is 20 % on level 1."""
+    scene = load_scene("hertz-cylinder", ["discretisation.order=2"])
+    traces = contact_traces(solve_scene(scene, 1))
+    force = float(np.sum(traces.edge_length * -traces.sigma_n))
+    exact = hertz(force, 10.0, scene.material.E, scene.material.nu)
+    x, p = traces.trace_xy[..., 0].ravel(), -traces.trace_sigma_n.ravel()
+    core = np.abs(x) < exact.a / 2
+    error = np.abs(p[core] - exact.pressure(x[core])).max() / exact.p0
+    assert core.sum() >= 4 and error < 0.03, error
+
+
+@pytest.mark.filterwarnings("ignore::ngdual.solvers.result.PhysicsWarning")
+def test_the_traces_at_order_1_are_read_at_the_control_points_of_the_fine_edges():
+    """contact_traces of a facet solution: the pressure at every control point is the moment
+    its contact condition signs, over int psi_i (so the moments sum to the contact force),
+    the sampled P_1 traces interpolate their edge means, and the labels name control
+    points."""
+    solution = solve_scene(load_scene("hertz-cylinder", ["discretisation.order=1"]), 1)
+    traces = contact_traces(solution)
+    gamma_c = solution.problem.spaces.gamma_c
+    mass = gamma_c.hat_means(solution.problem.spaces.prolongations["lam_n"]).T @ gamma_c.lengths
+    assert traces.node_kind == "control point"
+    assert np.sum(traces.pressure * mass) == pytest.approx(
+        np.sum(-traces.sigma_n * traces.edge_length), rel=1e-12)
+    assert np.all(traces.pressure[traces.coarse_in_contact] >= 0)
+    # the P_1 trace sampled at 6 equispaced points: its mean by the trapezoidal rule is exact
+    # (up to the evaluation a round-off inside the triangle)
+    samples = traces.trace_sigma_n
+    mean = (samples[:, 1:] + samples[:, :-1]).sum(axis=1) / (2 * (samples.shape[1] - 1))
+    assert mean == pytest.approx(traces.sigma_n, rel=1e-8, abs=1e-5 * np.abs(mean).max())
+    assert traces.edge_active.sum() == np.count_nonzero(
+        traces.coarse_in_contact.reshape(-1, 2).any(axis=1))
