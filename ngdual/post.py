@@ -14,6 +14,7 @@ from dataclasses import asdict, dataclass
 import ngsolve as ngs
 import numpy as np
 
+from .boundary import FacetMesh
 from .checks import ForceBalance, contact_forces, friction_forms_of
 from .checks import in_contact as _in_contact
 from .friction import hat_projection
@@ -22,6 +23,11 @@ from .io import versions
 from .quantities import fields, norms, require_contact
 from .scene import SceneError, SceneTypeError
 from .solvers.result import Solution
+
+# the sampled traces are evaluated these shares of |e| inside the triangle of their edge,
+# along the edge and across it: NGSolve's point search accepts points within about 1e-8 of
+# an element, so a point closer to a vertex may be found in the neighbouring triangle
+INSIDE = (1e-4, 1e-6)
 
 
 def von_mises(sigma, nu: float) -> ngs.CoefficientFunction:
@@ -51,6 +57,16 @@ class ContactTraces:
     (``end_xy``, where lambda is prescribed), which no contact condition constrains.
     ``coarse_status``: "separation", "contact" (without friction), "stick" or "slip"
     (:func:`friction_diagnostics`); ``friction``: the scene has a friction law.
+
+    With the facet P_k multipliers (:mod:`ngdual.boundary.facet`, ``node_kind`` "control
+    point") the "nodes" are the control points of every fine edge, the k + 1 unknowns of
+    lambda_n on it (``coarse_lam_n`` their coefficients, zero where the edge touches there),
+    and ``pressure``, ``shear`` the moments t_i = d_C(psi_i, sigma) of (3.62) against the
+    basis functions psi_i over int psi_i ds: what the sign conditions of the facet family
+    control. ``sigma_n``, ``sigma_t`` are the means of the P_k traces on the fine edges;
+    ``trace_xy``, ``trace_sigma_n``, ``trace_sigma_t`` (n_edges, m) sample the traces
+    themselves along every edge, end points included (None for the thesis' RT_0 traces,
+    constant per edge). ``edge_active``: the edges with an unknown in contact.
     """
 
     edge_xy: np.ndarray
@@ -73,6 +89,10 @@ class ContactTraces:
     end_shear: np.ndarray
     coarse_status: np.ndarray
     friction: bool
+    node_kind: str = "h~ node"
+    trace_xy: np.ndarray | None = None
+    trace_sigma_n: np.ndarray | None = None
+    trace_sigma_t: np.ndarray | None = None
 
 
 def contact_traces(solution: Solution) -> ContactTraces:
@@ -117,6 +137,12 @@ def contact_traces(solution: Solution) -> ContactTraces:
                       else np.zeros(0),
                       hat_projection(means, gamma_c.lengths, s_t) if means.shape[1]
                       else np.zeros(0)]
+    facet = {}
+    if isinstance(contact, FacetMesh):
+        projected[:2] = _facet_moments(solution)
+        active = in_contact.reshape(-1, contact.order + 1).any(axis=1)
+        facet = dict(zip(("trace_xy", "trace_sigma_n", "trace_sigma_t"),
+                         _trace_samples(solution)), node_kind="control point")
     if solution.nu is not None:
         status = friction_diagnostics(solution).node_status
     else:
@@ -128,7 +154,42 @@ def contact_traces(solution: Solution) -> ContactTraces:
                                                           pb.spaces.end_hats["lam_n"]),
                          coarse_xy, lam_n_c, lam_t_c,
                          in_contact, projected[0], projected[1], contact.end_points(),
-                         projected[2], projected[3], status, solution.nu is not None)
+                         projected[2], projected[3], status, solution.nu is not None,
+                         **facet)
+
+
+def _facet_moments(solution: Solution) -> list[np.ndarray]:
+    """[p_h, q_h] at the control points of the facet multipliers: -t_n,i / m_i and
+    t_t,i / m_i with the moments t_i = d_C(psi_i, sigma) of (3.62), read off the assembled
+    coupling (exact: the traces of RT_k are P_k on every edge), and m_i = int psi_i ds."""
+    pb = solution.problem
+    gamma_c, sigma = pb.spaces.gamma_c, solution.x[pb.sigma]
+    mass = gamma_c.hat_means(pb.spaces.prolongations["lam_n"]).T @ gamma_c.lengths
+    return [-(pb.block(pb.lam_n, pb.sigma) @ sigma) / mass,
+            (pb.block(pb.index("lam_t"), pb.sigma) @ sigma) / mass]
+
+
+def _trace_samples(solution: Solution) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(points (n_edges, m, 2), sigma_n, sigma_t (n_edges, m)): the traces of sigma_h at
+    4k + 2 points along every fine edge of Gamma_C, end points included."""
+    pb = solution.problem
+    gamma_c, k = pb.spaces.gamma_c, pb.spaces.order
+    t = np.linspace(0.0, 1.0, 4 * k + 2)
+    starts = np.vstack([chain.path_points[:-1] for chain in pb.spaces.contact.chains])
+    stops = np.vstack([chain.path_points[1:] for chain in pb.spaces.contact.chains])
+    points = starts[:, None, :] + t[None, :, None] * (stops - starts)[:, None, :]
+    # evaluated in the one triangle of every edge, away from the vertices, which the
+    # neighbouring triangles share (INSIDE)
+    shrunk = 0.5 + (1.0 - INSIDE[0]) * (t - 0.5)
+    inside = starts[:, None, :] + shrunk[None, :, None] * (stops - starts)[:, None, :] \
+        - (INSIDE[1] * gamma_c.lengths)[:, None, None] * gamma_c.normals[:, None, :]
+    mesh = pb.fes.mesh
+    flat = inside.reshape(-1, 2)
+    sigma = np.asarray(fields(solution).sigma(mesh(flat[:, 0], flat[:, 1])))
+    traction = np.einsum("eqij,ej->eqi", sigma.reshape(*points.shape[:2], 2, 2),
+                         gamma_c.normals)
+    return (points, np.einsum("eqi,ei->eq", traction, gamma_c.normals),
+            np.einsum("eqi,ei->eq", traction, gamma_c.tangents))
 
 
 def contact_summary(solution: Solution) -> dict:

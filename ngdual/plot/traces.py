@@ -14,6 +14,7 @@ from .scales import length_unit, stress_unit, unit_label
 TRACE_CLIP = 90.0   # percentile of |value| beyond which secondary curves of a trace go off scale
 ZONE_COLOURS = {"contact": ("tab:blue", "contact"), "stick": ("tab:green", "stick"),
                 "slip": ("tab:orange", "slip")}
+NODE_LABELS = {"h~ node": r"$\tilde h$ node"}   # ContactTraces.node_kind as a label
 ZOOM = 0.4     # traction panels zoom on the contact zone when it spans less of Gamma_C
 QUIET = 0.02   # ... and p_h, q_h outside it stay below this fraction of their largest value
 
@@ -161,19 +162,31 @@ def plot_contact_traces(traces, title: str = "", units=None, clip: float | None 
         if exact.shear is not None:
             exact_shear = (exact.x[exact_order], exact.shear[exact_order])
     friction = "with friction" if traces.friction else "frictionless: (3.62) makes it zero"
+    node = NODE_LABELS.get(traces.node_kind, traces.node_kind)
     panels = [
         (axes[0, 0], pressure, traces.end_pressure, -traces.sigma_n, exact_pressure,
-         r"$p_h$ ($\tilde h$ node)", r"$-\sigma_n^h$ (fine edge)",
+         rf"$p_h$ ({node})", r"$-\sigma_n^h$ (fine edge)",
          unit_label(r"pressure $p_h = -\sigma_n$", stress), "C0",
          "Contact pressure: what (3.62) controls"),
         (axes[0, 1], shear, traces.end_shear, traces.sigma_t, exact_shear,
-         r"$q_h$ ($\tilde h$ node)", r"$\sigma_t^h$ (fine edge)",
+         rf"$q_h$ ({node})", r"$\sigma_t^h$ (fine edge)",
          unit_label(r"shear $q_h$ along $t$", stress), "C1", f"Shear traction ({friction})"),
     ]
+    sampled = None if traces.trace_xy is None else \
+        (traces.trace_xy[..., 0], -traces.trace_sigma_n, traces.trace_sigma_t)
     for ax, main, end_values, fine, exact_curve, label, fine_label, ylabel, colour, name \
             in panels:
-        ax.plot(x_edge[edge_order], fine[edge_order], drawstyle="steps-mid", lw=0.6,
-                color="0.6", label=fine_label)
+        fine_x = x_edge
+        if sampled is None:
+            ax.plot(x_edge[edge_order], fine[edge_order], drawstyle="steps-mid", lw=0.6,
+                    color="0.6", label=fine_label)
+        else:
+            # the P_k trace of every fine edge, broken between edges (it is discontinuous)
+            values = sampled[1] if ax is axes[0, 0] else sampled[2]
+            gap = np.full((len(values), 1), np.nan)
+            ax.plot(np.hstack([sampled[0], gap]).ravel(), np.hstack([values, gap]).ravel(),
+                    lw=0.6, color="0.6", label=fine_label)
+            fine, fine_x = values.ravel(), sampled[0].ravel()
         if exact_curve is not None:
             ax.plot(*exact_curve, "k--", lw=1.0, label=exact.label)
         ax.plot(x_nodes[order], main[order], "-", color=colour, lw=1.6)
@@ -183,7 +196,7 @@ def plot_contact_traces(traces, title: str = "", units=None, clip: float | None 
                     label=r"fixed end of $\Gamma_C$ (no contact condition)")
         inside = (lambda x: np.ones(len(x), bool)) if window is None else \
             (lambda x: (x >= window[0]) & (x <= window[1]))
-        secondary = [(fine[inside(x_edge)], "fine-edge values")]
+        secondary = [(fine[inside(fine_x)], "fine-edge values")]
         if exact_curve is not None:
             secondary.append((exact_curve[1][inside(exact_curve[0])], "exact solution"))
         own = []
@@ -207,10 +220,11 @@ def plot_contact_traces(traces, title: str = "", units=None, clip: float | None 
     axes[1, 1].plot(x_node[fine_order], traces.lam_t[fine_order], lw=1.2)
     contact = traces.coarse_xy[traces.coarse_in_contact, 0]
     axes[1, 0].plot(contact, np.interp(contact, x_node[fine_order], gap), "rv", ms=4,
-                    label=r"$\tilde h$ node in contact")
-    for ax, label, name in ((axes[1, 0], r"$\lambda_n^{\tilde h} - g = -u_n$",
+                    label=f"{node} in contact")
+    mesh = r"\tilde h" if traces.node_kind == "h~ node" else "h"
+    for ax, label, name in ((axes[1, 0], rf"$\lambda_n^{{{mesh}}} - g = -u_n$",
                              "Normal multiplier minus the gap"),
-                            (axes[1, 1], r"$\lambda_t^{\tilde h} = -u_t$",
+                            (axes[1, 1], rf"$\lambda_t^{{{mesh}}} = -u_t$",
                              "Tangential multiplier")):
         ax.set_ylabel(unit_label(label, length))
         ax.set_title(name, fontsize=10)
