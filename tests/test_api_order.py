@@ -64,3 +64,9 @@ def test_a_bad_order_or_family_argument_is_refused_naming_the_argument(arguments
         nd.solve(scene, 1, **arguments)
     assert caught.value.field == field
 
+
+
+def test_order_1_with_the_thesis_end_values_names_the_scenes_contact_ends():
+    with pytest.raises(SceneError) as caught:
+        nd.solve(nd.load_scene("thesis-3.46-frictionless"), 1, order=1)
+    assert caught.value.field == "contact.ends"

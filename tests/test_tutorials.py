@@ -185,9 +185,18 @@ def check_your_own_scene(r: dict) -> None:
     assert all(3.5 < b / a < 4.5 for a, b in zip(dims, dims[1:])), dims
 
 
+def check_order_against_mesh_size(r: dict) -> None:
+    """The stress of PEERS_k converges at order k + 1 against the exact solution; a higher
+    order reaches the target error with fewer unknowns."""
+    for k, observed in r["observed_order"].items():
+        assert abs(observed - (int(k) + 1)) <= 0.2, r["observed_order"]
+    unknowns = [r["costs"][k]["ndof"] for k in ("0", "1", "2")]
+    assert unknowns[0] > unknowns[1] > unknowns[2], unknowns
+
+
 CHECKS = {1: check_peers_spaces, 2: check_locking, 3: check_signorini_uzawa,
           4: check_friction, 5: check_friction_inf_sup, 6: check_estimator,
-          7: check_adaptivity, 8: check_your_own_scene}
+          7: check_adaptivity, 8: check_your_own_scene, 9: check_order_against_mesh_size}
 
 
 def check_solutions(number: int, r: dict) -> None:
@@ -240,13 +249,18 @@ def check_solutions(number: int, r: dict) -> None:
         assert r["touching"]["0.95"] == 0 and r["touching"]["1.05"] >= 1, r["touching"]
         assert sorted(r["arch_errors"].values()) == ["contact.ends", "geometry.points"]
         assert r["arch_contact"] >= 1
+    elif number == 9:
+        for k, observed in r["orders"].items():
+            assert abs(observed["u"] - (int(k) + 1)) <= 0.2, r["orders"]
+        coarse, facet = r["pairings"]["coarse"], r["pairings"]["facet"]
+        assert abs(facet["sigma_order"] - 1) <= 0.2 and abs(coarse["sigma_order"] - 1) <= 0.2
 
 
 # --- the tests ---------------------------------------------------------------------------------
 
 def test_tutorials_are_found_and_numbered():
     numbers = [t.number for t in TUTORIALS]
-    assert set(numbers) == set(range(1, 9)) and numbers == sorted(set(numbers))
+    assert set(numbers) == set(range(1, 10)) and numbers == sorted(set(numbers))
 
 
 def test_every_tutorial_has_a_check_and_solutions():

@@ -112,8 +112,8 @@ def with_discretisation(scene: Scene, order: int | None = None,
     ``multipliers`` the family of phi, lambda_n, lambda_t (``"auto"``, ``"coarse"``,
     ``"facet"``: :class:`ngdual.scene.Discretisation`). The changed scene is validated as a
     whole; a problem of either entry raises a :class:`~ngdual.scene.SceneError` naming the
-    argument (``order``, ``multipliers``), one that the entries cause elsewhere (friction on
-    the facet multipliers) names the scene's field.
+    argument (``order``, ``multipliers``), one that the entries cause elsewhere (the thesis'
+    end values with the facet multipliers) names the scene's field (``contact.ends``).
     """
     ensure_valid(scene)
     given = {name: value for name, value in (("order", order), ("multipliers", multipliers))
