@@ -13,7 +13,9 @@ total error (3.124) and the effectivity index estimate / e_tot (Table 4.4). Unif
 refinement is ``marking="max", theta=0``.
 
 The loop aims at a goal (:data:`GOALS`): ``"stress"``, the thesis' (4.50), or
-``"pressure"``, the contact pressure on Gamma_C (:mod:`ngdual.goal`). Given a tolerance
+``"pressure"``, the contact pressure on Gamma_C (:mod:`ngdual.goal`). It runs at the order k
+of the scene's ``[discretisation]``: the indicators are those of (4.50) at order k, and the
+pressure goal's p_h is the trace of sigma_h with the facet multipliers. Given a tolerance
 ``tol`` it stops as soon as the goal's relative estimate (:func:`relative_estimate`) is
 below it, ``steps`` being then only a bound.
 """
@@ -170,7 +172,9 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
                            allow_large, goal, tol, window)
     marking = MARKING if marking is None else marking
     theta, steps, level = loop_defaults(tol, theta, steps, level)
-    budget.check(scene.geometry, level, "level", allow_large, method=scene.solver.method)
+    budget.check(scene.geometry, level, "level", allow_large, method=scene.solver.method,
+                 order=scene.discretisation.order, multipliers=scene.discretisation.family,
+                 contact=scene.labels("contact"))
     start = time.perf_counter()
     mesh = build_mesh(scene.geometry, level)
     coarse = BoundaryMeshes.for_scene(scene, mesh)
