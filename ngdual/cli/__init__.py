@@ -14,8 +14,9 @@ writes them as Jupyter notebooks.
 ``ngdual bench BENCHMARK [--json FILE]`` runs one benchmark of :mod:`ngdual.studies.bench`:
 ``limit-ratio`` (the contact solvers against one linear solve of the same matrix),
 ``levels``, ``estimator-cost``, ``infsup``, ``primal-peer``.
-``ngdual verify [--quick] [--json FILE]`` prints the errors against exact solutions with
-observed orders (:mod:`ngdual.verification.report`).
+``ngdual verify [--quick] [--orders K ...] [--json FILE]`` prints the errors against exact
+solutions with observed orders, per order k of PEERS_k too (:mod:`ngdual.verification.report`;
+exit status 1 when an observed order misses k + 1).
 After the result table ``solve`` prints one ``warning:`` line per failed physics check
 (tension or a force imbalance on Gamma_C, penetration, the friction bound, contact at a
 clamped end, thesis end values that contradict the data; :mod:`ngdual.checks`), also
@@ -267,9 +268,14 @@ def parser() -> argparse.ArgumentParser:
                                        "problems and the Hertz, flat-punch and "
                                        "Cattaneo-Mindlin benchmarks, with observed orders")
     ve.add_argument("--quick", action="store_true",
-                    help="two levels of two manufactured cases and of every benchmark (~20 s)")
+                    help="two levels of two manufactured cases and of every benchmark, "
+                         "three of each order k (~50 s)")
     ve.add_argument("--json", default=None, metavar="FILE",
                     help="also write every row (with package versions) to FILE, atomically")
+    ve.add_argument("--orders", nargs="+", type=int, default=None, metavar="K",
+                    help="only the convergence of PEERS_k for these orders k (0, 1, 2) on "
+                         "elasticity and frictionless contact; exit status 1 when sigma's "
+                         "observed order misses k + 1")
     ve.set_defaults(func=cmd_verify)
     return p
 

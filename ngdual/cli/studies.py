@@ -203,9 +203,17 @@ BENCH_SETTINGS = {"limit-ratio": _limit_ratio_settings, "levels": _levels_settin
 
 
 def cmd_verify(args) -> int:
+    """Print the verification tables (:mod:`ngdual.verification.report`); ``--orders K ...``
+    only those of the orders K of PEERS_k."""
     from ..io import check_output_file
+    from ..scene import ORDERS
     from ..verification.report import run
 
+    wrong = sorted(set(args.orders or ()) - set(ORDERS))
+    if wrong:
+        raise SceneError("--orders", f"the order k of PEERS_k is one of "
+                                     f"{', '.join(map(str, ORDERS))}, got "
+                                     f"{', '.join(map(str, wrong))}")
     if args.json:
         check_output_file(args.json, "--json")
     return run(args)

@@ -1,4 +1,4 @@
-"""The PEERS family of order k verified on linear elasticity: convergence and inf-sup.
+"""The PEERS family of order k verified: convergence on elasticity and on contact, inf-sup.
 
 A smooth manufactured displacement on the unit square Omega = (0, 1)^2 (plane strain,
 :data:`LAME`), clamped to its exact values on Gamma_D = left and bottom and loaded with its
@@ -20,6 +20,12 @@ measures it with the one rate of ngdual (:func:`ngdual.rates.observed_rates`, th
 h_N = N^{-1/2}). :func:`infsup_constants` computes the Babuska-Brezzi constant of
 b(tau, (v, xi)) = (div tau, v) + s(xi, tau) in the H(div) x L^2 x L^2 norms on the clamped
 square with the machinery of :mod:`ngdual.verification.infsup`.
+
+:func:`contact_study` solves the manufactured frictionless contact problem of
+:mod:`ngdual.verification.manufactured` (Example 3.46's box, contact on [-2, 2]) at order k
+with the multipliers of its default family and measures the same errors and the contact
+set; :func:`order_check` says whether the observed orders of sigma reach k + 1 (issue 27:
+within :data:`ORDER_SLACK` on the last two levels).
 """
 
 from __future__ import annotations
@@ -44,6 +50,7 @@ E, NU = 1.0, 0.3
 LAME = (E * NU / ((1 + NU) * (1 - 2 * NU)), E / (2 * (1 + NU)))    # plane strain (lambda, mu)
 DIRICHLET, NEUMANN = "left|bottom", "right|top"
 QUANTITIES = ("sigma", "u", "eta")
+ORDER_SLACK = 0.15    # the observed order of sigma lies within this of k + 1
 
 
 def unit_square(level: int) -> ngs.Mesh:
@@ -270,3 +277,76 @@ def format_rows(rows: list[dict], quantities=QUANTITIES) -> str:
         lines.append(f"{row['family']:>6} {row['order']:2d} {row['level']:3d} {row['ndof']:7d} "
                      f"{row['seconds']:7.3f} " + " ".join(cells))
     return "\n".join(lines)
+
+
+def contact_set(solution) -> list[tuple[float, float]]:
+    """The discrete contact set of a solution on Example 3.46's box, as intervals of x.
+
+    With the coarse multipliers the h~ edges on which lambda_n^h vanishes
+    (:func:`ngdual.verification.manufactured_errors.discrete_sets`); with the facet ones the
+    fine edges all of whose Bernstein coefficients of lambda_n vanish (to 1e-9 of the
+    largest): there the P_k function lambda_n^h is zero.
+    """
+    from .manufactured_errors import discrete_sets
+
+    problem = solution.problem
+    disc = problem.scene.discretisation
+    if disc.family == "coarse":
+        return discrete_sets(solution)["contact"]
+    lam = solution.part("lam_n").reshape(-1, disc.order + 1)
+    touching = np.all(np.abs(lam) <= 1e-9 * np.abs(lam).max(initial=0.0), axis=1)
+    gamma_c = problem.spaces.gamma_c
+    mid, half = gamma_c.midpoints[touching, 0], 0.5 * gamma_c.lengths[touching]
+    return [(float(a), float(b)) for a, b in zip(mid - half, mid + half)]
+
+
+def contact_study(order: int = 0, levels=(1, 2, 3)) -> list[dict]:
+    """The manufactured frictionless contact case solved at order k on uniform levels.
+
+    Returns
+    -------
+    list of dict
+        One row per level: ``problem`` ("contact"), ``order``, ``level``, ``ndof`` (every
+        unknown), ``seconds`` (meshing, assembly and solve), the L^2 errors of
+        :data:`QUANTITIES` with their observed orders ``<quantity>_order`` (None on the
+        first level), and ``contact_set``: the length of the symmetric difference between
+        :func:`contact_set` and the exact contact set [-2, 2].
+    """
+    from ..solvers import solve_scene
+    from .manufactured import manufactured_case
+    from .manufactured_errors import symmetric_difference, volume_errors
+
+    case = manufactured_case("frictionless")
+    scene = case.scene(order=order)
+    rows = []
+    for level in levels:
+        start = time.perf_counter()
+        solution = solve_scene(scene, level)
+        seconds = time.perf_counter() - start
+        errors = volume_errors(case, solution)
+        rows.append({"problem": "contact", "order": order, "level": level,
+                     "ndof": solution.problem.fes.ndof, "seconds": seconds,
+                     **{q: errors[q] for q in QUANTITIES},
+                     "contact_set": symmetric_difference(contact_set(solution),
+                                                         case.contact_set)})
+    for q in QUANTITIES:
+        for row, rate in zip(rows, observed_rates([r["ndof"] for r in rows],
+                                                  [r[q] for r in rows])):
+            row[q + "_order"] = rate
+    return rows
+
+
+def order_check(rows: list[dict], quantity: str = "sigma") -> dict:
+    """Whether the observed orders of ``quantity`` on the last two levels of a study of one
+    order k (rows of :func:`convergence_study` or :func:`contact_study`) lie within
+    :data:`ORDER_SLACK` of k + 1.
+
+    >>> rows = [{"order": 1, "sigma_order": None}, {"order": 1, "sigma_order": 2.05},
+    ...         {"order": 1, "sigma_order": 1.98}]
+    >>> order_check(rows)["passed"]
+    True
+    """
+    target = rows[0]["order"] + 1
+    observed = [r[quantity + "_order"] for r in rows[-2:] if r[quantity + "_order"] is not None]
+    return {"quantity": quantity, "target": target, "observed": observed,
+            "passed": bool(observed) and all(abs(a - target) <= ORDER_SLACK for a in observed)}

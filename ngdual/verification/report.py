@@ -2,10 +2,16 @@
 
 Manufactured solutions (:mod:`ngdual.verification.manufactured`) and the analytic contact
 benchmarks (:mod:`ngdual.verification.contact_benchmarks`) under uniform refinement; the
-full run adds the adaptive runs and the finite-box study. ``--quick`` runs two levels of
-each (under a minute), ``--json PATH`` writes every row (atomically).
+full run adds the adaptive runs and the finite-box study. Per order k = 0, 1, 2 of PEERS_k
+(:mod:`ngdual.verification.order`): the manufactured elasticity problem on the unit square
+and the manufactured frictionless contact problem, with the observed orders of sigma, u and
+the rotation and a check of sigma's against k + 1 (within 0.15 on the last two levels).
+``--quick`` runs two levels of each (three for the orders; under a minute and a half),
+``--orders K [K ...]`` only the tables of those orders, ``--json PATH`` writes every row
+(atomically).
 
-:func:`run` is the command (``ngdual.cli`` defines its two options).
+:func:`run` is the command (``ngdual.cli`` defines its options); its exit status is 1 when
+an observed order misses its target.
 """
 
 from __future__ import annotations
@@ -14,30 +20,78 @@ import argparse
 import math
 
 from ..io import write_json
+from ..scene import ORDERS
 from .contact_benchmarks import BENCHMARKS, KEYS, adaptive_study, domain_study, format_rows
 from .contact_benchmarks import uniform_study as benchmark_study
 from .manufactured import CASES
 from .manufactured_errors import format_study, manufactured_study
+from .order import ORDER_SLACK, contact_study, convergence_study, order_check
 
 QUICK = {"manufactured": ("frictionless", "coulomb"), "manufactured_levels": (1, 2),
-         "benchmark_levels": (1, 2)}
+         "benchmark_levels": (1, 2), "elasticity_levels": (1, 2, 3),
+         "contact_levels": (1, 2, 3)}
 FULL = {"manufactured": tuple(CASES), "manufactured_levels": (1, 2, 3, 4, 5),
-        "benchmark_levels": (1, 2, 3, 4)}
+        "benchmark_levels": (1, 2, 3, 4), "elasticity_levels": (1, 2, 3, 4),
+        "contact_levels": (1, 2, 3, 4)}
 
 
-def verification_rows(quick: bool = False) -> dict:
-    """All rows of the verification: manufactured studies, benchmark studies and, unless
-    ``quick``, the adaptive benchmark runs and the finite-box study of the flat punch."""
+def verification_rows(quick: bool = False, orders=ORDERS, only_orders: bool = False) -> dict:
+    """All rows of the verification: manufactured studies, benchmark studies, the studies
+    of every order in ``orders`` (:func:`order_rows`) and, unless ``quick``, the adaptive
+    benchmark runs and the finite-box study of the flat punch; ``only_orders``: the
+    studies of the orders alone."""
     plan = QUICK if quick else FULL
-    out = {"manufactured": {case: manufactured_study(case, plan["manufactured_levels"])
-                            for case in plan["manufactured"]},
-           "benchmarks": {name: benchmark_study(name, plan["benchmark_levels"])
-                          for name in BENCHMARKS},
-           "adaptive": {}, "domain": []}
+    out = {"manufactured": {}, "benchmarks": {}, "adaptive": {}, "domain": [],
+           "orders": order_rows(orders, plan)}
+    if only_orders:
+        return out
+    out["manufactured"] = {case: manufactured_study(case, plan["manufactured_levels"])
+                           for case in plan["manufactured"]}
+    out["benchmarks"] = {name: benchmark_study(name, plan["benchmark_levels"])
+                         for name in BENCHMARKS}
     if not quick:
         out["adaptive"] = {name: adaptive_study(name) for name in ("hertz", "flat-punch")}
         out["domain"] = domain_study("flat-punch")
     return out
+
+
+def order_rows(orders, plan: dict) -> list[dict]:
+    """Per order k and problem ("elasticity": the unit square, "contact": the manufactured
+    frictionless contact), the rows of the study on the plan's levels and the check of
+    sigma's observed order against k + 1 (:func:`ngdual.verification.order.order_check`)."""
+    out = []
+    for k in orders:
+        for problem, rows in (
+                ("elasticity", convergence_study("peers", k, plan["elasticity_levels"])),
+                ("contact", contact_study(k, plan["contact_levels"]))):
+            out.append({"problem": problem, "order": k, "rows": rows,
+                        "check": order_check(rows)})
+    return out
+
+
+def format_orders(studies: list[dict]) -> str:
+    """The studies of :func:`order_rows` as one text table: errors and observed orders per
+    level, and on each study's last row sigma's check ("pass" or "FAIL")."""
+    if not studies:
+        return ""
+    lines = [f"order k of PEERS_k: observed orders (in N^-1/2) against k + 1; sigma must lie "
+             f"within {ORDER_SLACK:g} of it on the last two levels",
+             f"{'problem':>10} {'k':>2} {'lvl':>3} {'ndof':>7} {'sec':>6} "
+             + " ".join(f"{q:>9} {'ord':>5}" for q in ("sigma", "u", "eta"))
+             + f" {'set':>7} {'check':>5}"]
+    for study in studies:
+        rows = study["rows"]
+        for i, row in enumerate(rows):
+            cells = [f"{row[q]:9.3e} " + (f"{row[q + '_order']:5.2f}"
+                                           if row[q + "_order"] is not None else f"{'':>5}")
+                     for q in ("sigma", "u", "eta")]
+            cset = f"{row['contact_set']:7.4f}" if "contact_set" in row else f"{'':>7}"
+            check = ("pass" if study["check"]["passed"] else "FAIL") if i == len(rows) - 1 \
+                else ""
+            lines.append(f"{study['problem']:>10} {row['order']:2d} {row['level']:3d} "
+                         f"{row['ndof']:7d} {row['seconds']:6.2f} " + " ".join(cells)
+                         + f" {cset} {check:>5}")
+    return "\n".join(lines)
 
 
 def format_domain(rows: list[dict]) -> str:
@@ -74,6 +128,7 @@ def format_report(rows: dict) -> str:
         parts.append(f"adaptive {name} (Doerfler 0.5; lvl = step, orders in N^-1/2)\n"
                      + format_rows(study, KEYS[name], "N^-1/2").split("\n", 1)[1])
     parts.append(format_domain(rows["domain"]))
+    parts.append(format_orders(rows["orders"]))
     return "\n\n".join(p for p in parts if p)
 
 
@@ -90,9 +145,12 @@ def _plain(value):
 
 
 def run(args: argparse.Namespace) -> int:
-    """Compute, print and (with ``--json``) write the verification tables; returns 0."""
-    rows = verification_rows(quick=args.quick)
+    """Compute, print and (with ``--json``) write the verification tables; returns 0, or 1
+    when an observed order of sigma misses k + 1 (``--orders``: only those orders)."""
+    only = args.orders is not None
+    rows = verification_rows(quick=args.quick, orders=tuple(args.orders) if only else ORDERS,
+                             only_orders=only)
     print(format_report(rows))
     if args.json:
         write_json(_plain(rows), args.json)
-    return 0
+    return 0 if all(study["check"]["passed"] for study in rows["orders"]) else 1
