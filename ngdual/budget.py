@@ -34,15 +34,17 @@ from pathlib import Path
 import numpy as np
 
 from . import geometry
-from .scene import Geometry, SceneError
+from .scene import Geometry, Scene, SceneError
 
 UNKNOWNS_PER_ELEMENT = 7.5    # PEERS_0 (3.61): unknowns_per_element(0)
 # peak of a solve per unknown (factorisation, condensation, records), by solver.method
 BYTES_PER_UNKNOWN = {"auto": 2500.0, "active-set": 2500.0, "uzawa": 8500.0}
 # the sparse LU of the conforming K and the records per unknown, by order k, beyond the
-# dense arrays of the condensation (Example 3.46 without friction, level 4: k = 1 8.2 kB,
-# k = 2 10.2 kB; tests/test_budget_order.py)
-BYTES_PER_UNKNOWN_CONFORMING = {0: 9000.0, 1: 9000.0, 2: 10500.0}
+# dense arrays of the condensation; measured peaks on Example 3.46 without friction
+# (tests/test_budget_order.py): k = 0 level 5 0.65 GB, k = 1 level 4 0.74 GB and level 5
+# 3.04 GB (4.6, 8.2 and 10.1 kB per unknown: the fill of the LU grows with N), k = 2
+# level 4 1.54 GB (10.2 kB)
+BYTES_PER_UNKNOWN_CONFORMING = {0: 5000.0, 1: 10000.0, 2: 11000.0}
 BYTES_PER_ELEMENT_MESH = 2000.0  # mesh and spaces only (``ngdual dofs``)
 BASE_BYTES = 400e6              # Python, NGSolve, SciPy, cvxpy loaded
 
@@ -270,6 +272,15 @@ def check(geo: Geometry, level: int | None = None, field_name: str = "geometry.l
                                      f"{describe_available(have)}; choose {remedy}, or pass "
                                      "--allow-large (allow_large=True) to try anyway")
     return size
+
+
+def check_scene(scene: Scene, level: int | None = None, field_name: str = "geometry.level",
+                allow_large: bool = False, mesh_only: bool = False) -> Estimate:
+    """:func:`check` for the run ``scene`` asks for: its geometry, ``solver.method``, the
+    order k and the multiplier family of ``[discretisation]`` and its Gamma_C."""
+    disc = scene.discretisation
+    return check(scene.geometry, level, field_name, allow_large, mesh_only,
+                 scene.solver.method, disc.order, disc.family, scene.labels("contact"))
 
 
 def _finest_size(geo: Geometry) -> tuple[str, str]:

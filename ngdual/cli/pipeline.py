@@ -31,8 +31,7 @@ def cmd_solve(args) -> int:
     level = check_level(args.level, "--level", optional=True)
     scene = load_scene(args.scene, args.set)
     out = check_output_dir(args.out, "--out")
-    size = budget.check(scene.geometry, level, "--level", args.allow_large,
-                        method=scene.solver.method)
+    size = budget.check_scene(scene, level, "--level", args.allow_large)
     if size.elements > LARGE_MESH:
         print(f"ngdual: {size.describe()}: meshing and solving take a while", file=sys.stderr)
     status = PhaseStatus(sys.stderr.isatty() or size.elements > LARGE_MESH)
@@ -101,7 +100,7 @@ def cmd_dofs(args) -> int:
     levels = level_flags(args.levels, "--levels")
     scene = load_scene(args.scene, args.set)
     for level in levels:
-        budget.check(scene.geometry, level, "--levels", args.allow_large, mesh_only=True)
+        budget.check_scene(scene, level, "--levels", args.allow_large, mesh_only=True)
     print("level " + " ".join(f"{k:>9s}" for k in ("X", "M", "S", "N", "C", "L")))
     for level in levels:
         dofs = Spaces.build(scene, build_mesh(scene.geometry, level)).dofs()
@@ -148,10 +147,9 @@ def _adapt(args) -> int:
     scene = load_scene(args.scene, args.set)
     out = check_output_dir(args.out, "--out")
     theta, steps, level = loop_defaults(args.tol, args.theta, args.steps, level)
-    budget.check(scene.geometry, level, "--level", args.allow_large, method=scene.solver.method)
+    budget.check_scene(scene, level, "--level", args.allow_large)
     for reference in args.reference_levels or []:
-        budget.check(scene.geometry, reference, "--reference-levels", args.allow_large,
-                     method=scene.solver.method)
+        budget.check_scene(scene, reference, "--reference-levels", args.allow_large)
     run = {"scene": scene.name, "marking": args.marking, "theta": theta,
            "steps": steps, "level": level, "asymmetry": args.asymmetry,
            "goal": args.goal, "tol": args.tol, "window": args.window,

@@ -89,9 +89,7 @@ def solve_scene(scene: Scene, level: int | None = None,
                                          f"increment), got {type(progress).__name__}")
     if not isinstance(allow_large, bool):
         raise SceneTypeError("allow_large", f"must be True or False, got {allow_large!r}")
-    budget.check(scene.geometry, level, "level", allow_large, method=scene.solver.method,
-                 order=scene.discretisation.order, multipliers=scene.discretisation.family,
-                 contact=scene.labels("contact"))
+    budget.check_scene(scene, level, "level", allow_large)
     level = scene.geometry.level if level is None else level
     if status is not None:
         status(f"meshing level {level}")
