@@ -23,6 +23,8 @@ squared, per element T, are::
         ``u_contact``       sum h_e ||lam_t t + (lam_n - g) n + u_Gamma||_e^2
     the friction and Neumann terms of (4.50)
         ``friction``        sum_{e in E^T on A_C} h~_e ||sigma_t - F nu||_e^2,  A_C = supp F
+                            (with the facet multipliers h_e ||(|sigma_t| - F)_+||_e^2,
+                            :func:`_moment_friction_term`)
         ``neumann``         log(1 + C~_N) sum_{e in E^T on Gamma_N} h~_e ||sigma_h n - t0||_e^2
 
 u_Gamma is the value of the piecewise constant u_h of the element at the edge
@@ -324,6 +326,8 @@ def estimate(solution: Solution, asymmetry: str = "l2") -> Estimate:
         on_edges["u_contact"] = he * edges.integrals(squared(mult + u_gamma), labels_c)
         if spaces.friction is not None and solution.friction_bound is not None:
             on_edges["friction"] = _friction_term(solution, edges, sigma_n * t, labels_c)
+        elif spaces.family == "facet" and solution.friction_bound is not None:
+            on_edges["friction"] = _moment_friction_term(solution, edges, sigma_n, labels_c)
     for name in ("jump_dirichlet", "jump_neumann", "jump_contact", "u_dirichlet", "u_neumann",
                  "u_contact", "friction", "neumann"):
         values = on_edges.get(name)
@@ -357,3 +361,30 @@ def _friction_term(solution: Solution, edges: BoundaryEdges, sigma_t, labels) ->
     htilde = gamma_c.coarse.edge_lengths()[gamma_c.htilde_edge]
     weight = edges.scatter(gamma_c.vertices, np.where(bound > 0, htilde, 0.0))
     return weight * edges.integrals((sigma_t - gf) * (sigma_t - gf), labels)
+
+
+def _moment_friction_term(solution: Solution, edges: BoundaryEdges, traction, labels
+                          ) -> np.ndarray:
+    """h_e ||(|sigma_t| - F)_+||_e^2 on the fine Gamma_C edges of A_C with the facet
+    multipliers of order k (``traction``: sigma_h n on the boundary).
+
+    Their friction law holds on the Bernstein moments (:class:`ngdual.friction.MomentFriction`):
+    int sigma_t B_i = nu_i int F B_i, so the function F nu whose moments these are is the
+    P_k trace sigma_t itself and sigma_t - F nu vanishes. What the moments leave free is
+    the pointwise bound |sigma_t| <= F (F = mu_f (-sigma_n)_+ for Coulomb, the trace's
+    own pressure, or the given Tresca bound), whose excess is a part of the error as the
+    tension of the pressure is (:func:`ngdual.goal.goal_estimate`). A_C: the fine edges
+    where ``friction_bound`` (the mean of F on the edge) is positive.
+    """
+    friction = solution.problem.scene.friction
+    n = ngs.specialcf.normal(2)
+    sigma_t, sigma_nn = traction * tangent(n), traction * n
+    if friction.law == "coulomb":
+        bound = friction.mu * ngs.IfPos(-sigma_nn, -sigma_nn, 0)
+    else:
+        bound = Expression(friction.bound).coefficient()
+    excess = ngs.IfPos(sigma_t, sigma_t, -sigma_t) - bound
+    gamma_c = solution.problem.spaces.gamma_c
+    on_a_c = np.asarray(solution.friction_bound, dtype=float) > 0
+    weight = edges.scatter(gamma_c.vertices, np.where(on_a_c, gamma_c.lengths, 0.0))
+    return weight * edges.integrals(ngs.IfPos(excess, excess * excess, 0), labels)
