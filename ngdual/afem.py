@@ -172,9 +172,7 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
                            allow_large, goal, tol, window)
     marking = MARKING if marking is None else marking
     theta, steps, level = loop_defaults(tol, theta, steps, level)
-    budget.check(scene.geometry, level, "level", allow_large, method=scene.solver.method,
-                 order=scene.discretisation.order, multipliers=scene.discretisation.family,
-                 contact=scene.labels("contact"))
+    budget.check_scene(scene, level, "level", allow_large)
     start = time.perf_counter()
     mesh = build_mesh(scene.geometry, level)
     coarse = BoundaryMeshes.for_scene(scene, mesh)
