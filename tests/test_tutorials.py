@@ -187,11 +187,14 @@ def check_your_own_scene(r: dict) -> None:
 
 def check_order_against_mesh_size(r: dict) -> None:
     """The stress of PEERS_k converges at order k + 1 against the exact solution; a higher
-    order reaches the target error with fewer unknowns."""
+    order reaches the target error with fewer unknowns; the adaptive loop runs at every
+    order and reduces the error."""
     for k, observed in r["observed_order"].items():
         assert abs(observed - (int(k) + 1)) <= 0.2, r["observed_order"]
     unknowns = [r["costs"][k]["ndof"] for k in ("0", "1", "2")]
     assert unknowns[0] > unknowns[1] > unknowns[2], unknowns
+    for k, kept in r["adaptive"].items():
+        assert kept["sigma"][-1] < kept["sigma"][0] and kept["ndof"][-1] > kept["ndof"][0], k
 
 
 CHECKS = {1: check_peers_spaces, 2: check_locking, 3: check_signorini_uzawa,
