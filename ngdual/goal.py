@@ -157,8 +157,10 @@ def goal_estimate(solution: Solution, estimated: Estimate,
                                            spaces.end_hats["lam_n"])
     starts = _edge_starts(gamma_c)
     lam_mean = 0.5 * (lam_n[starts] + lam_n[starts + 1])
-    if spaces.family == "facet":   # lambda_n is P_k on every edge at order k: its own mean
-        lam_mean = gamma_c.hat_means(spaces.prolongations["lam_n"]) @ solution.x[pb.lam_n]
+    if spaces.family == "facet":   # lambda_n is P_k on every edge at order k: its own mean,
+        # >= 0 as its Bernstein coefficients are (up to the solver's round-off)
+        lam_mean = np.maximum(
+            gamma_c.hat_means(spaces.prolongations["lam_n"]) @ solution.x[pb.lam_n], 0.0)
 
     on_edges = {
         "residual": residual,   # the tension of p_h at order k
