@@ -300,6 +300,25 @@ def contact_set(solution) -> list[tuple[float, float]]:
     return [(float(a), float(b)) for a, b in zip(mid - half, mid + half)]
 
 
+def pressure_error(case, solution) -> float:
+    """||sigma_n^h - sigma_n||_{L^2(Gamma_C)}: the normal stress of the discrete solution on
+    Gamma_C (n . sigma_h n, the normal traces of the stress rows: P_k on every fine edge)
+    against the exact one of a manufactured ``case``, integrated exactly (Gamma_C's breaks
+    x = +-2 are mesh vertices)."""
+    from ..expr import Expression
+    from ..quantities import fields
+
+    mesh = solution.problem.fes.mesh
+    exact = case.exact.sigma_n
+    n = ngs.specialcf.normal(2)
+    sigma = fields(solution).sigma
+    error = ngs.InnerProduct(sigma * n, n) - Expression(exact.text()).coefficient()
+    degree = 2 * max(solution.problem.scene.discretisation.order, exact.degree) + 2
+    region = mesh.Boundaries("|".join(solution.problem.scene.labels("contact")))
+    return math.sqrt(max(ngs.Integrate(error * error, mesh, ngs.BND, order=degree,
+                                       definedon=region), 0.0))
+
+
 def contact_study(order: int = 0, levels=(1, 2, 3)) -> list[dict]:
     """The manufactured frictionless contact case solved at order k on uniform levels.
 
@@ -309,7 +328,8 @@ def contact_study(order: int = 0, levels=(1, 2, 3)) -> list[dict]:
         One row per level: ``problem`` ("contact"), ``order``, ``level``, ``ndof`` (every
         unknown), ``seconds`` (meshing, assembly and solve), the L^2 errors of
         :data:`QUANTITIES` with their observed orders ``<quantity>_order`` (None on the
-        first level), and ``contact_set``: the length of the symmetric difference between
+        first level), the pressure's error ``pressure`` (:func:`pressure_error`) with its
+        order, and ``contact_set``: the length of the symmetric difference between
         :func:`contact_set` and the exact contact set [-2, 2].
     """
     from ..solvers import solve_scene
@@ -327,9 +347,10 @@ def contact_study(order: int = 0, levels=(1, 2, 3)) -> list[dict]:
         rows.append({"problem": "contact", "order": order, "level": level,
                      "ndof": solution.problem.fes.ndof, "seconds": seconds,
                      **{q: errors[q] for q in QUANTITIES},
+                     "pressure": pressure_error(case, solution),
                      "contact_set": symmetric_difference(contact_set(solution),
                                                          case.contact_set)})
-    for q in QUANTITIES:
+    for q in (*QUANTITIES, "pressure"):
         for row, rate in zip(rows, observed_rates([r["ndof"] for r in rows],
                                                   [r[q] for r in rows])):
             row[q + "_order"] = rate

@@ -33,6 +33,7 @@ QUICK = {"manufactured": ("frictionless", "coulomb"), "manufactured_levels": (1,
 FULL = {"manufactured": tuple(CASES), "manufactured_levels": (1, 2, 3, 4, 5),
         "benchmark_levels": (1, 2, 3, 4), "elasticity_levels": (1, 2, 3, 4),
         "contact_levels": (1, 2, 3, 4)}
+ORDER_COLUMNS = ("sigma", "u", "eta", "pressure")   # errors with orders in the order tables
 
 
 def verification_rows(quick: bool = False, orders=ORDERS, only_orders: bool = False) -> dict:
@@ -75,16 +76,17 @@ def format_orders(studies: list[dict]) -> str:
     if not studies:
         return ""
     lines = [f"order k of PEERS_k: observed orders (in N^-1/2) against k + 1; sigma must lie "
-             f"within {ORDER_SLACK:g} of it on the last two levels",
+             f"within {ORDER_SLACK:g} of it on the last two levels; pressure: sigma_n^h on "
+             "Gamma_C in L2; set: the contact set's error (length)",
              f"{'problem':>10} {'k':>2} {'lvl':>3} {'ndof':>7} {'sec':>6} "
-             + " ".join(f"{q:>9} {'ord':>5}" for q in ("sigma", "u", "eta"))
+             + " ".join(f"{q:>9} {'ord':>5}" for q in ORDER_COLUMNS)
              + f" {'set':>7} {'check':>5}"]
     for study in studies:
         rows = study["rows"]
         for i, row in enumerate(rows):
-            cells = [f"{row[q]:9.3e} " + (f"{row[q + '_order']:5.2f}"
-                                           if row[q + "_order"] is not None else f"{'':>5}")
-                     for q in ("sigma", "u", "eta")]
+            cells = [f"{'':>15}" if q not in row else f"{row[q]:9.3e} "
+                     + (f"{row[q + '_order']:5.2f}" if row[q + "_order"] is not None
+                        else f"{'':>5}") for q in ORDER_COLUMNS]
             cset = f"{row['contact_set']:7.4f}" if "contact_set" in row else f"{'':>7}"
             check = ("pass" if study["check"]["passed"] else "FAIL") if i == len(rows) - 1 \
                 else ""
