@@ -10,7 +10,9 @@ estimator read Gamma_C from it instead of deriving it again:
   h~ and h^ edge of every fine edge and the mean of every h~ hat on every fine edge;
 * the gap g (a formula, or from a foundation line, :class:`ngdual.scene.Contact`) as an
   NGSolve coefficient, at points, and its P1 interpolant g_h on the h~ mesh (the gap of
-  ``contact.discrete_gap = "nodal"``);
+  ``contact.discrete_gap = "nodal"``), or with the facet multipliers its P_k interpolant on
+  every fine edge, taken on the boundary curve the edge is a chord of, along the curve's
+  normal (:meth:`on_curve`, :func:`curve_normal`);
 * the prescribed end values of lambda_n = g - u_n and lambda_t = -u_t where Gamma_C meets
   Gamma_D (``contact.ends = "consistent"``): g - u_D.n and -u_D.t; zero for ``"thesis"``.
 """
@@ -25,7 +27,7 @@ import scipy.sparse as sp
 
 from .boundary import CoarseMesh, FacetMesh, edge_normals, host_space
 from .expr import Expression
-from .geometry import tangent
+from .geometry import Side, tangent
 from .scene import Scene, gap_at
 from .scene.contact import foundation_gap
 
@@ -56,6 +58,35 @@ def _means(space: ngs.FESpace, labels: list[str], bubble_dofs: np.ndarray,
     integrals += space.TestFunction() * ngs.ds(definedon=space.mesh.Boundaries("|".join(labels)))
     integrals.Assemble()
     return integrals.vec.FV().NumPy()[bubble_dofs] / lengths[:, None]
+
+
+def _contact_arcs(scene: Scene) -> list[tuple[Side, float]]:
+    """The arcs of Gamma_C with the sign that turns the radial direction from the centre
+    into the outward normal (+1: the body lies inside the circle)."""
+    arcs = []
+    for side in scene.geometry.curves():
+        if side.is_arc and side.label in scene.labels("contact"):
+            points, normals = side.sample(2)
+            arcs.append((side, float(np.sign(np.sum((points[0] - side.center) * normals[0])))))
+    return arcs
+
+
+def curve_normal(scene: Scene, mesh: ngs.Mesh) -> ngs.CoefficientFunction:
+    """The outward unit normal of the boundary curve of Gamma_C on its fine edges, as an
+    NGSolve coefficient: on an arc the radial direction at every point of a chord (the
+    arc's normal on the same ray, :meth:`ContactBoundary.on_curve`), on a straight side the
+    edge normal. The facet multipliers pair with sigma in it (:func:`ngdual.forms._forms`),
+    so that lambda_n = g - u.n and the frictionless t.sigma n = 0 hold for the arc's normal
+    and tangent, not for a chord's, which differ from them by up to |e| / (2 R)."""
+    n = ngs.specialcf.normal(2)
+    arcs = _contact_arcs(scene)
+    if not arcs:
+        return n
+    values = {}
+    for side, sign in arcs:
+        radial = ngs.CF((ngs.x - float(side.center[0]), ngs.y - float(side.center[1])))
+        values[side.label] = sign * radial / ngs.sqrt(radial * radial)
+    return mesh.BoundaryCF(values, default=n)
 
 
 def gap_coefficient(scene: Scene) -> ngs.CoefficientFunction:
@@ -212,49 +243,41 @@ class ContactBoundary:
         if isinstance(self.coarse, FacetMesh):
             # the facet multipliers: g of the boundary curve interpolated on every fine edge
             return prolongation @ self.coarse.interpolant(
-                lambda points, edges: gap_at(self.scene.contact,
-                                             self.on_curve(points, edges), self.normals[edges]))
+                lambda points, edges: gap_at(self.scene.contact, *self.on_curve(points, edges)))
         at_dofs, at_ends = self.gap_at_nodes()
         return prolongation @ at_dofs + end_hats @ at_ends
 
-    def on_curve(self, points: np.ndarray, edges: np.ndarray) -> np.ndarray:
-        """``points`` of the fine ``edges`` moved along the edge normals onto the boundary
-        curve of Gamma_C that the edges approximate.
+    def on_curve(self, points: np.ndarray, edges: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray]:
+        """``points`` of the fine ``edges`` moved onto the boundary curve of Gamma_C that the
+        edges approximate, and its outward unit normals there (:func:`curve_normal`).
 
-        The fine edges are chords: where Gamma_C is an arc, a chord lies inside the body by
-        its sagitta, up to |e|^2 / (8 R). The gap at a point of the chord is that of the
-        arc's point on the same normal, g(x + s n) = g(x) - s for a foundation line: the
-        body is the arc, not the polygon of its chords. On the vertices (s = 0) and on
-        straight sides nothing moves, so the P1 interpolant of the gap is that of the
-        polygon; at k >= 2 the chords' gap would carry the kinks of the polygon at every
-        vertex, an O(h / R) jump of the slope of u_n, into the contact zone, where the
-        traces of RT_k resolve it as pressure peaks at the vertices
+        The fine edges are chords: where Gamma_C is an arc of radius R, a chord lies inside
+        the body by its sagitta, up to |e|^2 / (8 R), and its normal is the arc's only at
+        its midpoint. A point x of a chord moves along the radius to the arc, where the gap
+        is measured along the arc's normal: the body is the arc, not the polygon of its
+        chords. On straight sides (and at the vertices, which lie on the arc) nothing moves,
+        so the P1 interpolant of the gap is that of the polygon; at k >= 2 the chords' gap
+        would put the kinks of the polygon at every vertex, an O(h / R) jump of the slope of
+        u_n, into the contact zone, where the traces of RT_k resolve them as pressure peaks
         (docs/theory/order.md).
         """
         points = np.asarray(points, dtype=float)
-        arcs = [side for side in self.scene.geometry.curves()
-                if side.is_arc and side.label in self.scene.labels("contact")]
-        if not arcs:
-            return points
+        normals = self.normals[edges].copy()
+        moved = points.copy()
         starts = np.vstack([chain.path_points[:-1] for chain in self.coarse.chains])
         stops = np.vstack([chain.path_points[1:] for chain in self.coarse.chains])
-        n = self.normals[edges]
-        # the side of every edge: the arc through both its end points (a straight side,
-        # on which nothing moves, otherwise)
-        moved = points.copy()
-        for side in arcs:
+        for side, sign in _contact_arcs(self.scene):
             r = np.linalg.norm(side.start - side.center)
+            # the edges of this arc: both end points on it
             on_arc = np.maximum(np.abs(np.linalg.norm(starts - side.center, axis=1) - r),
                                 np.abs(np.linalg.norm(stops - side.center, axis=1) - r))
             mine = on_arc[edges] <= 1e-9 * r
-            d = points[mine] - side.center
-            b = np.sum(d * n[mine], axis=1)
-            # |x + s n - c| = r: the root of least |s| (s > 0 where the arc bulges out of
-            # the body, s < 0 where it bulges in)
-            s = -b + np.sign(b) * np.sqrt(np.maximum(b * b - (np.sum(d * d, axis=1) - r * r),
-                                                     0.0))
-            moved[mine] = points[mine] + s[:, None] * n[mine]
-        return moved
+            radial = points[mine] - side.center
+            radial /= np.linalg.norm(radial, axis=1)[:, None]
+            moved[mine] = side.center + r * radial
+            normals[mine] = sign * radial
+        return moved, normals
 
     def end_values(self, u_d: tuple[str, str]) -> tuple[np.ndarray, np.ndarray]:
         """(lambda_n, lambda_t) at the fixed ends (``coarse.end_points()``).

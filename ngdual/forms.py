@@ -26,7 +26,7 @@ import scipy.sparse as sp
 
 from . import peers
 from .boundary import BoundaryMeshes, CoarseMesh, FacetMesh, end_rule, host_space
-from .contact import ContactBoundary, gap_coefficient, trace_space
+from .contact import ContactBoundary, curve_normal, gap_coefficient, trace_space
 from .expr import Expression
 from .geometry import tangent
 from .scene import Scene
@@ -414,6 +414,10 @@ def _forms(scene: Scene, fes: ngs.FESpace, names: list[str]):
     if "lam_n" in names:
         ds_c = ngs.ds(definedon=mesh.Boundaries(boundary_regex(scene.labels("contact"))),
                       intrules=TRACE_RULES)
+        if scene.discretisation.family == "facet":
+            # the normal and tangent of the boundary curve, not of its chords (curve_normal)
+            n = curve_normal(scene, mesh)
+            t = tangent(n)
         d += (trial["lam_t"] * (t * trac_tau) + test["lam_t"] * (t * trac_sig)) * ds_c  # d_Ct
         d += (trial["lam_n"] * (n * trac_tau) + test["lam_n"] * (n * trac_sig)) * ds_c  # d_Cn
         if scene.contact.discrete_gap == "thesis":

@@ -6,10 +6,12 @@ h^ mesh, no value at an end of Gamma_C. ``contact.htilde_factor``, ``hhat_factor
 field; the defaults describe what the facet family does.
 """
 
+import ngsolve as ngs
 import numpy as np
 import pytest
 
 from ngdual.boundary.facet import bernstein_values
+from ngdual.contact import curve_normal
 from ngdual.forms import Spaces
 from ngdual.mesh import build_mesh
 from ngdual.post import contact_traces
@@ -58,35 +60,55 @@ def _facet_gamma_c(name, order, level):
 
 def test_the_gap_of_the_facet_multipliers_is_the_gap_of_the_arc_not_of_its_chords():
     """hertz-cylinder's bottom is the arc |x - (0, 10)| = 10 above the plane y = 0: at every
-    control point x of a chord, g_h is the distance along the edge normal n from the arc's
-    point x + s n to the plane (truth: the circle), s the chord's sagitta there."""
+    control point x of a chord, g_h is the distance from the arc's point on the radius
+    through x to the plane along the arc's normal (truth: the circle); the chord lies
+    inside the arc by its sagitta."""
     scene, gamma_c = _facet_gamma_c("hertz-cylinder", 2, 1)
     t = np.array([0.0, 0.5, 1.0])
     starts = np.vstack([c.path_points[:-1] for c in gamma_c.coarse.chains])
     stops = np.vstack([c.path_points[1:] for c in gamma_c.coarse.chains])
     edges = np.repeat(np.arange(len(starts)), 3)
     points = (starts[:, None] + t[None, :, None] * (stops - starts)[:, None]).reshape(-1, 2)
-    moved = gamma_c.on_curve(points, edges)
+    moved, normals = gamma_c.on_curve(points, edges)
     centre = np.array([0.0, 10.0])
     assert np.allclose(np.linalg.norm(moved - centre, axis=1), 10.0, rtol=0, atol=1e-12)
-    s = np.sum((moved - points) * gamma_c.normals[edges], axis=1)
-    chord = gamma_c.lengths[edges]
+    assert np.allclose(normals, (moved - centre) / 10.0, rtol=0, atol=1e-14)
     # the sagitta of a chord of length |e| at its parameter t: t (1 - t) |e|^2 / (2 R)
-    assert s == pytest.approx(np.tile(t * (1 - t), len(starts)) * chord**2 / 20, rel=1e-3,
-                              abs=1e-12)
-    n = gamma_c.normals[edges]
-    exact = moved[:, 1] / -n[:, 1]
-    values = bernstein_values(2, t)
+    sagitta = np.linalg.norm(moved - points, axis=1)
+    assert sagitta == pytest.approx(np.tile(t * (1 - t), len(starts)) * gamma_c.lengths[edges]**2
+                                    / 20, rel=1e-3, abs=1e-12)
+    exact = moved[:, 1] / -normals[:, 1]
     coefficients = gamma_c.coarse.interpolant(
-        lambda p, e: gap_at(scene.contact, gamma_c.on_curve(p, e), gamma_c.normals[e]))
-    interpolated = (coefficients.reshape(-1, 3) @ values.T).ravel()
+        lambda p, e: gap_at(scene.contact, *gamma_c.on_curve(p, e)))
+    interpolated = (coefficients.reshape(-1, 3) @ bernstein_values(2, t).T).ravel()
     assert interpolated == pytest.approx(exact, rel=1e-12)
+
+
+def test_the_facet_multipliers_pair_with_the_normal_of_the_arc():
+    """d_Cn(mu, tau) = int mu n_c.(tau n) ds with n_c the arc's outward normal: on every
+    chord the radial direction from the centre (0, 10), which differs from the chord's
+    normal away from its midpoint; on the flat punch the edge normal itself."""
+    def squared_distance(scene, label, other):
+        mesh = build_mesh(scene.geometry, 1)
+        n_c = curve_normal(scene, mesh)
+        other = other(mesh)
+        return ngs.Integrate(ngs.InnerProduct(n_c - other, n_c - other), mesh, ngs.BND,
+                             definedon=mesh.Boundaries(label))
+
+    hertz_scene = load_scene("hertz-cylinder", ["discretisation.order=1"])
+    radial = ngs.CF((ngs.x, ngs.y - 10.0))
+    assert squared_distance(hertz_scene, "bottom",
+                            lambda mesh: radial / ngs.sqrt(radial * radial)) < 1e-24
+    assert squared_distance(hertz_scene, "bottom", lambda mesh: ngs.specialcf.normal(2)) > 1e-6
+    punch = load_scene("flat-punch", ["discretisation.order=1"])
+    assert squared_distance(punch, "punch", lambda mesh: ngs.specialcf.normal(2)) == 0.0
 
 
 def test_on_straight_sides_the_gap_of_the_facet_multipliers_is_that_of_the_edges():
     _, gamma_c = _facet_gamma_c("flat-punch", 2, 1)
     points = gamma_c.midpoints
-    assert np.array_equal(gamma_c.on_curve(points, np.arange(len(points))), points)
+    moved, normals = gamma_c.on_curve(points, np.arange(len(points)))
+    assert np.array_equal(moved, points) and np.array_equal(normals, gamma_c.normals)
 
 
 @pytest.mark.filterwarnings("ignore::ngdual.solvers.result.PhysicsWarning")
@@ -109,8 +131,8 @@ def test_the_traces_at_order_1_are_read_at_the_control_points_of_the_fine_edges(
     """contact_traces of a facet solution: the pressure at every control point is the moment
     its contact condition signs, over int psi_i (so the moments sum to the contact force),
     the sampled P_1 traces interpolate their edge means, and the labels name control
-    points."""
-    solution = solve_scene(load_scene("hertz-cylinder", ["discretisation.order=1"]), 1)
+    points (a straight Gamma_C, where the multipliers pair with the edge normal)."""
+    solution = solve_scene(load_scene("thesis-3.46-frictionless", FACET + [CONSISTENT]), 1)
     traces = contact_traces(solution)
     gamma_c = solution.problem.spaces.gamma_c
     mass = gamma_c.hat_means(solution.problem.spaces.prolongations["lam_n"]).T @ gamma_c.lengths
