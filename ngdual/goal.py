@@ -63,6 +63,9 @@ STRAIN_TERMS = ("curl", "jump_interior", "jump_dirichlet", "jump_neumann")
 # One constant: 1 / (the geometric mean, 9.7, of the uncalibrated effectivity over six
 # theta = 0.8 steps on hertz-cylinder), rounded to one digit (docs/theory/estimator.md).
 CALIBRATION = 0.1
+# At order k with the facet multipliers, the same: 1 / (the geometric mean, 4.2, over eight
+# theta = 0.8 steps on hertz-cylinder at order 1 from level 1), rounded to one digit.
+CALIBRATION_ORDER_K = 0.2
 # lambda_n below this share of its largest value on Gamma_C is contact
 CONTACT_SHARE = 1e-6
 
@@ -71,16 +74,19 @@ CONTACT_SHARE = 1e-6
 class PressureEstimate:
     """The indicators of ||p - p_h||_{L2(Gamma_C)}: ``terms[k]`` squared per element.
 
-    ``size`` is ||p_h||_{L2(Gamma_C)}, the size the relative estimate is taken against.
+    ``size`` is ||p_h||_{L2(Gamma_C)}, the size the relative estimate is taken against;
+    ``calibration`` the constant C of the estimate (CALIBRATION_ORDER_K at order k with the
+    facet multipliers).
     """
 
     terms: dict[str, np.ndarray]
     size: float
+    calibration: float = CALIBRATION   # or CALIBRATION_ORDER_K, by the order
 
     @property
     def indicators(self) -> np.ndarray:
-        """The element indicators, CALIBRATION (sum_k terms[k])^{1/2} (they drive MARK)."""
-        return CALIBRATION * np.sqrt(sum(self.terms.values()))
+        """The element indicators, C (sum_k terms[k])^{1/2} (they drive MARK; C of order k)."""
+        return self.calibration * np.sqrt(sum(self.terms.values()))
 
     @property
     def total(self) -> float:
@@ -88,8 +94,8 @@ class PressureEstimate:
         return float(np.sqrt(np.sum(self.indicators**2)))
 
     def summed(self) -> dict[str, float]:
-        """CALIBRATION (sum_T terms[k]_T)^{1/2} of every term."""
-        return {k: float(CALIBRATION * np.sqrt(v.sum())) for k, v in self.terms.items()}
+        """C (sum_T terms[k]_T)^{1/2} of every term (C of order k)."""
+        return {k: float(self.calibration * np.sqrt(v.sum())) for k, v in self.terms.items()}
 
 
 def goal_estimate(solution: Solution, estimated: Estimate,
@@ -181,7 +187,9 @@ def goal_estimate(solution: Solution, estimated: Estimate,
         terms["far"] = eta_sigma * h_near / (h_near + distance)**2
     else:
         terms["far"] = eta_sigma * _dipole_weight(corners, distance, h_near)
-    return PressureEstimate(terms, size)
+    # the facet multipliers of order k have their own constant
+    return PressureEstimate(terms, size, CALIBRATION_ORDER_K if spaces.family == "facet"
+                            else CALIBRATION)
 
 
 def _dipole_weight(corners: np.ndarray, distance: np.ndarray, h_near: np.ndarray
