@@ -6,7 +6,7 @@
 # and right sides ($\Gamma_D$), loaded on the top ($\Gamma_N$). The loads are manufactured
 # (`ngdual.verification.manufactured`, case `frictionless`): the exact displacement and
 # stress are known, the body touches the foundation exactly on $[-2, 2]$ with the pressure
-# $-\sigma_n = 5\,(1 - x^2/4)^3$ and lifts off towards the clamped ends. So every error below
+# $-\sigma_n = 5\,(1 - x^2/4)^2$ and lifts off towards the clamped ends. So every error below
 # is measured against the truth.
 #
 # **Discretisation.** PEERS of order $k$ (Stenberg's PEERS$_k$, `docs/theory/order.md`):
