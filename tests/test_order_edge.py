@@ -1,9 +1,13 @@
-"""The contact settings of the coarse multipliers with the facet multipliers (issue 27).
+"""Gamma_C of the facet multipliers at order k (issue 27): its settings, its curve, its traces.
 
-The facet P_k multipliers live on the fine edges, discontinuous from edge to edge: no h~ or
-h^ mesh, no value at an end of Gamma_C. ``contact.htilde_factor``, ``hhat_factor`` and
-``ends`` other than their defaults would do nothing, so the scene is refused, naming the
-field; the defaults describe what the facet family does.
+* The facet P_k multipliers live on the fine edges, discontinuous from edge to edge: no h~
+  or h^ mesh, no value at an end of Gamma_C. ``contact.htilde_factor``, ``hhat_factor`` and
+  ``ends`` other than their defaults would do nothing, so the scene is refused, naming the
+  field.
+* On an arc the gap and the normal are those of the arc, not of its chords (truth: the
+  circle; Hertz's pressure on the core of the contact zone).
+* ``contact_traces`` reads the moments the sign conditions control at the control points
+  (truth: they sum to the contact force) and samples the P_k traces.
 """
 
 import ngsolve as ngs
@@ -18,6 +22,7 @@ from ngdual.post import contact_traces
 from ngdual.scene import SceneError, gap_at, load_scene
 from ngdual.solvers import solve_scene
 from ngdual.verification.analytic import hertz
+from ngdual.verification.traction import traction_profile
 
 FACET = ["discretisation.order=1"]
 CONSISTENT = "contact.ends='consistent'"
@@ -147,3 +152,14 @@ def test_the_traces_at_order_1_are_read_at_the_control_points_of_the_fine_edges(
     assert mean == pytest.approx(traces.sigma_n, rel=1e-8, abs=1e-5 * np.abs(mean).max())
     assert traces.edge_active.sum() == np.count_nonzero(
         traces.coarse_in_contact.reshape(-1, 2).any(axis=1))
+
+
+@pytest.mark.filterwarnings("ignore::ngdual.solvers.result.PhysicsWarning")
+def test_the_traction_profile_at_order_1_is_the_trace_and_integrates_to_the_contact_force():
+    """The analytic curves of ``ngdual solve`` are drawn for the profile's force: at order k
+    it is the P_k trace itself, whose integral is int -sigma_n ds exactly at k = 1."""
+    solution = solve_scene(load_scene("thesis-3.46-frictionless", FACET + [CONSISTENT]), 1)
+    traces, profile = contact_traces(solution), traction_profile(solution)
+    assert profile.force == pytest.approx(np.sum(-traces.sigma_n * traces.edge_length),
+                                          rel=1e-9)
+    assert np.array_equal(profile.pressure, -traces.trace_sigma_n.ravel())

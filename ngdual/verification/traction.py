@@ -38,6 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
+from ..boundary import FacetMesh
 from ..friction import hat_projection
 from ..geometry import tangent
 from ..post import contact_traces, force_balance
@@ -134,10 +135,13 @@ def _plane_coordinate(solution: Solution, points: np.ndarray) -> np.ndarray:
 
 def traction_profile(solution: Solution) -> TractionProfile:
     """The lumped L2 projections of -sigma_n^h and sigma_t^h onto the h~ hats (see the module
-    docstring for why these are the compared tractions)."""
+    docstring for why these are the compared tractions); with the facet multipliers of order
+    k the traces themselves (:func:`_facet_profile`)."""
     pb = solution.problem
     gamma_c, coarse = pb.spaces.gamma_c, pb.spaces.contact
     traces = contact_traces(solution)
+    if isinstance(coarse, FacetMesh):
+        return _facet_profile(solution, traces)
     hats = gamma_c.hat_means(pb.spaces.prolongations["lam_n"])          # dof hats
     end_hats = gamma_c.hat_means(pb.spaces.end_hats["lam_n"])           # fixed-end hats
     length = gamma_c.lengths
@@ -166,6 +170,22 @@ def traction_profile(solution: Solution) -> TractionProfile:
     x = _plane_coordinate(solution, np.vstack(xs))
     return TractionProfile(x, np.array(starts), -sigma_n[columns], sigma_t[columns],
                           contact[columns])
+
+
+def _facet_profile(solution: Solution, traces) -> TractionProfile:
+    """The traces -sigma_n^h, sigma_t^h of order k as the profile: the facet multipliers are
+    the trace space of RT_k, so the traces are what the contact conditions control, with
+    nothing orthogonal to project away. Linear between the samples of
+    :func:`ngdual.post.contact_traces` (4k + 2 per fine edge, end points included: exact at
+    k <= 1); every edge is a piece of its own (the traces are discontinuous)."""
+    pb = solution.problem
+    gamma_c = pb.spaces.gamma_c
+    samples = traces.trace_xy.shape[1]
+    along = np.sign(gamma_c.tangents @ plane_direction(pb.scene))
+    x = _plane_coordinate(solution, traces.trace_xy.reshape(-1, 2))
+    return TractionProfile(x, samples * np.arange(len(gamma_c)), -traces.trace_sigma_n.ravel(),
+                           (along[:, None] * traces.trace_sigma_t).ravel(),
+                           np.repeat(traces.edge_active, samples))
 
 
 def plane_direction(scene: Scene) -> np.ndarray:
