@@ -13,7 +13,7 @@ import pytest
 from ngdual.forms import assemble
 from ngdual.mesh import build_mesh
 from ngdual.scene import load_scene
-from ngdual.solvers import solve_problem
+from ngdual.solvers import conforming, solve_problem
 from ngdual.solvers.qp import solve_qp_friction
 from ngdual.solvers.settings import Model
 
@@ -21,7 +21,8 @@ QP_AGREEMENT = 1e-8  # Clarabel's interior point, not polished with friction (me
 
 
 def _problem(name: str, order: int, level: int):
-    scene = load_scene(name, [f"discretisation.order={order}", "contact.ends='consistent'"])
+    ends = [] if name == "hertz-cylinder" else ["contact.ends='consistent'"]
+    scene = load_scene(name, [f"discretisation.order={order}", *ends])
     return assemble(scene, build_mesh(scene.geometry, level))
 
 
@@ -54,3 +55,29 @@ def test_the_coulomb_solution_on_example_3_46_passes_every_physics_check(order):
     solution = solve_problem(problem)
     assert solution.warnings == []
     assert solution.residuals["coulomb_bound"] < 1e-10
+
+
+@pytest.mark.parametrize("name", ["thesis-3.46-frictionless", "thesis-3.46-coulomb"])
+def test_condensing_onto_every_coefficient_gives_the_solution_of_the_candidates(name,
+                                                                               monkeypatch):
+    """The path of a singular K (a floating body: every multiplier eliminated, all N_C
+    coefficients condensed) and the candidates' path solve the same discrete problem."""
+    problem = _problem(name, 1, 1)
+    candidates = solve_problem(problem)
+    monkeypatch.setattr(conforming.WholeFactorization, "regular", property(lambda self: False))
+    every = solve_problem(problem)
+    assert every.iterations["condensed"] == len(problem.lam_n)
+    assert candidates.iterations["condensed"] < len(problem.lam_n)
+    assert _relative(every.x, candidates.x) < 1e-9
+
+
+def test_hertz_condenses_onto_a_few_coefficients_around_the_contact_zone():
+    """Hertz at k = 1: the candidates are the coefficients in contact and a few around them,
+    a small part of Gamma_C, and each costs one solve."""
+    problem = _problem("hertz-cylinder", 1, 1)
+    solution = solve_problem(problem)
+    lam_n = solution.x[problem.lam_n]
+    touching = int(np.sum(lam_n <= 1e-8 * np.max(lam_n)))
+    assert touching <= solution.iterations["condensed"] <= 2 * touching
+    assert solution.iterations["solves"] == solution.iterations["condensed"] + 2
+    assert solution.iterations["condensed"] < len(problem.lam_n) / 4

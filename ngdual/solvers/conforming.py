@@ -71,6 +71,7 @@ from .settings import ActiveSetSettings
 TOLERANCE = 1e-9   # relative residuals of (3.103) accepted as round-off
 REGULAR = 1e-8     # the free solve of a regular K leaves relative residuals below this
 CONTACT_START = 1e-8  # a warm start's lambda_n in contact: below this of its largest value
+DEEPEST = 0.5      # candidates per round: penetrations of at least this share of the deepest
 
 
 @dataclass
@@ -260,7 +261,7 @@ def _on_candidates(whole: WholeFactorization, law: str, mu_f: float, bound, fric
     until no coefficient off J violates a condition (module docstring)."""
     n_c = len(whole.problem.lam_n)
     has_friction = law != "none"
-    candidate = whole.a[:n_c] < 0.0
+    candidate = _deepest(whole.a[:n_c], 0.0)
     if first is not None:
         candidate |= first[0] <= CONTACT_START * (np.max(np.abs(first[0]), initial=0.0) or 1.0)
     if law == "tresca":
@@ -284,7 +285,7 @@ def _on_candidates(whole: WholeFactorization, law: str, mu_f: float, bound, fric
         scale = float(np.max(np.abs(lam), initial=0.0)) or 1.0
         level = SAFETY * (cond.roundoff if len(J) else EPS) * scale
         off = ~candidate
-        violated = off & (lam[:n_c] < -level)
+        violated = off & _deepest(np.where(off, lam[:n_c], 0.0), level)
         if law == "tresca":
             violated |= off & (bound > 0.0) & (np.abs(lam[n_c:]) > level)
         if not violated.any():
@@ -304,6 +305,14 @@ def _on_candidates(whole: WholeFactorization, law: str, mu_f: float, bound, fric
     return x, state, F, {"iterations": {"outer": its["outer"], "inner": int(inner),
                                         "candidate_rounds": rounds},
                          "history": history, "unknowns": len(J), "solves": whole.solves}
+
+
+def _deepest(lam_n: np.ndarray, level: float) -> np.ndarray:
+    """The coefficients that penetrate (lambda_n < -``level``) by at least ``DEEPEST`` of the
+    deepest penetration: contact there lifts the body elsewhere, so the shallow ones are
+    taken in only if they still penetrate afterwards."""
+    deepest = float(np.min(lam_n, initial=0.0))
+    return (lam_n < -level) & (lam_n <= DEEPEST * deepest)
 
 
 def _on_every_coefficient(problem: DiscreteProblem, law: str, mu_f: float, bound, friction,
