@@ -157,9 +157,10 @@ def test_the_traces_at_order_1_are_read_at_the_control_points_of_the_fine_edges(
 @pytest.mark.filterwarnings("ignore::ngdual.solvers.result.PhysicsWarning")
 def test_the_traction_profile_at_order_1_is_the_trace_and_integrates_to_the_contact_force():
     """The analytic curves of ``ngdual solve`` are drawn for the profile's force: at order k
-    it is the P_k trace itself, whose integral is int -sigma_n ds exactly at k = 1."""
+    it is the P_k trace itself, whose integral is int -sigma_n ds exactly at k = 1 (up to its
+    evaluation a share 1e-6 of |e| inside the triangle, ngdual.post.INSIDE)."""
     solution = solve_scene(load_scene("thesis-3.46-frictionless", FACET + [CONSISTENT]), 1)
     traces, profile = contact_traces(solution), traction_profile(solution)
     assert profile.force == pytest.approx(np.sum(-traces.sigma_n * traces.edge_length),
-                                          rel=1e-9)
+                                          rel=1e-6)
     assert np.array_equal(profile.pressure, -traces.trace_sigma_n.ravel())
