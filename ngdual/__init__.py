@@ -8,10 +8,13 @@ notebook needs:
 >>> scene = nd.load_scene("thesis-3.46-coulomb", ["geometry.level=2"])
 >>> solution = nd.solve(scene)                                   # doctest: +SKIP
 >>> nd.norms(solution)["sigma_X"]                                # doctest: +SKIP
+>>> frictionless = nd.load_scene("thesis-3.46-frictionless", ["contact.ends='consistent'"])
+>>> nd.solve(frictionless, 2, order=1)                           # doctest: +SKIP
 
 Scenes: :func:`load_scene`, :func:`validate`, :func:`shipped_scenes`, :class:`Scene`,
 :class:`SceneError`. Solving: :func:`solve` (mesh, assemble, solve; Algorithms 3.38/3.41
-or the active-set method), :class:`Solution`. Adaptivity (Chapter 4): :func:`estimate`
+or the active-set method; ``order=k`` for PEERS of order k, ``multipliers=`` for the family
+of the boundary multipliers), :class:`Solution`. Adaptivity (Chapter 4): :func:`estimate`
 (the indicators of eq. 4.50), :func:`mark`, :func:`adapt` (SOLVE, ESTIMATE, MARK,
 REFINE). Post-processing: :func:`fields`, :func:`norms`, :func:`contact_traces`,
 :func:`force_balance`, :func:`result_record`. Plotting (each returns a matplotlib figure):
