@@ -191,8 +191,7 @@ def _adaptive_settings(args) -> dict:
     number_flag(args.steps, "--steps", 1, 100, integer=True)
     number_flag(args.theta, "--theta", 0, 1)
     scene = load_scene(args.scene, args.overrides)
-    budget.check(scene.geometry, level, "--level", args.allow_large,
-                 method=scene.solver.method)
+    budget.check_scene(scene, level, "--level", args.allow_large)
     return {"scene": args.scene, "overrides": args.overrides, "level": level,
             "steps": args.steps, "theta": args.theta, "allow_large": args.allow_large}
 
