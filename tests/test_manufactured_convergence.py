@@ -100,14 +100,20 @@ def manufactured(nu, rigid=False):
          poly_add(poly_scale(poly_dx(psi), -1), poly_scale(w[1], 1 / lam))]
     if rigid:
         u = [poly_add(u[i], RIGID[i]) for i in range(2)]
+    grad, sigma, div_sigma = elasticity_fields(u, lam, mu)
+    eta = poly_scale(poly_add(grad[0][1], poly_scale(grad[1][0], -1)), 0.5)
+    return u, sigma, div_sigma, eta
+
+
+def elasticity_fields(u, lam, mu):
+    """grad u, sigma = 2 mu eps(u) + lam div(u) I and div sigma of a polynomial u."""
     grad = [[poly_dx(u[i]), poly_dy(u[i])] for i in range(2)]
     div_u = poly_add(grad[0][0], grad[1][1])
     sigma = [[poly_add(poly_scale(poly_add(grad[i][j], grad[j][i]), mu),
                        poly_scale(div_u, lam) if i == j else {}) for j in range(2)]
              for i in range(2)]
     div_sigma = [poly_add(poly_dx(sigma[i][0]), poly_dy(sigma[i][1])) for i in range(2)]
-    eta = poly_scale(poly_add(grad[0][1], poly_scale(grad[1][0], -1)), 0.5)
-    return u, sigma, div_sigma, eta
+    return grad, sigma, div_sigma
 
 
 def scene(nu, rigid=False):
