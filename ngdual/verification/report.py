@@ -4,9 +4,9 @@ Manufactured solutions (:mod:`ngdual.verification.manufactured`) and the analyti
 benchmarks (:mod:`ngdual.verification.contact_benchmarks`) under uniform refinement; the
 full run adds the adaptive runs and the finite-box study. Per order k = 0, 1, 2 of PEERS_k
 (:mod:`ngdual.verification.order`): the manufactured elasticity problem on the unit square
-and the manufactured frictionless contact problem, with the observed orders of sigma, u and
-the rotation and a check of sigma's against k + 1 (within 0.15 on the last two levels).
-``--quick`` runs two levels of each (three for the orders; under a minute and a half),
+and the manufactured frictionless contact problem, with the observed orders of sigma, u, the
+rotation and the contact pressure and a check of sigma's against k + 1 (within 0.15 on the
+last two levels). ``--quick`` runs two levels of each (three for the orders; under a minute),
 ``--orders K [K ...]`` only the tables of those orders, ``--json PATH`` writes every row
 (atomically).
 
@@ -150,7 +150,7 @@ def run(args: argparse.Namespace) -> int:
     """Compute, print and (with ``--json``) write the verification tables; returns 0, or 1
     when an observed order of sigma misses k + 1 (``--orders``: only those orders)."""
     only = args.orders is not None
-    rows = verification_rows(quick=args.quick, orders=tuple(args.orders) if only else ORDERS,
+    rows = verification_rows(quick=args.quick, orders=sorted(set(args.orders)) if only else ORDERS,
                              only_orders=only)
     print(format_report(rows))
     if args.json:
