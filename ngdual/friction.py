@@ -190,7 +190,8 @@ class FacetFrictionForms(FrictionForms):
     The friction law acts on the Bernstein coefficients (:class:`MomentFriction`); per fine
     edge e it implies |int_e sigma_t ds| <= sum_{i in e} F_i, which is what the fine-edge
     bound ``edge_bound(F)`` = sum_{i in e} F_i / |e| states in the terms of the thesis'
-    F per fine edge (the physics checks read it through :meth:`q_matrix`).
+    F per fine edge (the physics checks read it through :meth:`q_matrix`), and
+    ``edge_nu`` the nu of every fine edge that goes with it (the stick / slip diagnostics).
     """
 
     @property
@@ -201,11 +202,22 @@ class FacetFrictionForms(FrictionForms):
     def hat_lengths(self) -> np.ndarray:
         return self.lengths
 
-    def edge_bound(self, coefficients: np.ndarray) -> np.ndarray:
-        """sum_{i in e} F_i / |e| on every fine edge e from F_i of the Bernstein coefficients
-        (the means of the B_i on their edge are all 1 / (k + 1))."""
+    def edge_sums(self, coefficients: np.ndarray) -> np.ndarray:
+        """sum_{i in e} c_i on every fine edge e (the means of the B_i on their edge are all
+        1 / (k + 1))."""
         per_edge = self.midpoint_hats.shape[1] / self.midpoint_hats.shape[0]
-        return per_edge * (self.midpoint_hats @ coefficients) / self.lengths
+        return per_edge * (self.midpoint_hats @ coefficients)
+
+    def edge_bound(self, coefficients: np.ndarray) -> np.ndarray:
+        """sum_{i in e} F_i / |e| on every fine edge e from F_i of the Bernstein coefficients."""
+        return self.edge_sums(coefficients) / self.lengths
+
+    def edge_nu(self, t_t: np.ndarray, bound: np.ndarray) -> np.ndarray:
+        """nu on every fine edge: sum_{i in e} t_t,i / sum_{i in e} F_i (zero where the edge
+        has no bound), in [-1, 1] by the law on the coefficients; +-1 where every coefficient
+        of the edge slips the same way."""
+        t, F = self.edge_sums(t_t), self.edge_sums(bound)
+        return np.divide(t, F, out=np.zeros_like(t), where=F > 0)
 
 
 @dataclass(frozen=True)

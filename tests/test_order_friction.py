@@ -7,10 +7,14 @@ semismooth Newton method; Coulomb as its fixed point of Tresca QPs), and the phy
 of :mod:`ngdual.checks` (friction bound, force balance, tension).
 """
 
+import json
+
 import numpy as np
 import pytest
 
+from ngdual.cli import main
 from ngdual.forms import assemble
+from ngdual.friction import tresca_moments
 from ngdual.mesh import build_mesh
 from ngdual.scene import load_scene
 from ngdual.solvers import conforming, solve_problem
@@ -43,8 +47,12 @@ def test_friction_at_order_k_is_the_solution_of_the_qp(name, order):
         assert _relative(solution.x[part], qp.x[part]) < QP_AGREEMENT
     assert solution.residuals["friction_bound"] < 1e-12
     assert solution.residuals["slip"] < 1e-12
-    slipping = np.abs(np.abs(solution.nu) - 1.0) < 1e-9
-    assert slipping.any() and (~slipping).any()
+    t_n = (problem.K @ solution.x - problem.rhs)[problem.lam_n]
+    t_t = (problem.K @ solution.x - problem.rhs)[problem.index("lam_t")]
+    F = tresca_moments(problem) if "tresca" in name else 0.5 * np.maximum(-t_n, 0.0)
+    slipping = np.abs(np.abs(t_t) - F) <= 1e-9 * np.max(F)
+    sticking = (F > 0) & ~slipping
+    assert slipping.any() and sticking.any()
 
 
 @pytest.mark.parametrize("order", [1, 2])
@@ -81,3 +89,17 @@ def test_hertz_condenses_onto_a_few_coefficients_around_the_contact_zone():
     assert touching <= solution.iterations["condensed"] <= 2 * touching
     assert solution.iterations["solves"] == solution.iterations["condensed"] + 2
     assert solution.iterations["condensed"] < len(problem.lam_n) / 4
+
+
+@pytest.mark.slow
+def test_the_command_line_reports_stick_slip_and_the_coulomb_ratio_at_order_1(tmp_path):
+    """``ngdual solve`` with Coulomb friction at k = 1: the per-edge nu of the diagnostics,
+    stick and slip, and |t_t| / |t_n| at most mu_f = 0.5 on every coefficient."""
+    assert main(["solve", "thesis-3.46-coulomb", "--level", "1", "--set",
+                 "discretisation.order=1", "--set", "contact.ends='consistent'",
+                 "--out", str(tmp_path)]) == 0
+    record = json.loads((tmp_path / "result.json").read_text())
+    contact = record["contact"]
+    assert contact["stick_nodes"] > 0 and contact["slip_nodes"] > 0
+    assert contact["max_traction_ratio"] == pytest.approx(0.5, rel=1e-9)
+    assert record["warnings"] == []

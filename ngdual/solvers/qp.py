@@ -134,7 +134,8 @@ def solve_qp_friction(problem: DiscreteProblem, model: Model, tol: float = 1e-10
     no metric, no factorisation shared with :mod:`ngdual.solvers.nested`). With the facet
     multipliers of order k the law acts on the Bernstein moments
     (:class:`ngdual.friction.MomentFriction`: Q_F = diag(F_i), F_i = int F B_i ds or
-    mu_f (-t_n,i)); ``friction_bound`` is then its bound per fine edge.
+    mu_f (-t_n,i)); ``friction_bound`` and ``nu`` are then reported per fine edge
+    (:class:`ngdual.friction.FacetFrictionForms`).
 
     Raises
     ------
@@ -174,6 +175,8 @@ def solve_qp_friction(problem: DiscreteProblem, model: Model, tol: float = 1e-10
         else:
             raise ConvergenceError(f"the fixed point on F did not converge in {max_iter} QPs",
                                    history)
+    if facet:  # per fine edge, as the active-set method reports them
+        sol.nu = forms.edge_nu((problem.K @ sol.x - problem.rhs)[problem.index("lam_t")], bound)
     sol.friction_bound = forms.edge_bound(bound) if facet else bound
     sol.friction_forms = forms
     sol.method, sol.history = f"qp-{law}", history
