@@ -40,11 +40,16 @@ import scipy.sparse as sp
 from ngsolve.meshes import MakeStructured2DMesh
 
 from .. import peers
+from ..expr import Expression
 from ..forms import peers_form
+from ..quantities import fields
 from ..rates import observed_rates
+from ..solvers import solve_scene
 from ..solvers.linear import Factorization
 from ..sparse import to_scipy
 from .infsup import gram_matrix, smallest_singular_values
+from .manufactured import manufactured_case
+from .manufactured_errors import discrete_sets, symmetric_difference, volume_errors
 
 E, NU = 1.0, 0.3
 LAME = (E * NU / ((1 + NU) * (1 - 2 * NU)), E / (2 * (1 + NU)))    # plane strain (lambda, mu)
@@ -287,8 +292,6 @@ def contact_set(solution) -> list[tuple[float, float]]:
     fine edges all of whose Bernstein coefficients of lambda_n vanish (to 1e-9 of the
     largest): there the P_k function lambda_n^h is zero.
     """
-    from .manufactured_errors import discrete_sets
-
     problem = solution.problem
     disc = problem.scene.discretisation
     if disc.family == "coarse":
@@ -305,9 +308,6 @@ def pressure_error(case, solution) -> float:
     Gamma_C (n . sigma_h n, the normal traces of the stress rows: P_k on every fine edge)
     against the exact one of a manufactured ``case``, integrated exactly (Gamma_C's breaks
     x = +-2 are mesh vertices)."""
-    from ..expr import Expression
-    from ..quantities import fields
-
     mesh = solution.problem.fes.mesh
     exact = case.exact.sigma_n
     n = ngs.specialcf.normal(2)
@@ -332,10 +332,6 @@ def contact_study(order: int = 0, levels=(1, 2, 3)) -> list[dict]:
         order, and ``contact_set``: the length of the symmetric difference between
         :func:`contact_set` and the exact contact set [-2, 2].
     """
-    from ..solvers import solve_scene
-    from .manufactured import manufactured_case
-    from .manufactured_errors import symmetric_difference, volume_errors
-
     case = manufactured_case("frictionless")
     scene = case.scene(order=order)
     rows = []
