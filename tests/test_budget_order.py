@@ -12,6 +12,7 @@ import pytest
 import ngdual as nd
 from ngdual import budget, peers
 from ngdual.cli import main
+from ngdual.forms import assemble
 from ngdual.mesh import build_mesh
 from ngdual.scene import Geometry, SceneError
 
@@ -38,6 +39,14 @@ def test_the_fine_edges_of_gamma_c_are_those_of_the_assembled_problem(order):
     problem = nd.solve(scene, 2).problem
     edges = budget.contact_edges(scene.geometry, scene.labels("contact"), 2)
     assert len(problem.lam_n) == (order + 1) * edges
+
+
+def test_the_fine_edges_of_an_arc_of_gamma_c_are_counted_from_its_mesh_size():
+    """hertz-cylinder (Gamma_C an arc, netgen, side_maxh): 32.9 estimated, 32 meshed."""
+    scene = nd.load_scene("hertz-cylinder", ["discretisation.order=1"])
+    problem = assemble(scene, build_mesh(scene.geometry, 1))
+    edges = budget.contact_edges(scene.geometry, scene.labels("contact"), 1)
+    assert edges == pytest.approx(len(problem.lam_n) / 2, rel=0.05)
 
 
 def test_a_level_that_fits_at_order_0_is_refused_at_order_2_naming_the_level(monkeypatch):
