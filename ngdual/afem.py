@@ -203,7 +203,7 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
         if last:
             break
         # REFINE
-        _check_refinement_size(scene, mesh, marked, allow_large)
+        _check_refinement_size(scene, solution, marked, allow_large)
         with _timed(record, "refine"):
             mesh, coarse = refine_with_boundary(scene, mesh, coarse, marked)
             warm = _warm_start(solution)
@@ -307,12 +307,16 @@ def _check_adapt_arguments(scene, marking, theta, steps, level, asymmetry, refer
         raise SceneTypeError("allow_large", f"must be True or False, got {allow_large!r}")
 
 
-def _check_refinement_size(scene: Scene, mesh: ngs.Mesh, marked: np.ndarray,
+def _check_refinement_size(scene: Scene, solution: Solution, marked: np.ndarray,
                            allow_large: bool) -> None:
-    """Refuse a refinement whose mesh would not fit in memory (bisection of the marked
-    triangles and their closure: at most about 4 new triangles per marked one)."""
-    elements = mesh.ne + 4.0 * int(np.sum(marked))
-    need = budget.solve_memory(elements, scene.solver.method)
+    """Refuse a refinement of the solution's mesh whose solve would not fit in memory at the
+    scene's order k (bisection of the marked triangles and their closure: at most about 4
+    new triangles per marked one, and each edge of Gamma_C bisected at most once)."""
+    elements = solution.problem.fes.mesh.ne + 4.0 * int(np.sum(marked))
+    gamma_c = solution.problem.spaces.gamma_c
+    disc = scene.discretisation
+    need = budget.solve_memory(elements, scene.solver.method, disc.order, disc.family,
+                               2.0 * len(gamma_c) if gamma_c is not None else 0.0)
     have = budget.available_memory()
     if need > have and not allow_large:
         raise SceneError("steps", f"the next refinement would have about {elements:.3g} "

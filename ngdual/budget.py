@@ -126,19 +126,23 @@ def estimate(geo: Geometry, level: int | None = None, method: str = "auto", orde
                 elements += 4.0 * lengths[label] / h * max(1.0, math.log2(geo.maxh / h))
         elements *= refinements
     unknowns = unknowns_per_element(order) * elements
-    if multipliers == "facet":
-        dense = 16.0 * unknowns * (order + 1) * contact_edges(geo, contact, level)
-        memory = BASE_BYTES + BYTES_PER_UNKNOWN_CONFORMING[order] * unknowns + dense
-    else:
-        memory = solve_memory(elements, method)
+    edges = contact_edges(geo, contact, level) if multipliers == "facet" else 0.0
+    memory = solve_memory(elements, method, order, multipliers, edges)
     mesh_memory = BASE_BYTES + BYTES_PER_ELEMENT_MESH * elements * (
         unknowns_per_element(order) / UNKNOWNS_PER_ELEMENT)
     return Estimate(elements, unknowns, memory, mesh_memory)
 
 
-def solve_memory(elements: float, method: str = "auto") -> float:
-    """Predicted peak bytes of a solve of PEERS_0 with the coarse multipliers and ``method``
-    on a mesh of ``elements`` triangles."""
+def solve_memory(elements: float, method: str = "auto", order: int = 0,
+                 multipliers: str = "coarse", contact_edges: float = 0.0) -> float:
+    """Predicted peak bytes of a solve with ``method`` of PEERS_``order`` with the multiplier
+    family ``multipliers`` on a mesh of ``elements`` triangles, ``contact_edges`` of whose
+    edges lie on Gamma_C (the facet family's condensation holds dense arrays of the
+    unknowns times the contact coefficients)."""
+    if multipliers == "facet":
+        unknowns = unknowns_per_element(order) * elements
+        dense = 16.0 * unknowns * (order + 1) * contact_edges
+        return BASE_BYTES + BYTES_PER_UNKNOWN_CONFORMING[order] * unknowns + dense
     per_unknown = BYTES_PER_UNKNOWN.get(method, max(BYTES_PER_UNKNOWN.values()))
     return BASE_BYTES + per_unknown * UNKNOWNS_PER_ELEMENT * elements
 

@@ -15,9 +15,10 @@ import math
 import numpy as np
 import pytest
 
+from ngdual import budget
 from ngdual.afem import adapt
 from ngdual.cli import main
-from ngdual.scene import load_scene
+from ngdual.scene import SceneError, load_scene
 
 
 def order_of(history: list[dict]) -> float:
@@ -47,6 +48,20 @@ def test_ngdual_adapt_takes_the_order_on_the_command_line(tmp_path):
     steps = json.loads((tmp_path / "history.json").read_text())["history"]
     assert [s["step"] for s in steps] == [0, 1]
     assert steps[0]["dofs"]["M"] == 2 * 3 * steps[0]["elements"]
+
+
+def test_a_refinement_is_refused_by_the_memory_its_order_needs(monkeypatch):
+    """Refining all 32 triangles of Example 3.46's level 1 gives about 160: PEERS_0 would
+    need 384 MB, PEERS_2 with the facet multipliers 483 MB; with 450 MB available the
+    loop at order 2 refuses the refinement, naming ``steps``."""
+    scene = load_scene("thesis-3.46-frictionless",
+                       ["discretisation.order=2", "contact.ends=consistent"])
+    have = 450 * 2**20
+    assert budget.solve_memory(160) < have < budget.solve_memory(160, "auto", 2, "facet", 16)
+    monkeypatch.setattr(budget, "available_memory", lambda: have)
+    with pytest.raises(SceneError) as err:
+        adapt(scene, marking="max", theta=0.0, steps=2, level=1)
+    assert err.value.field == "steps"
 
 
 @pytest.mark.slow
