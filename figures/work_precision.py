@@ -20,11 +20,13 @@ steps pay for the same mesh: ngdual.afem.THETA_TOL).
 References: no analytic solution is exact for these finite bodies (the Hertz, Sadowsky and
 Cattaneo-Mindlin pressures are half-space formulas), and a uniform overkill two levels
 beyond the budget would not fit. Each adaptive run's last step is the reference of its
-goal's measure (ngdual.studies.figures.truth): the pressure error of every solution is
-taken against the pressure-goal run's last step, the sigma error against the stress-goal
-run's. A reference's own error is Richardson-estimated from the two steps before it
-(nested meshes, exact distances); a target is resolved when that error is at most a third
-of it (the JSON's ``resolves``). Candidates whose meshes are not nested in the reference's
+goal's measure (ngdual.studies.figures.truth): per measure the run's last step with the
+smaller own error. A reference's own error is Richardson-estimated from the two steps
+before it (nested meshes, exact distances); where the steps give no converging sequence,
+by the three-cornered hat: the pairwise distances of the two runs' last steps and the
+finest uniform level, three mesh families whose errors are taken as orthogonal (the JSON's
+``estimate`` says which). A target is resolved when that error is at most a third of it
+(the JSON's ``resolves``). Candidates whose meshes are not nested in the reference's
 (uniform, the peers, the other goal's steps) carry a quadrature error; it is measured by
 integrating again on the reference's triangles split in four (``quadrature``).
 
@@ -153,7 +155,7 @@ def budgets(rows: list[dict], references: dict) -> list[dict]:
                     "stopped_by": ("1 % on both measures" if None not in first.values()
                                    else "budget"),
                     **{f"reference_{m}_{k}": ref[m][k] for m in MEASURES
-                       for k in ("method", "ndof", "overkill_error")},
+                       for k in ("method", "ndof", "overkill_error", "estimate")},
                     "analytic_pressure_difference": (ref["pressure"]["analytic"] or {}).get(
                         "relative_l2"),
                     "quadrature_max": max((q["relative_change"]
@@ -203,7 +205,7 @@ def _panels(rows: list[dict], references: dict) -> list[dict]:
                              + ("time" if xkey == "time_s" else "unknowns"),
                     "xlabel": xlabel, "ylabel": ylabel, "loglog": True, "curves": curves,
                     "hlines": [(t, None, {"color": "0.7", "lw": 0.6}) for t in TARGETS]
-                    + ([(floor, "reference's own error (Richardson)",
+                    + ([(floor, "reference's own error",
                          {"color": "k", "ls": "-.", "lw": 0.8})] if floor else [])})
     return panels
 
@@ -233,8 +235,8 @@ def _numbers(verdict: list[dict], effectivity: list[dict], budget: list[dict]) -
             f"{b['stopped_by']} (level {b['uniform_budget_level']}, "
             f"{b['uniform_budget_ndof']} unknowns)")
         for m in MEASURES:
-            numbers[f"{b['problem']}: reference of {m}, own error (Richardson)"] = \
-                b[f"reference_{m}_overkill_error"]
+            numbers[f"{b['problem']}: reference of {m}, own error"] = (
+                f"{b[f'reference_{m}_overkill_error']} ({b[f'reference_{m}_estimate']})")
         numbers[f"{b['problem']}: quadrature error of non-nested sigma errors"] = \
             b["quadrature_max"]
         if b["analytic_pressure_difference"] is not None:

@@ -28,6 +28,7 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from ngdual.afem import adapt
@@ -175,7 +176,8 @@ def test_work_precision_measures_true_errors_against_references_it_checks(coarse
     """Every solution of the six problems carries a finite true error against the adaptive
     references (a reference none in its own measure), uniform, both adaptive goals and the
     primal P1 / P2 peer are there, the uniform stress error falls from level to level, a
-    reference resolves only targets at least three times its own (Richardson) error, the
+    reference resolves only targets at least three times its own (Richardson, or the
+    three-cornered hat where Richardson has none) error, the
     quadrature of non-nested candidates changes their errors by under 5 %, and the pressure
     goal's effectivity is recorded on Hertz, the flat punch and Cattaneo-Mindlin for every
     adaptive step whose error the reference resolves."""
@@ -204,6 +206,8 @@ def test_work_precision_measures_true_errors_against_references_it_checks(coarse
             ref = result["references"][problem][measure]
             for target in ref["resolves"]:
                 assert ref["overkill_error"] <= target / 3
+            if ref["estimate"] == "three-cornered hat":
+                assert ref["overkill_error"] == ref["hat"]
         for q in result["references"][problem]["sigma_energy"]["quadrature"]:
             assert q["relative_change"] < 0.05, (problem, q)
     for problem in ("hertz-cylinder", "flat-punch", "cattaneo-mindlin"):
@@ -326,6 +330,23 @@ def test_error_helpers():
           "c": {"status": "failed"}}
     assert best(ok) == "a"
     assert "| 1 | - |" in markdown_table([{"a": 1}], {"a": "A", "b": "B"})
+
+
+def test_the_three_cornered_hat_recovers_three_orthogonal_errors_and_refuses_others():
+    """Three solutions of one truth whose errors live on disjoint parts (orthogonal): the
+    pairwise distances give each error exactly; distances no orthogonal errors can have
+    (one longer than the other two together in squares) give no estimate."""
+    from ngdual.studies.figures.truth import three_cornered_hat
+
+    truth = np.sin(np.linspace(0, 3, 30))
+    errors = [np.zeros(30) for _ in range(3)]
+    for k, size in enumerate((0.01, 0.002, 0.03)):
+        errors[k][10 * k:10 * k + 10] = size * np.cos(np.arange(10))
+    a, b, c = (truth + e for e in errors)
+    d = np.linalg.norm
+    assert three_cornered_hat(d(a - b), d(a - c), d(b - c)) == pytest.approx(d(errors[0]))
+    assert three_cornered_hat(d(b - c), d(b - a), d(a - c)) == pytest.approx(d(errors[1]))
+    assert three_cornered_hat(1.0, 1.0, 2.0) is None
 
 
 def test_a_solve_record_and_an_adaptive_step_hold_the_estimate_under_the_same_keys():
