@@ -249,9 +249,12 @@ class BrokenPeers:
 
 
 def broken_peers(spaces: Spaces, lame: tuple[float, float]) -> BrokenPeers:
-    """Assemble the PEERS block of (3.62) with broken Raviart-Thomas rows (:class:`BrokenPeers`)."""
-    mesh = spaces.mesh
-    broken_rt = ngs.HDiv(mesh, order=0, discontinuous=True)
+    """Assemble the PEERS block of (3.62) of order ``spaces.order`` with broken
+    Raviart-Thomas rows (:class:`BrokenPeers`): ``HDiv(order=k, RT=True, discontinuous=True)``,
+    every triangle with its own RT_k functions."""
+    mesh, order = spaces.mesh, spaces.order
+    broken_rt = ngs.HDiv(mesh, order=0, discontinuous=True) if order == 0 else ngs.HDiv(
+        mesh, order=order, RT=True, discontinuous=True)
     comps = {name: broken_rt if name in ("r1", "r2") else spaces.components[name]
              for name in peers.PEERS}
     fes = ngs.FESpace(list(comps.values()))
@@ -260,7 +263,8 @@ def broken_peers(spaces: Spaces, lame: tuple[float, float]) -> BrokenPeers:
                     dict(zip(peers.PEERS, fes.TestFunction())), lame)
     with parallel_tasks(mesh):
         a.Assemble()
-    edge = _edge_of_broken(spaces.components["r1"], broken_rt)
+    edge = _edge_of_broken(spaces.components["r1"], broken_rt) if order == 0 else \
+        _restricted_dofs(spaces.components["r1"], broken_rt)
     conforming, offset = [], 0
     for name in peers.PEERS:
         own = edge if name in ("r1", "r2") else np.arange(comps[name].ndof)
@@ -281,6 +285,22 @@ def conforming_peers(spaces: Spaces, lame: tuple[float, float], size: int) -> sp
         a.Assemble()
     K = to_scipy(a.mat).tocoo()
     return sp.csr_matrix((K.data, (K.row, K.col)), shape=(size, size))
+
+
+def _restricted_dofs(rt: ngs.FESpace, broken_rt: ngs.FESpace) -> np.ndarray:
+    """The RT_k function (of ``rt``) whose restriction to its triangle every broken one is.
+
+    A discontinuous NGSolve space has the element's own shape functions, in the element's
+    order, with the orientation of the global edges: the broken dofs of a triangle restrict
+    its conforming dofs position by position.
+    """
+    edge = np.full(broken_rt.ndof, -1, dtype=np.int64)
+    for el in rt.mesh.Elements(ngs.VOL):
+        edge[list(broken_rt.GetDofNrs(el))] = rt.GetDofNrs(el)
+    if np.any(edge < 0):
+        raise RuntimeError("NGSolve's broken Raviart-Thomas functions are not restrictions "
+                           "of the continuous ones")
+    return edge
 
 
 def _edge_of_broken(rt: ngs.FESpace, broken_rt: ngs.FESpace, tol: float = 1e-8) -> np.ndarray:
