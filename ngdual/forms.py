@@ -260,7 +260,7 @@ def broken_peers(spaces: Spaces, lame: tuple[float, float]) -> BrokenPeers:
     fes = ngs.FESpace(list(comps.values()))
     a = ngs.BilinearForm(fes)
     a += peers_form(dict(zip(peers.PEERS, fes.TrialFunction())),
-                    dict(zip(peers.PEERS, fes.TestFunction())), lame)
+                    dict(zip(peers.PEERS, fes.TestFunction())), lame, order)
     with parallel_tasks(mesh):
         a.Assemble()
     edge = _edge_of_broken(spaces.components["r1"], broken_rt) if order == 0 else \
