@@ -134,8 +134,6 @@ def goal_estimate(solution: Solution, estimated: Estimate,
     htilde = gamma_c.coarse.edge_lengths()[gamma_c.htilde_edge]
     inside = _in_window(gamma_c.midpoints[:, 0], window)
 
-    # sigma_n^h per fine edge (its mean at order k), from the solver's fine-edge operators
-    sigma_n = friction_forms_of(solution).T_n @ solution.x
     edges = BoundaryEdges(mesh, spaces.order)
     on_gamma_c = [edges.dof_of_edge[frozenset(map(int, p))] for p in gamma_c.vertices]
     element = edges.element[on_gamma_c]
@@ -144,6 +142,8 @@ def goal_estimate(solution: Solution, estimated: Estimate,
         # the facet multipliers of order k are the traces of RT_k: p_h = -sigma_n^h
         p_mean, residual, p_squared = _trace_pressure(solution, edges, on_gamma_c)
     else:
+        # sigma_n^h per fine edge (constant for RT_0, order 0), from the fine-edge operators
+        sigma_n = friction_forms_of(solution).T_n @ solution.x
         # p_h = -(hat projection of sigma_n^h), as means over the fine edges
         p_mean = np.zeros(len(length))
         for hats in (spaces.prolongations["lam_n"], spaces.end_hats["lam_n"]):
