@@ -27,10 +27,10 @@ squared, per element T, are::
                             :func:`_moment_friction_term`)
         ``neumann``         log(1 + C~_N) sum_{e in E^T on Gamma_N} h~_e ||sigma_h n - t0||_e^2
 
-u_Gamma is the value of the piecewise constant u_h of the element at the edge
-(4.29). The thesis has u_D = 0; the ``du_D/dt`` and ``- u_D`` parts are the
-same terms for non-homogeneous Dirichlet data (w_h t approximates du/dt, and
-u = u_D on Gamma_D). h_T = diam T and h_e = length(e) stand for the equivalent
+u_Gamma is the trace on the edge of the element's u_h (4.29): its constant value at
+k = 0, a polynomial of degree k at order k. The thesis has u_D = 0; the ``du_D/dt`` and
+``- u_D`` parts are the same terms for non-homogeneous Dirichlet data (w_h t approximates
+du/dt, and u = u_D on Gamma_D). h_T = diam T and h_e = length(e) stand for the equivalent
 patch diameters of (3.60); h~_e is the length of the coarse (h~) edge holding e.
 
 Every term is an NGSolve integral: element integrals, element-boundary
@@ -48,8 +48,8 @@ equilibrium interpolant E_h onto RT_k, and at k >= 1 int grad_h u_h : (E_h r - r
 (integrate by parts on every triangle: div(E_h r - r) is orthogonal to P_k and so are the
 normal moments on every edge), so ``u_volume`` is h_T^2 ||w_h - grad_h u_h||^2, the
 element residual of C^{-1} sigma + eta = grad u; the thesis' h_T^2 ||w_h||^2 at k = 0.
-With h_T^2 ||w_h||^2 the term would stay O(h) at every order (it is the largest term of
-the manufactured contact case at k = 2, docs/theory/estimator.md).
+With h_T^2 ||w_h||^2 the term would stay O(h) at every order (it would be the largest term
+of the manufactured contact case at k = 2, docs/theory/estimator.md).
 """
 
 from __future__ import annotations
