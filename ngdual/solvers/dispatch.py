@@ -15,8 +15,9 @@ Cholesky factorisation, and for contact the semismooth Newton method on Gamma_C
 (:mod:`ngdual.solvers.active_set`): the same discrete solution at about the cost of one linear
 solve. The hybridisation is that of broken RT_0 rows and the P1 multipliers on h~; at order
 k >= 1 or with the facet multipliers (``discretisation``) the problem has no such system
-(``problem.broken`` is None) and the semismooth Newton method runs on the conforming K
-condensed onto lambda_n: one sparse LU and N_C substitutions (:mod:`ngdual.solvers.conforming`).
+(``problem.broken`` is None) and the system is hybridised with broken RT_k rows and the facet
+multipliers themselves (:mod:`ngdual.solvers.hybrid_order`); :mod:`ngdual.solvers.conforming`
+solves the same problem on the conforming K, the independent check of the tests.
 """
 
 from __future__ import annotations
@@ -37,7 +38,7 @@ from ..quadrature_check import check_formulas
 from ..scene import Scene, SceneError, SceneTypeError, check_level, ensure_valid, validate
 from ..scene.values import show
 from .active_set import ContactStart, active_set_solve
-from .conforming import conforming_active_set
+from .hybrid_order import hybrid_active_set
 from .linear import solve_linear
 from .nested import nested_uzawa
 from .result import ConvergenceError, PhysicsWarning, Solution
@@ -221,7 +222,7 @@ def solve_problem(problem: DiscreteProblem, settings: Settings | None = None,
         raise ValueError(f"a warm start is for the active-set method, not "
                          f"{type(settings).__name__}")
     if isinstance(settings, ActiveSetSettings) and problem.broken is None:
-        solution = conforming_active_set(problem, settings, start=start)
+        solution = hybrid_active_set(problem, settings, start=start)
     elif isinstance(settings, ActiveSetSettings):
         solution = active_set_solve(problem, settings, progress=progress, start=start)
     elif isinstance(settings, LinearSettings):

@@ -55,7 +55,7 @@ from ..sparse import to_scipy
 from ..tolerances import BLAS_THREADS, COULOMB_FIXED_POINT_TOL
 from .active_set import ContactStart
 from .cholesky import SchurCholesky
-from .conforming import TOLERANCE, Condensed
+from .conforming import TOLERANCE, Condensed, conforming_active_set
 from .conforming import _moments as moments
 from .conforming import _residuals as conforming_residuals
 from .conforming import _solve_condensed as solve_condensed
@@ -269,7 +269,12 @@ def hybrid_active_set(problem: DiscreteProblem, settings: ActiveSetSettings,
     begin = time.perf_counter()
     first = start.at(problem.spaces.contact.node_points()) if start is not None else None
     hybrid = OrderHybridSystem(problem, friction=law != "none")
-    chol = SchurCholesky(hybrid.H, hybrid.contact_index, ordering)
+    try:
+        chol = SchurCholesky(hybrid.H, hybrid.contact_index, ordering)
+    except ArithmeticError:
+        # H is singular where K is (a body held by Gamma_C alone has rigid motions when
+        # nothing touches): the conforming solver eliminates every multiplier instead
+        return conforming_active_set(problem, settings, start, tol)
     y = chol.forward(hybrid.rhs(problem.rhs))
     n_c = len(problem.lam_n)
     G, b = chol.schur, chol.reduced_rhs(y)

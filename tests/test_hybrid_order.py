@@ -1,0 +1,95 @@
+"""The hybridised solver at order k (issue 27): the same discrete solution as the conforming one.
+
+Truth: :func:`ngdual.solvers.conforming.conforming_active_set`, which solves (3.62) on the
+assembled conforming K with one sparse LU and shares neither the broken spaces, the edge
+multipliers, the static condensation nor the Cholesky factorisation with
+:func:`ngdual.solvers.hybrid_order.hybrid_active_set`. Fast: Example 3.46 (consistent ends)
+at k = 0 (facet), 1, 2 without friction and with Tresca and Coulomb friction, Hertz at k = 1;
+slow: Hertz at k = 2 and level 2 of Example 3.46 with Coulomb friction at k = 2.
+"""
+
+import numpy as np
+import pytest
+
+from ngdual.forms import assemble, broken_peers, conforming_peers
+from ngdual.mesh import build_mesh
+from ngdual.scene import load_scene
+from ngdual.solvers import solve_scene
+from ngdual.solvers.conforming import conforming_active_set
+from ngdual.solvers.hybrid_order import OrderHybridSystem, hybrid_active_set
+from ngdual.solvers.settings import solver_settings
+from ngdual.verification.manufactured import manufactured_case
+
+ROUND_OFF = 1e-10  # relative difference of the two solvers' unknowns (measured: 3e-14-2e-11)
+
+
+def _problem(name: str, order: int, level: int):
+    overrides = [f"discretisation.order={order}", "discretisation.multipliers='facet'"]
+    if name.startswith("thesis-3.46"):
+        overrides.append("contact.ends='consistent'")
+    scene = load_scene(name, overrides)
+    return assemble(scene, build_mesh(scene.geometry, level)), solver_settings(scene)
+
+
+def _assert_same_solution(name: str, order: int, level: int) -> None:
+    _assert_same(*_problem(name, order, level))
+
+
+def _assert_same(problem, settings) -> None:
+    hybrid = hybrid_active_set(problem, settings)
+    conforming = conforming_active_set(problem, settings)
+    assert np.max(np.abs(hybrid.x - conforming.x)) <= ROUND_OFF * np.max(np.abs(conforming.x))
+    assert max(hybrid.residuals.values()) < 1e-11
+    if settings.model.law != "none":
+        assert np.allclose(hybrid.friction_bound, conforming.friction_bound, rtol=0,
+                           atol=ROUND_OFF * np.max(conforming.friction_bound))
+
+
+@pytest.mark.parametrize("order", [0, 1, 2])
+@pytest.mark.parametrize("name", ["thesis-3.46-frictionless", "thesis-3.46-tresca",
+                                  "thesis-3.46-coulomb"])
+def test_the_hybridised_solution_is_the_conforming_one_on_example_3_46(name, order):
+    _assert_same_solution(name, order, 1 if order == 2 else 2)
+
+
+def test_the_hybridised_solution_is_the_conforming_one_on_hertz_at_order_1():
+    _assert_same_solution("hertz-cylinder", 1, 1)
+
+
+@pytest.mark.parametrize("order", [1, 2])
+def test_the_hybridised_solution_is_the_conforming_one_on_the_manufactured_case(order):
+    scene = manufactured_case("frictionless").scene(order=order)
+    _assert_same(assemble(scene, build_mesh(scene.geometry, 2)), solver_settings(scene))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name, order, level", [("hertz-cylinder", 2, 2),
+                                                ("hertz-cylinder", 1, 3),
+                                                ("thesis-3.46-coulomb", 2, 3)])
+def test_the_hybridised_solution_is_the_conforming_one_on_finer_levels(name, order, level):
+    _assert_same_solution(name, order, level)
+
+
+@pytest.mark.parametrize("order", [1, 2])
+def test_the_broken_peers_block_sums_to_the_conforming_one_bit_for_bit(order):
+    """E^T K_b E of the broken RT_k rows is the conforming PEERS_k block (same element
+    matrices, at most two summands per entry)."""
+    problem, _ = _problem("thesis-3.46-frictionless", order, 1)
+    lame = problem.scene.material.lame
+    n = problem.K.shape[0]
+    difference = broken_peers(problem.spaces, lame).summed(n) - conforming_peers(
+        problem.spaces, lame, n)
+    assert np.max(np.abs(difference.data), initial=0.0) == 0.0
+
+
+def test_the_hybridised_matrix_is_symmetric_positive_definite():
+    problem, _ = _problem("thesis-3.46-coulomb", 1, 1)
+    H = OrderHybridSystem(problem, friction=True).H.toarray()
+    assert np.array_equal(H, H.T)
+    assert np.linalg.eigvalsh(H)[0] > 0.0
+
+
+def test_the_order_k_default_solver_is_the_hybridised_one():
+    scene = load_scene("thesis-3.46-frictionless", ["discretisation.order=1",
+                                                    "contact.ends='consistent'"])
+    assert solve_scene(scene, 1).method == "active-set-hybrid"
