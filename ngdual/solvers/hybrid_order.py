@@ -46,6 +46,7 @@ import ngsolve as ngs
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
 from threadpoolctl import threadpool_limits
 
 from .. import peers
@@ -70,6 +71,8 @@ class OrderHybridSystem:
     ----------
     problem : DiscreteProblem
         An assembled problem with the facet multipliers (``spaces.family == "facet"``).
+    lame : tuple of float
+        Lame's constants (lambda, mu) of its material.
     friction : bool
         Whether lambda_t is a contact unknown (ordered last with lambda_n) or eliminated
         with the other multipliers (no friction: t_t = 0).
@@ -88,15 +91,15 @@ class OrderHybridSystem:
         (the elimination of the element-local unknowns).
     """
 
-    def __init__(self, problem: DiscreteProblem, friction: bool):
+    def __init__(self, problem: DiscreteProblem, lame: tuple[float, float], friction: bool):
         start = time.perf_counter()
         self.problem = problem
         spaces, K = problem.spaces, problem.K.tocsr()
-        self.broken = broken = broken_peers(spaces, problem.scene.material.lame)
+        self.broken = broken = broken_peers(spaces, lame)
         fes = broken.fes
         ranges = {name: fes.Range(i) for i, name in enumerate(peers.PEERS)}
         n_b, n_p = fes.ndof, len(np.bincount(broken.conforming))
-        self.local = _element_dofs(fes, ranges["eta"].start)
+        self.local = _element_dofs(broken.matrix, ranges["eta"].start)
         mu = _edge_coupling(fes.components[peers.PEERS.index("r1")], spaces.order)
         n_mu = mu.shape[1]
         contact = problem.lam_n if not friction else np.concatenate(
@@ -106,29 +109,28 @@ class OrderHybridSystem:
         # a boundary edge has one triangle: d acts on its broken functions unchanged
         Q = sp.csr_matrix((np.ones(n_p), (_first_copies(broken.conforming, n_p),
                                           np.arange(n_p))), shape=(n_b, n_p))
-        r1, r2 = ranges["r1"], ranges["r2"]
-        n_rt = r1.stop - r1.start
-        place = [sp.csr_matrix((np.ones(n_rt), (np.arange(r.start, r.stop), np.arange(n_rt))),
-                               shape=(n_b, n_rt)) for r in (r1, r2)]
-        n_m = len(multipliers)
-        A = sp.bmat([[broken.matrix, place[0] @ mu, place[1] @ mu,
-                      Q @ K[:n_p][:, multipliers]],
-                     [None, None, None, sp.csr_matrix((n_mu, n_m))],
-                     [None, None, None, sp.csr_matrix((n_mu, n_m))],
-                     [None, None, None, K[multipliers][:, multipliers]]], format="csr")
-        A = sp.triu(A) + sp.triu(A, 1).T
+        coupled = (Q @ K[:n_p][:, multipliers]).tocsr()
         self._Q = Q
         self.seconds = {"broken": time.perf_counter() - start}
 
         start = time.perf_counter()
+        eta = np.arange(ranges["eta"].start, n_b)
         L = self.local.ravel()
-        keep = np.ones(A.shape[0], dtype=bool)
-        keep[L] = False
-        self.interface = np.flatnonzero(keep)
-        A_LL = A[L][:, L]
-        self.A_LI = A[L][:, self.interface].tocsr()
-        A_II = A[self.interface][:, self.interface]
-        self.B_inv = _block_inverse(A_LL.tocsr(), self.local.shape[1])
+        n_l, n_m = len(L), len(multipliers)
+        # the global unknowns: eta, mu_1, mu_2, the other multipliers, the contact ones
+        self.interface = np.concatenate([eta, n_b + np.arange(2 * n_mu + n_m)])
+        where = np.empty(n_b, dtype=np.int64)  # the row of every broken unknown of L
+        where[L] = np.arange(n_l)
+        rows = [sp.csr_matrix((np.ones(r.stop - r.start),
+                               (where[r.start:r.stop], np.arange(r.stop - r.start))),
+                              shape=(n_l, r.stop - r.start)) @ mu
+                for r in (ranges["r1"], ranges["r2"])]
+        Kb = broken.matrix
+        self.A_LI = sp.hstack([Kb[L][:, eta], *rows, coupled[L]], format="csr")
+        A_II = sp.bmat([[Kb[eta][:, eta], None, coupled[eta]],
+                        [None, sp.csr_matrix((2 * n_mu, 2 * n_mu)), None],
+                        [coupled[eta].T, None, K[multipliers][:, multipliers]]], format="csr")
+        self.B_inv = _block_inverse(Kb[L][:, L].tocsr(), self.local.shape[1])
         extension = self.B_inv @ self.A_LI
         self.H = (self.A_LI.T @ extension - A_II).tocsr()
         self.H = 0.5 * (self.H + self.H.T)
@@ -181,20 +183,20 @@ class OrderHybridSystem:
         return x + self.unknowns(dw, R)
 
 
-def _element_dofs(fes: ngs.FESpace, n_local: int) -> np.ndarray:
+def _element_dofs(matrix: sp.csr_matrix, n_local: int) -> np.ndarray:
     """(triangles, local unknowns): the element-local unknowns (those numbered below
-    ``n_local``: the broken sigma rows, the bubbles, u) of every triangle."""
-    rows = []
-    for el in fes.mesh.Elements(ngs.VOL):
-        dofs = np.array(fes.GetDofNrs(el))
-        rows.append(dofs[(dofs >= 0) & (dofs < n_local)])
-    if len({len(row) for row in rows}) != 1:
+    ``n_local``: the broken sigma rows, the bubbles, u) of every triangle.
+
+    Read from NGSolve's sparsity pattern of the broken PEERS matrix, which holds every pair
+    of unknowns of a triangle (explicit zeros included) and couples the local unknowns of
+    different triangles nowhere: the triangles are its connected components.
+    """
+    pattern = matrix[:n_local][:, :n_local]
+    n_el, label = connected_components(pattern, directed=False)
+    order = np.argsort(label, kind="stable")
+    if np.any(np.bincount(label) != n_local // n_el) or n_local % n_el:
         raise RuntimeError("the triangles do not have the same number of local unknowns")
-    local = np.array(rows)
-    if not np.array_equal(np.sort(local.ravel()), np.arange(n_local)):
-        raise RuntimeError("the local unknowns of the triangles do not partition the broken "
-                           "PEERS unknowns")
-    return local
+    return order.reshape(n_el, -1)
 
 
 def _first_copies(conforming: np.ndarray, n_p: int) -> np.ndarray:
@@ -268,7 +270,7 @@ def hybrid_active_set(problem: DiscreteProblem, settings: ActiveSetSettings,
     law = model.law
     begin = time.perf_counter()
     first = start.at(problem.spaces.contact.node_points()) if start is not None else None
-    hybrid = OrderHybridSystem(problem, friction=law != "none")
+    hybrid = OrderHybridSystem(problem, model.lame, friction=law != "none")
     try:
         chol = SchurCholesky(hybrid.H, hybrid.contact_index, ordering)
     except ArithmeticError:
