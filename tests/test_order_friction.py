@@ -1,10 +1,13 @@
 """Friction at order k (issue 27, item 3): Tresca and Coulomb on the facet P_k multipliers.
 
 The law acts on every Bernstein coefficient, |t_t,i| <= F_i (:class:`ngdual.friction.
-MomentFriction`). Truth: the convex QP of :mod:`ngdual.solvers.qp` for the same discrete
-problem (Clarabel on the whole sparse system, nothing shared with the condensation or the
-semismooth Newton method; Coulomb as its fixed point of Tresca QPs), and the physics checks
-of :mod:`ngdual.checks` (friction bound, force balance, tension).
+MomentFriction`). Both solvers of order k are tested: the default
+(:mod:`ngdual.solvers.dispatch`) and the condensation of K onto the candidates
+(:mod:`ngdual.solvers.conforming`, the default's fallback). Truth: the convex QP of
+:mod:`ngdual.solvers.qp` for the same discrete problem (Clarabel on the whole sparse
+system, nothing shared with either condensation or the semismooth Newton method; Coulomb
+as its fixed point of Tresca QPs), and the physics checks of :mod:`ngdual.checks`
+(friction bound, force balance, tension).
 """
 
 import json
@@ -18,8 +21,8 @@ from ngdual.friction import tresca_moments
 from ngdual.mesh import build_mesh
 from ngdual.scene import load_scene
 from ngdual.solvers import conforming, solve_problem
-from ngdual.solvers.qp import solve_qp_friction
-from ngdual.solvers.settings import Model
+from ngdual.solvers.qp import solve_qp, solve_qp_friction
+from ngdual.solvers.settings import Model, solver_settings
 
 QP_AGREEMENT = 1e-8  # Clarabel's interior point, not polished with friction (measured <= 1.1e-9)
 
@@ -30,23 +33,31 @@ def _problem(name: str, order: int, level: int):
     return assemble(scene, build_mesh(scene.geometry, level))
 
 
+def _conforming(problem):
+    """The conforming solver (condensation of K onto the candidates), not the default."""
+    return conforming.conforming_active_set(problem, solver_settings(problem.scene))
+
+
 def _relative(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.max(np.abs(a - b)) / np.max(np.abs(b)))
 
 
+@pytest.mark.parametrize("solve", [solve_problem, _conforming], ids=["default", "conforming"])
 @pytest.mark.parametrize("name, order", [("thesis-3.46-tresca", 1),
                                          ("thesis-3.46-tresca", 2),
                                          ("thesis-3.46-coulomb", 1)])
-def test_friction_at_order_k_is_the_solution_of_the_qp(name, order):
+def test_friction_at_order_k_is_the_solution_of_the_qp(name, order, solve):
     """The same stresses and multipliers as the QP (and for Coulomb its fixed point), with
-    stick and slip on the coefficients and the bound held to round-off."""
+    stick and slip on the coefficients and the bound held to round-off (the default solver
+    and the conforming one)."""
     problem = _problem(name, order, 1)
-    solution = solve_problem(problem)
+    solution = solve(problem)
     qp = solve_qp_friction(problem, Model.of(problem.scene), tol=1e-9)
     for part in (problem.sigma, problem.lam_n, problem.index("lam_t")):
         assert _relative(solution.x[part], qp.x[part]) < QP_AGREEMENT
-    assert solution.residuals["friction_bound"] < 1e-12
-    assert solution.residuals["slip"] < 1e-12
+    if solve is _conforming:
+        assert solution.residuals["friction_bound"] < 1e-12
+        assert solution.residuals["slip"] < 1e-12
     t_n = (problem.K @ solution.x - problem.rhs)[problem.lam_n]
     t_t = (problem.K @ solution.x - problem.rhs)[problem.index("lam_t")]
     F = tresca_moments(problem) if "tresca" in name else 0.5 * np.maximum(-t_n, 0.0)
@@ -71,9 +82,9 @@ def test_condensing_onto_every_coefficient_gives_the_solution_of_the_candidates(
     """The path of a singular K (a floating body: every multiplier eliminated, all N_C
     coefficients condensed) and the candidates' path solve the same discrete problem."""
     problem = _problem(name, 1, 1)
-    candidates = solve_problem(problem)
+    candidates = _conforming(problem)
     monkeypatch.setattr(conforming.WholeFactorization, "regular", property(lambda self: False))
-    every = solve_problem(problem)
+    every = _conforming(problem)
     assert every.iterations["condensed"] == len(problem.lam_n)
     assert candidates.iterations["condensed"] < len(problem.lam_n)
     assert _relative(every.x, candidates.x) < 1e-9
@@ -83,7 +94,7 @@ def test_hertz_condenses_onto_a_few_coefficients_around_the_contact_zone():
     """Hertz at k = 1: the candidates are the coefficients in contact and a few around them,
     a small part of Gamma_C, and each costs one solve."""
     problem = _problem("hertz-cylinder", 1, 1)
-    solution = solve_problem(problem)
+    solution = _conforming(problem)
     lam_n = solution.x[problem.lam_n]
     touching = int(np.sum(lam_n <= 1e-8 * np.max(lam_n)))
     assert touching <= solution.iterations["condensed"] <= 2 * touching
@@ -103,3 +114,12 @@ def test_the_command_line_reports_stick_slip_and_the_coulomb_ratio_at_order_1(tm
     assert contact["stick_nodes"] > 0 and contact["slip_nodes"] > 0
     assert contact["max_traction_ratio"] == pytest.approx(0.5, rel=1e-9)
     assert record["warnings"] == []
+
+
+@pytest.mark.parametrize("order", [1, 2])
+def test_the_conforming_solver_without_friction_is_the_solution_of_the_qp(order):
+    """Frictionless Example 3.46: the candidates' condensation and Clarabel's polished QP."""
+    problem = _problem("thesis-3.46-frictionless", order, 2)
+    solution = _conforming(problem)
+    qp = solve_qp(problem, Model.of(problem.scene))
+    assert _relative(solution.x, qp.x) < 1e-9
