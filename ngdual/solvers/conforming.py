@@ -3,8 +3,10 @@
 The hybridised solver of :mod:`ngdual.solvers.active_set` eliminates broken RT_0 rows and
 P1 traces on the h~ mesh (:class:`~ngdual.solvers.hybrid.HybridSystem`); at order k >= 1,
 or with the facet multipliers (:mod:`ngdual.boundary.facet`), there is no such system, and
-the problem (3.62) is solved on the assembled K itself, with one sparse LU factorisation
-(UMFPACK, :class:`~ngdual.solvers.linear.Factorization`).
+the problem (3.62) can be solved on the assembled K itself, with one sparse LU factorisation
+(UMFPACK, :class:`~ngdual.solvers.linear.Factorization`). The default at order k is the
+hybridised system of the facet multipliers (:mod:`ngdual.solvers.hybrid_order`); this
+solver is its fallback where that system is singular, and a second solver to check it by.
 
 The contact and friction conditions act on the Bernstein coefficients of lambda_n and
 lambda_t and on their moments t = C^T sigma - r (C = K_sigma,lambda, r the lambda rows of
