@@ -41,6 +41,7 @@ from .rates import extrapolated_norms, total_error
 from .scene import Scene, SceneError, SceneTypeError, check_level, ensure_valid
 from .solvers import solve_on_mesh, solve_scene
 from .solvers.active_set import ContactStart
+from .solvers.dispatch import with_discretisation
 from .solvers.result import Solution
 
 StepCallback = Callable[[dict, Solution, Estimate, np.ndarray | None], None]
@@ -114,7 +115,8 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
           steps: int | None = None, level: int | None = None, asymmetry: str = "l2",
           reference: dict | None = None, on_step: StepCallback | None = None,
           allow_large: bool = False, goal: str = "stress", tol: float | None = None,
-          window: tuple[float, float] | None = None) -> list[dict]:
+          window: tuple[float, float] | None = None, order: int | None = None,
+          multipliers: str | None = None) -> list[dict]:
     """Run ``steps`` adaptive steps on ``scene`` from its mesh on ``level``, or fewer when
     the goal's relative estimate falls below ``tol``.
 
@@ -156,6 +158,10 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
         With ``goal="pressure"``: the pressure's error is that on the part of Gamma_C whose
         x lies in [lo, hi] (:func:`ngdual.goal.goal_estimate`), e.g. the core |x| < a/2 of
         a flat punch, whose pressure is not in L2 at its edges. Default: all of Gamma_C.
+    order, multipliers : int, str, optional
+        The order k of PEERS_k and the multiplier family in place of the scene's
+        ``[discretisation]`` entries, as for :func:`ngdual.solve`
+        (:func:`ngdual.solvers.dispatch.with_discretisation`).
 
     Returns
     -------
@@ -168,6 +174,7 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
         up to MARK). The last record's ``stopped_by`` is ``"tol"``
         or ``"steps"``.
     """
+    scene = with_discretisation(scene, order, multipliers)
     _check_adapt_arguments(scene, marking, theta, steps, level, asymmetry, reference, on_step,
                            allow_large, goal, tol, window)
     marking = MARKING if marking is None else marking

@@ -47,6 +47,16 @@ def test_both_goals_run_at_order_1_with_the_unknowns_and_indicators_of_order_1(g
     assert history[1]["estimator"] < first["estimator"]
 
 
+def test_adapt_takes_the_order_as_an_argument_and_leaves_the_scene_alone():
+    scene = load_scene("hertz-cylinder")
+    history = adapt(scene, steps=1, level=1, order=1)
+    assert history[0]["dofs"]["M"] == 2 * 3 * history[0]["elements"]
+    assert scene.discretisation.order == 0
+    with pytest.raises(SceneError) as err:
+        adapt(scene, steps=1, level=1, order=3)
+    assert err.value.field == "order"
+
+
 def test_ngdual_adapt_takes_the_order_on_the_command_line(tmp_path):
     assert main(["adapt", "thesis-3.46-frictionless", "--set", "discretisation.order=1",
                  "--set", "contact.ends=consistent", "--steps", "2", "--level", "1",
