@@ -109,7 +109,8 @@ class OrderHybridSystem:
         # a boundary edge has one triangle: d acts on its broken functions unchanged
         Q = sp.csr_matrix((np.ones(n_p), (_first_copies(broken.conforming, n_p),
                                           np.arange(n_p))), shape=(n_b, n_p))
-        coupled = (Q @ K[:n_p][:, multipliers]).tocsr()
+        # K is symmetric: its multiplier rows are few, its PEERS rows many
+        coupled = (Q @ K[multipliers][:, :n_p].T).tocsr()
         self._Q = Q
         self.seconds = {"broken": time.perf_counter() - start}
 
@@ -127,7 +128,7 @@ class OrderHybridSystem:
                 for r in (ranges["r1"], ranges["r2"])]
         Kb = broken.matrix
         self.A_LI = sp.hstack([Kb[L][:, eta], *rows, coupled[L]], format="csr")
-        A_II = sp.bmat([[Kb[eta][:, eta], None, coupled[eta]],
+        A_II = sp.bmat([[Kb[eta[0]:, eta[0]:], None, coupled[eta]],
                         [None, sp.csr_matrix((2 * n_mu, 2 * n_mu)), None],
                         [coupled[eta].T, None, K[multipliers][:, multipliers]]], format="csr")
         self.B_inv = _block_inverse(Kb[L][:, L].tocsr(), self.local.shape[1])
@@ -191,7 +192,7 @@ def _element_dofs(matrix: sp.csr_matrix, n_local: int) -> np.ndarray:
     of unknowns of a triangle (explicit zeros included) and couples the local unknowns of
     different triangles nowhere: the triangles are its connected components.
     """
-    pattern = matrix[:n_local][:, :n_local]
+    pattern = matrix[:n_local, :n_local]
     n_el, label = connected_components(pattern, directed=False)
     order = np.argsort(label, kind="stable")
     if np.any(np.bincount(label) != n_local // n_el) or n_local % n_el:
