@@ -126,12 +126,14 @@ class OrderHybridSystem:
                                (where[r.start:r.stop], np.arange(r.stop - r.start))),
                               shape=(n_l, r.stop - r.start)) @ mu
                 for r in (ranges["r1"], ranges["r2"])]
-        Kb = broken.matrix
-        self.A_LI = sp.hstack([Kb[L][:, eta], *rows, coupled[L]], format="csr")
-        A_II = sp.bmat([[Kb[eta[0]:, eta[0]:], None, coupled[eta]],
+        # one permutation of the broken matrix (triangle by triangle, then eta), sliced
+        order = np.concatenate([L, eta])
+        Kb = broken.matrix[order][:, order]
+        self.A_LI = sp.hstack([Kb[:n_l, n_l:], *rows, coupled[L]], format="csr")
+        A_II = sp.bmat([[Kb[n_l:, n_l:], None, coupled[eta]],
                         [None, sp.csr_matrix((2 * n_mu, 2 * n_mu)), None],
                         [coupled[eta].T, None, K[multipliers][:, multipliers]]], format="csr")
-        self.B_inv = _block_inverse(Kb[L][:, L].tocsr(), self.local.shape[1])
+        self.B_inv = _block_inverse(Kb[:n_l, :n_l], self.local.shape[1])
         extension = self.B_inv @ self.A_LI
         self.H = (self.A_LI.T @ extension - A_II).tocsr()
         self.H = 0.5 * (self.H + self.H.T)
