@@ -28,8 +28,9 @@ The traces are piecewise polynomials in x with breakpoints at the end points of 
 stick and slip sets. There sigma_n, lambda_n and the friction margin F - |sigma_t| start
 like (.)_+^2 (C^1 functions) and lambda_t, whose derivative enters b_2, like (.)_+^3 (C^2).
 So u is C^1 with piecewise polynomial second derivatives: u in H^{5/2-eps}, sigma in
-H^{3/2-eps} (in H^1), lambda_t, lambda_n in H^{3/2}(Gamma_C), and div sigma = -f is piecewise
-polynomial with jumps across the lines x = const through the set end points.
+H^{3/2-eps} (in H^1), lambda_t, lambda_n in H^{5/2-eps}(Gamma_C), and div sigma = -f is
+piecewise polynomial with jumps across the lines x = const through the set end points.
+:func:`frictionless_case` takes the onset p as a parameter and states what each p gives.
 
 Why quadratic onsets and a small lift. The discrete sets are decided node by node against
 the exact margins next to a set end point -- the pressure, the gap lambda_n, F - |sigma_t| at
@@ -216,17 +217,46 @@ class ManufacturedCase:
         return sc
 
 
-def frictionless_case(a: float = 2.0, name: str | None = None) -> ManufacturedCase:
-    """Contact on [-a, a] (sigma_n = -P (1 - x^2/a^2)^3), lift-off towards the clamped ends."""
+def frictionless_case(a: float = 2.0, name: str | None = None,
+                      onset: int = ONSET) -> ManufacturedCase:
+    """Contact on [-a, a] (sigma_n = -P (1 - x^2/a^2)_+^p), lift-off towards the clamped ends.
+
+    Parameters
+    ----------
+    a : float
+        Half the length of the contact set.
+    name : str, optional
+        The case's name (default ``frictionless-a<a>``), followed by ``-onset<p>`` for
+        p != 2.
+    onset : int
+        p >= 2: sigma_n and lambda_n grow like d^p from the end points +-a, d the distance
+        to the nearer one (u_n and lambda_t are polynomials). Their p-th derivatives jump
+        there, so sigma_n, lambda_n lie in H^{p+1/2-eps}(Gamma_C); u = (.., -u_n + Y b_2)
+        with b_2 carrying sigma_n lies in H^{p+1/2-eps}(Omega) and sigma, which carries
+        Y sigma_n'(x) in sigma_12, in H^{p-1/2-eps}(Omega), the jumps sitting on the lines
+        x = +-a. On a mesh that cuts these lines the best L^2 approximation of sigma is
+        O(h^{min(k+1, p-1/2)}): order k needs p >= k + 2. On Example 3.46's structured
+        mesh with a = 2 the lines are mesh lines and sigma is a polynomial on every
+        triangle, so any p >= 2 verifies any k; there p decides the contact ends instead.
+        A margin d^p next to an end (the pressure on the contact side, lambda_n on the
+        separated side) must dominate the O(h^{k+1}) errors of the Bernstein coefficients
+        that decide the set: p = 2 recovers the set exactly at k = 0, 1, 2, while p = 3
+        and 4 misclassify one fine edge, and more as h falls, next to each end at k = 1, 2
+        (docs/theory/order.md, "Verification per order"). The default p = 2 is therefore
+        the onset of every order's verification.
+    """
+    if onset < 2:
+        raise ValueError(f"onset must be >= 2 (sigma_n in C^1), got {onset}")
     x = _x()
+    suffix = "" if onset == ONSET else f"-onset{onset}"
     return ManufacturedCase(
-        name=name or f"frictionless-a{a:g}",
-        description=f"frictionless; contact set [-{a:g}, {a:g}]",
+        name=(name or f"frictionless-a{a:g}") + suffix,
+        description=f"frictionless; contact set [-{a:g}, {a:g}]{suffix}",
         law="none",
         lam_t=SLIDE * (x / 4.0) * (1.0 - x * x / 16.0),
         u_n=APPROACH * (1.0 - x * x / 16.0) ** 2,
-        lam_n=LIFT * (bump(-HALF_WIDTH, -a) + bump(a, HALF_WIDTH)),
-        sigma_n=-PRESSURE * cap(a),
+        lam_n=LIFT * (bump(-HALF_WIDTH, -a, onset) + bump(a, HALF_WIDTH, onset)),
+        sigma_n=-PRESSURE * cap(a, onset),
         sigma_t=Piecewise.constant(0.0),
         contact_set=((-a, a),))
 

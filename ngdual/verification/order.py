@@ -48,7 +48,7 @@ from ..solvers import solve_scene
 from ..solvers.linear import Factorization
 from ..sparse import to_scipy
 from .infsup import gram_matrix, smallest_singular_values
-from .manufactured import manufactured_case
+from .manufactured import ONSET, frictionless_case
 from .manufactured_errors import discrete_sets, symmetric_difference, volume_errors
 
 E, NU = 1.0, 0.3
@@ -319,8 +319,12 @@ def pressure_error(case, solution) -> float:
                                        definedon=region), 0.0))
 
 
-def contact_study(order: int = 0, levels=(1, 2, 3)) -> list[dict]:
+def contact_study(order: int = 0, levels=(1, 2, 3), onset: int = ONSET) -> list[dict]:
     """The manufactured frictionless contact case solved at order k on uniform levels.
+
+    ``onset`` is the p of :func:`ngdual.verification.manufactured.frictionless_case`
+    (sigma_n, lambda_n like d^p from the contact ends x = +-2, which are mesh lines):
+    the default p = 2 is the one whose contact set every order recovers exactly.
 
     Returns
     -------
@@ -332,7 +336,7 @@ def contact_study(order: int = 0, levels=(1, 2, 3)) -> list[dict]:
         order, and ``contact_set``: the length of the symmetric difference between
         :func:`contact_set` and the exact contact set [-2, 2].
     """
-    case = manufactured_case("frictionless")
+    case = frictionless_case(2.0, "frictionless", onset)
     scene = case.scene(order=order)
     rows = []
     for level in levels:
