@@ -17,6 +17,7 @@ from ngdual.scene import load_scene
 from ngdual.solvers import solve_scene
 from ngdual.solvers.conforming import conforming_active_set
 from ngdual.solvers.hybrid_order import OrderHybridSystem, hybrid_active_set
+from ngdual.solvers.linear import solve_linear
 from ngdual.solvers.settings import solver_settings
 from ngdual.verification.manufactured import manufactured_case
 
@@ -93,3 +94,14 @@ def test_the_order_k_default_solver_is_the_hybridised_one():
     scene = load_scene("thesis-3.46-frictionless", ["discretisation.order=1",
                                                     "contact.ends='consistent'"])
     assert solve_scene(scene, 1).method == "active-set-hybrid"
+
+
+def test_without_contact_the_hybridised_solution_is_the_sparse_lu_one():
+    """Gamma_C relabelled Gamma_N: the linear problem, against UMFPACK on K."""
+    scene = load_scene("thesis-3.46-frictionless", [
+        "discretisation.order=1", "contact.ends='consistent'", "boundary.contact=[]",
+        "boundary.neumann=['top', 'bottom']"])
+    problem = assemble(scene, build_mesh(scene.geometry, 1))
+    hybrid = hybrid_active_set(problem, solver_settings(scene))
+    lu = solve_linear(problem)
+    assert np.max(np.abs(hybrid.x - lu.x)) <= ROUND_OFF * np.max(np.abs(lu.x))
