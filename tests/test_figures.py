@@ -202,8 +202,10 @@ def test_work_precision_measures_true_errors_against_references_it_checks(coarse
         uniform = [float(r["sigma_energy"]) for r in mine if r["method"] == "uniform"]
         assert len(uniform) >= 2 and all(b < a for a, b in zip(uniform, uniform[1:]))
         for measure in ("pressure", "sigma_energy"):
-            assert sum(r[measure] == "" for r in mine) == 1     # the reference itself
             ref = result["references"][problem][measure]
+            # the reference itself, unless it is a run's steps solved again at order 2
+            assert sum(r[measure] == "" for r in mine) == (0 if "PEERS_2" in ref["method"]
+                                                           else 1)
             for target in ref["resolves"]:
                 assert ref["overkill_error"] <= target / 3
             if ref["estimate"] == "three-cornered hat":
@@ -220,6 +222,7 @@ def test_work_precision_measures_true_errors_against_references_it_checks(coarse
         assert all(math.isfinite(float(r["effectivity"])) and float(r["effectivity"]) > 0
                    for r in resolved)
     assert any(e["problem"] == "hertz-cylinder" for e in result["effectivity"])
+    assert any("PEERS_2" in result["references"][p]["sigma_energy"]["method"] for p in problems)
     sidecar = json.loads((coarse_run / "figures" / "work_precision.json").read_text())
     labels = set(sidecar["figure_legend"]) if sidecar["figure_legend"] else set()
     assert {"primal P1", "primal P2", "uniform", "adaptive, pressure goal"} <= labels, labels

@@ -16,6 +16,8 @@ from .plan import (
     GAP_CASES,
     MANUFACTURED_CASES,
     PEER_ORDERS,
+    REFERENCE_ORDER,
+    REFERENCE_ORDER_DOFS,
     REFERENCE_TOL,
     SCENES,
     TRUTH_GOALS,
@@ -104,7 +106,8 @@ def truth_adapt(plan: Plan, problem: str, goal: str) -> Task:
     (:data:`TRUTH_GOALS`; the pressure goal on the problem's ``pressure_window``), keeping
     every step's samples: a tolerance run of :func:`ngdual.afem.adapt` (its theta and
     initial level) to :data:`REFERENCE_TOL` or the budget :meth:`Plan.reference_elements`,
-    at most :data:`ADAPT_STEPS` solves."""
+    at most :data:`ADAPT_STEPS` solves; the stress goal's steps of at most
+    :data:`REFERENCE_ORDER_DOFS` unknowns also by PEERS_k, k = :data:`REFERENCE_ORDER`."""
     from ...afem import THETA_TOL
 
     tp = TRUTH_PROBLEMS[problem]
@@ -115,7 +118,10 @@ def truth_adapt(plan: Plan, problem: str, goal: str) -> Task:
                           "max_elements": plan.reference_elements(problem), "goal": goal,
                           "tol": REFERENCE_TOL,
                           "window": ([-window, window] if window and goal == "pressure"
-                                     else None)},
+                                     else None),
+                          **({"reference_order": REFERENCE_ORDER,
+                              "reference_dofs": REFERENCE_ORDER_DOFS} if goal == "stress"
+                             else {})},
                 f"{tp.scene} {goal} goal samples", 2.0 * plan.truth_levels(problem)[-1])
 
 

@@ -11,9 +11,11 @@ before (a run that stalls, growing by less than :data:`STALLED` per step, has no
 estimate). Where a run gives no such estimate, two independent solutions stand in for it
 (:func:`three_cornered_hat`): the other run's last step and the finest uniform level, on
 meshes of other families, whose three pairwise distances give each one's error if the
-three errors are orthogonal. The reference of a measure is the last step with the smallest
-own error, and it resolves the targets at least 1 / :data:`RESOLVES` times its error. The
-steps of a run
+three errors are orthogonal. The stress goal's steps up to a size are solved again by
+PEERS_2 on their meshes (:func:`order_reference`): their last one is the sigma reference
+where its own error, Richardson from the two before it, is smaller. The reference of a
+measure is the step with the smallest own error, and it resolves the targets at least
+1 / :data:`RESOLVES` times its error. The steps of a run
 are nested meshes (bisection), so their distances to its last step are exact integrals;
 every other candidate's mesh crosses the reference's triangles, and the quadrature error
 this costs (:mod:`ngdual.verification.overkill`) is measured by integrating the sigma
@@ -41,7 +43,7 @@ import numpy as np
 from ...io import plain, versions, write_json
 from ..sweep import estimator
 from .numbers import aligned_richardson_check, richardson_check
-from .plan import TRUTH_PROBLEMS
+from .plan import REFERENCE_ORDER, TRUTH_PROBLEMS
 from .tasks import truth_tasks
 
 if TYPE_CHECKING:
@@ -198,6 +200,47 @@ def _hat_checks(checks: list[dict], runs: dict, uniform: tuple[dict, dict] | Non
                 entry.update(overkill_error=hat, estimate="three-cornered hat")
 
 
+def distance(candidate: dict, reference: dict, lam: float, mu: float,
+             window: float | None = None) -> dict:
+    """:func:`ngdual.verification.overkill.true_errors` of ``candidate`` against
+    ``reference``, the fields integrated on the finer of the two meshes (a candidate finer
+    than the reference is exact on its own triangles, not on the reference's); the norms
+    are the reference's."""
+    from ...verification.overkill import field_errors, true_errors
+
+    out = true_errors(candidate, reference, lam, mu, window)
+    if len(candidate["triangles"]) > len(reference["triangles"]):
+        swapped = field_errors(reference, candidate, lam, mu)
+        out.update({k: v for k, v in swapped.items() if not k.endswith("_norm")})
+    return out
+
+
+def order_reference(run: list[tuple[dict, dict]], lam: float, mu: float
+                    ) -> tuple[dict, dict] | None:
+    """The sigma reference of an adaptive run's steps solved again by PEERS_k (k =
+    :data:`~ngdual.studies.figures.plan.REFERENCE_ORDER`, arrays ``order_*``): the last such
+    step's fields and their own error, Richardson (:data:`EXTRAPOLATION`, orthogonal) from
+    the two such steps before it (nested meshes: exact distances); None with fewer than
+    three such steps. Returns (its check, with the keys of :func:`_run_check`'s measures,
+    and its sample arrays)."""
+    steps = [(row, {"vertices": a["vertices"], "triangles": a["triangles"],
+                    **{n: a[f"order_{n}"] for n in ("sigma", "u", "eta")}}, int(a["order_ndof"]))
+             for row, a in run if "order_sigma" in a]
+    if len(steps) < 3:
+        return None
+    (row, last, ndof), before = steps[-1], steps[-3:-1]
+    d = [_measures(distance(arrays, last, lam, mu))["sigma_energy"] for _, arrays, _ in before]
+    check = EXTRAPOLATION["sigma_energy"](*d)
+    return ({"method": f"{row['method']}, PEERS_{REFERENCE_ORDER}", "step": row["level_or_step"],
+             "ndof": ndof, "elements": row["elements"], "d_last-2": d[0], "d_last-1": d[1],
+             **check, "estimate": None if check["overkill_error"] is None
+             else f"Richardson, PEERS_{REFERENCE_ORDER}"}, last)
+
+
+def _resolves(error: float | None) -> list[float]:
+    return [t for t in (0.05, 0.02, 0.01) if error is not None and error <= RESOLVES * t]
+
+
 def _choose(checks: list[dict], measure: str) -> dict:
     """The reference of ``measure``: the run's last step whose own error (Richardson, or
     the three-cornered hat where Richardson has none) is smallest, or without any such
@@ -205,10 +248,8 @@ def _choose(checks: list[dict], measure: str) -> dict:
     known = [c for c in checks if c[measure]["overkill_error"] is not None]
     best = (min(known, key=lambda c: c[measure]["overkill_error"]) if known
             else max(checks, key=lambda c: c["ndof"]))
-    error = best[measure]["overkill_error"]
     return {**{k: v for k, v in best.items() if k not in TRUE_MEASURES}, **best[measure],
-            "resolves": [t for t in (0.05, 0.02, 0.01) if error is not None
-                         and error <= RESOLVES * t]}
+            "resolves": _resolves(best[measure]["overkill_error"])}
 
 
 def analytic_check(scene, pressure: dict, window: float | None) -> dict | None:
@@ -254,7 +295,7 @@ def true_error_study(ctx: Context, problem: str) -> dict:
     three-cornered hat of :func:`_hat_checks`).
     """
     from ...scene import load_scene
-    from ...verification.overkill import true_errors
+    from ...verification.overkill import field_errors, true_errors
 
     tp = TRUTH_PROBLEMS[problem]
     ids = [t.id for ts in truth_tasks(ctx.plan, problem).values() for t in ts]
@@ -278,15 +319,23 @@ def true_error_study(ctx: Context, problem: str) -> dict:
                 lam, mu, tp.pressure_window)
     chosen = {m: _choose(checks, m) for m in TRUE_MEASURES}
     last = {m: runs[c["method"]][-1] for m, c in chosen.items()}
+    # a run's steps solved again at order k are a better sigma reference where their own
+    # error is smaller: no row is that reference
+    for found in filter(None, (order_reference(run, lam, mu) for run in runs.values())):
+        check, arrays = found
+        own = chosen["sigma_energy"]["overkill_error"]
+        if check["overkill_error"] is not None and (own is None or check["overkill_error"] < own):
+            chosen["sigma_energy"] = {**check, "resolves": _resolves(check["overkill_error"])}
+            last["sigma_energy"] = ({}, arrays)
     # sigma, u and the rotation from one run's last step, the pressure from one's
     pressure = {k: last["pressure"][1][k] for k in ("p_nodes", "p")}
-    reference = {**{k: v for k, v in last["sigma_energy"][1].items() if not k.startswith("p")},
-                 **pressure}
+    reference = {**{k: v for k, v in last["sigma_energy"][1].items()
+                    if k in ("vertices", "triangles", "sigma", "u", "eta")}, **pressure}
     rows, crossing = [], {}
     floor = chosen["pressure"]["overkill_error"]
     for row, arrays in candidates:
         if arrays:
-            row.update(_measures(true_errors(arrays, reference, lam, mu, tp.pressure_window)))
+            row.update(_measures(distance(arrays, reference, lam, mu, tp.pressure_window)))
             if (row["method"] == "adaptive, pressure goal" and floor is not None
                     and row["pressure"] >= floor / RESOLVES):
                 row["effectivity"] = row["goal_estimate"] / row["pressure_l2"]
@@ -297,11 +346,18 @@ def true_error_study(ctx: Context, problem: str) -> dict:
                 row[measure] = None
         rows.append(row)
     # the quadrature error of non-nested candidates: their sigma errors again, on the
-    # reference's triangles split in four
-    split = {**split_samples(reference), **pressure}
+    # triangles of the finer of the two split in four
+    split, norm = None, None
     changes = []
     for row, arrays in crossing.values():
-        again = _measures(true_errors(arrays, split, lam, mu))["sigma_energy"]
+        if len(arrays["triangles"]) > len(reference["triangles"]):
+            norm = norm or field_errors(reference, reference, lam, mu, ("sigma",))[
+                "sigma_energy_norm"]
+            again = field_errors(reference, split_samples(arrays), lam, mu, ("sigma",))[
+                "sigma_energy"] / norm
+        else:
+            split = split or {**split_samples(reference), **pressure}
+            again = _measures(true_errors(arrays, split, lam, mu))["sigma_energy"]
         changes.append({"method": row["method"], "level_or_step": row["level_or_step"],
                         "sigma_energy": row["sigma_energy"], "sigma_energy_split": again,
                         "relative_change": abs(again / row["sigma_energy"] - 1)})

@@ -91,7 +91,8 @@ class _Budget(Exception):
 def adapt_task(scene: str, marking: str, theta: float, steps: int, level: int,
                overrides: list[str] = (), snapshots: list[int] = (), samples: bool = False,
                max_elements: int | None = None, goal: str = "stress",
-               tol: float | None = None, window: list[float] | None = None
+               tol: float | None = None, window: list[float] | None = None,
+               reference_order: int | None = None, reference_dofs: int = 0
                ) -> tuple[dict, dict]:
     """An adaptive run (:func:`ngdual.afem.adapt` with its ``goal``, ``tol`` and ``window``):
     its history, with extras for Section 4.2.
@@ -105,7 +106,11 @@ def adapt_task(scene: str, marking: str, theta: float, steps: int, level: int,
     ``triangles_<k>`` and ``marked_<k>``. A ConvergenceError keeps the steps done.
     With ``samples=True`` every step's solution is kept as the arrays of
     :func:`ngdual.verification.overkill.solution_samples`, prefixed ``s<k>_``; the run stops
-    after the first step whose mesh has at least ``max_elements`` triangles.
+    after the first step whose mesh has at least ``max_elements`` triangles. With
+    ``reference_order`` k, every step of at most ``reference_dofs`` unknowns is solved again
+    by PEERS_k on its mesh (:func:`order_samples`, arrays ``s<k>_order_<name>``; not in
+    ``cumulative_s``): references for sigma; the first that fails ends them
+    (``reference_order_failed``).
     """
     from ...afem import adapt
     from ...estimator import estimate
@@ -114,6 +119,9 @@ def adapt_task(scene: str, marking: str, theta: float, steps: int, level: int,
 
     history, arrays = [], {}
     start, extra = time.perf_counter(), [0.0]
+    run = {"scene": scene, "marking": marking, "theta": theta, "steps": steps, "level": level,
+           "overrides": list(overrides), "goal": goal, "tol": tol, "window": window,
+           "reference_order": reference_order}
 
     def on_step(record, solution, indicators, marked):
         # wall time up to this solution, its estimate and marks (refine of the step before
@@ -136,13 +144,18 @@ def adapt_task(scene: str, marking: str, theta: float, steps: int, level: int,
             from ...verification.overkill import solution_samples
 
             arrays.update({f"s{k}_{n}": v for n, v in solution_samples(solution).items()})
+            if (reference_order and record["dofs"]["total"] <= reference_dofs
+                    and "reference_order_failed" not in run):
+                try:
+                    arrays.update({f"s{k}_order_{n}": v for n, v
+                                   in order_samples(solution, reference_order).items()})
+                except ConvergenceError as err:   # no reference from here on; k = 0 stays
+                    run["reference_order_failed"] = f"step {k}: {err}"
         history.append(dict(record))
         extra[0] += time.perf_counter() - t0
         if max_elements is not None and record["elements"] >= max_elements:
             raise _Budget
 
-    run = {"scene": scene, "marking": marking, "theta": theta, "steps": steps, "level": level,
-           "overrides": list(overrides), "goal": goal, "tol": tol, "window": window}
     try:
         adapt(load_scene_with(scene, overrides), marking, theta, steps, level, on_step=on_step,
               goal=goal, tol=tol, window=None if window is None else tuple(window))
@@ -154,6 +167,22 @@ def adapt_task(scene: str, marking: str, theta: float, steps: int, level: int,
         status = "ok" if all(r["converged"] for r in history) else "not-converged"
     run.update(status=status, history=history)
     return run, arrays
+
+
+def order_samples(solution, order: int) -> dict:
+    """sigma, u and eta of PEERS_``order`` on the mesh of ``solution`` (a discrete solution
+    of its scene), as the element samples of
+    :func:`ngdual.verification.overkill.element_samples`, and ``ndof``, its unknowns."""
+    from ...quantities import fields
+    from ...solvers.dispatch import solve_on_mesh, with_discretisation
+    from ...verification.overkill import element_samples
+
+    pb = solution.problem
+    finer = solve_on_mesh(with_discretisation(pb.scene, order=order), pb.fes.mesh)
+    f = fields(finer)
+    out = element_samples(pb.fes.mesh, {"sigma": f.sigma, "u": f.u, "eta": f.eta})
+    return {"sigma": out["sigma"], "u": out["u"], "eta": out["eta"],
+            "ndof": np.array(finer.problem.fes.ndof)}
 
 
 def peer_task(scene: str, level: int, order: int, overrides: list[str] = (),
