@@ -203,8 +203,8 @@ class Spaces:
 class BrokenPeers:
     """The PEERS block of (3.62), assembled once, element by element.
 
-    The Raviart-Thomas rows of sigma are broken (every triangle has its own three normal
-    fluxes); the bubbles, u and eta are those of the conforming space. The element matrices
+    The Raviart-Thomas rows of sigma are broken (every triangle has its own RT_k
+    functions); the bubbles, u and eta are those of the conforming space. The element matrices
     of a~ + b + s are the same as on the conforming space, but no two triangles share a
     stress unknown, so ``matrix`` keeps every triangle's matrix apart: the conforming PEERS
     block is K = E^T K_b E (:meth:`summed`), E the 0/1 map from conforming to broken
@@ -348,7 +348,7 @@ class DiscreteProblem:
         Gamma_N (zero for the homogeneous Dirichlet data of the thesis).
     blocks : dict[str, slice]
         Position of every component in the unknown vector.
-    broken : BrokenPeers or None
+    broken : BrokenPeers
         The PEERS block element by element, from which K's PEERS block was summed (the
         hybridised solver's input); None at order k >= 1 or with the facet multipliers,
         whose PEERS block is assembled on the conforming spaces (:func:`conforming_peers`).
@@ -363,7 +363,7 @@ class DiscreteProblem:
     rhs: np.ndarray
     blocks: dict[str, slice]
     lift: np.ndarray
-    broken: BrokenPeers | None
+    broken: BrokenPeers
     assemble_seconds: float
     level: int | None = None
 
@@ -453,8 +453,7 @@ def assemble(scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes | None = None
     spaces = Spaces.build(scene, mesh, coarse)
     names = list(spaces.components)
     fes = ngs.FESpace([spaces.components[n] for n in names])
-    thesis = spaces.order == 0 and spaces.family == "coarse"
-    broken = broken_peers(spaces, scene.material.lame) if thesis else None
+    broken = broken_peers(spaces, scene.material.lame)
     d, rhs = _forms(scene, fes, names)
     for form in (d, rhs):
         if form is not None:
@@ -468,8 +467,7 @@ def assemble(scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes | None = None
         offset += p.shape[1]
     P = sp.block_diag(blocks_p, format="csr")
     # the PEERS unknowns come first and are not prolonged
-    volume = broken.summed(P.shape[1]) if thesis else conforming_peers(
-        spaces, scene.material.lame, P.shape[1])
+    volume = broken.summed(P.shape[1])
     lift = _end_lift(scene, spaces, fes, names)
     F = P.T @ rhs.vec.FV().NumPy()
     if d is not None:

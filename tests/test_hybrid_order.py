@@ -85,7 +85,7 @@ def test_the_broken_peers_block_sums_to_the_conforming_one_bit_for_bit(order):
 
 def test_the_hybridised_matrix_is_symmetric_positive_definite():
     problem, _ = _problem("thesis-3.46-coulomb", 1, 1)
-    H = OrderHybridSystem(problem, problem.scene.material.lame, friction=True).H.toarray()
+    H = OrderHybridSystem(problem, friction=True).H.toarray()
     assert np.array_equal(H, H.T)
     assert np.linalg.eigvalsh(H)[0] > 0.0
 

@@ -14,10 +14,10 @@ Tresca / Coulomb     -> Algorithm 3.41 / Remark 3.45 (nested Uzawa)
 Cholesky factorisation, and for contact the semismooth Newton method on Gamma_C
 (:mod:`ngdual.solvers.active_set`): the same discrete solution at about the cost of one linear
 solve. The hybridisation is that of broken RT_0 rows and the P1 multipliers on h~; at order
-k >= 1 or with the facet multipliers (``discretisation``) the problem has no such system
-(``problem.broken`` is None) and the system is hybridised with broken RT_k rows and the facet
-multipliers themselves (:mod:`ngdual.solvers.hybrid_order`); :mod:`ngdual.solvers.conforming`
-solves the same problem on the conforming K, the independent check of the tests.
+k >= 1 or with the facet multipliers (``discretisation``) it is that of broken RT_k rows
+and the facet multipliers themselves (:mod:`ngdual.solvers.hybrid_order`);
+:mod:`ngdual.solvers.conforming` solves the same problem on the conforming K, the
+independent check of the tests.
 """
 
 from __future__ import annotations
@@ -221,7 +221,7 @@ def solve_problem(problem: DiscreteProblem, settings: Settings | None = None,
     if start is not None and not isinstance(settings, ActiveSetSettings):
         raise ValueError(f"a warm start is for the active-set method, not "
                          f"{type(settings).__name__}")
-    if isinstance(settings, ActiveSetSettings) and problem.broken is None:
+    if isinstance(settings, ActiveSetSettings) and problem.spaces.family == "facet":
         solution = hybrid_active_set(problem, settings, start=start)
     elif isinstance(settings, ActiveSetSettings):
         solution = active_set_solve(problem, settings, progress=progress, start=start)

@@ -7,9 +7,10 @@ holds at every order k, and is simpler, because the boundary multipliers already
 the hybridisation puts its own: on the fine edges, P_k per edge, the space of the normal
 traces of RT_k.
 
-The Raviart-Thomas rows of sigma are broken (:func:`ngdual.forms.broken_peers`: every
-triangle has its own RT_k functions), and the continuity of their normal traces across every
-interior edge e is enforced again by a multiplier mu of degree k per edge and row,
+The Raviart-Thomas rows of sigma are broken (``problem.broken``,
+:func:`ngdual.forms.broken_peers`: every triangle has its own RT_k functions), and the
+continuity of their normal traces across every interior edge e is enforced again by a
+multiplier mu of degree k per edge and row,
 
     a~(sigma, tau) + b(u, tau) + s(eta, tau) + sum_T int_{dT} mu . tau n_T ds
         + d(lambda, tau) = F(tau),
@@ -56,7 +57,7 @@ from scipy.sparse.csgraph import connected_components
 from threadpoolctl import threadpool_limits
 
 from .. import peers
-from ..forms import DiscreteProblem, broken_peers
+from ..forms import DiscreteProblem
 from ..friction import MomentFriction, build_friction_forms, tresca_moments
 from ..sparse import to_scipy
 from ..tolerances import BLAS_THREADS, COULOMB_FIXED_POINT_TOL
@@ -77,8 +78,6 @@ class OrderHybridSystem:
     ----------
     problem : DiscreteProblem
         An assembled problem with the facet multipliers (``spaces.family == "facet"``).
-    lame : tuple of float
-        Lame's constants (lambda, mu) of its material.
     friction : bool
         Whether lambda_t is a contact unknown (ordered last with lambda_n) or eliminated
         with the other multipliers (no friction: t_t = 0).
@@ -93,15 +92,15 @@ class OrderHybridSystem:
         The positions of the contact unknowns in x_I (the last ones): lambda_n, then
         lambda_t with friction, in the order of ``problem.lam_n`` and ``problem.index("lam_t")``.
     seconds : dict
-        ``broken`` (the broken PEERS_k assembly and the edge coupling) and ``condense``
-        (the elimination of the element-local unknowns).
+        ``broken`` (the edge coupling and the couplings of the multipliers to the broken
+        rows) and ``condense`` (the elimination of the element-local unknowns).
     """
 
-    def __init__(self, problem: DiscreteProblem, lame: tuple[float, float], friction: bool):
+    def __init__(self, problem: DiscreteProblem, friction: bool):
         start = time.perf_counter()
         self.problem = problem
         spaces, K = problem.spaces, problem.K.tocsr()
-        self.broken = broken = broken_peers(spaces, lame)
+        self.broken = broken = problem.broken
         fes = broken.fes
         ranges = {name: fes.Range(i) for i, name in enumerate(peers.PEERS)}
         n_b, n_p = fes.ndof, len(np.bincount(broken.conforming))
@@ -279,7 +278,7 @@ def hybrid_active_set(problem: DiscreteProblem, settings: ActiveSetSettings,
     law = model.law
     begin = time.perf_counter()
     first = start.at(problem.spaces.contact.node_points()) if start is not None else None
-    hybrid = OrderHybridSystem(problem, model.lame, friction=law != "none")
+    hybrid = OrderHybridSystem(problem, friction=law != "none")
     try:
         chol = SchurCholesky(hybrid.H, hybrid.contact_index, ordering)
     except ArithmeticError:
