@@ -208,8 +208,9 @@ class BrokenPeers:
     of a~ + b + s are the same as on the conforming space, but no two triangles share a
     stress unknown, so ``matrix`` keeps every triangle's matrix apart: the conforming PEERS
     block is K = E^T K_b E (:meth:`summed`), E the 0/1 map from conforming to broken
-    unknowns, and the hybridisation (:class:`ngdual.solvers.hybrid.HybridSystem`) eliminates
-    the element-local unknowns from the same matrix.
+    unknowns, and the hybridisation (:class:`ngdual.solvers.hybrid.HybridSystem`,
+    :class:`ngdual.solvers.hybrid_order.OrderHybridSystem`) eliminates the element-local
+    unknowns from the same matrix.
 
     Attributes
     ----------
@@ -350,8 +351,8 @@ class DiscreteProblem:
         Position of every component in the unknown vector.
     broken : BrokenPeers
         The PEERS block element by element, from which K's PEERS block was summed (the
-        hybridised solver's input); None at order k >= 1 or with the facet multipliers,
-        whose PEERS block is assembled on the conforming spaces (:func:`conforming_peers`).
+        input of the hybridised solvers, :mod:`ngdual.solvers.hybrid` and
+        :mod:`ngdual.solvers.hybrid_order`).
     """
 
     scene: Scene
