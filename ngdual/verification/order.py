@@ -22,10 +22,13 @@ b(tau, (v, xi)) = (div tau, v) + s(xi, tau) in the H(div) x L^2 x L^2 norms on t
 square with the machinery of :mod:`ngdual.verification.infsup`.
 
 :func:`contact_study` solves the manufactured frictionless contact problem of
-:mod:`ngdual.verification.manufactured` (Example 3.46's box, contact on [-2, 2]) at order k
-with the multipliers of its default family and measures the same errors and the contact
-set; :func:`order_check` says whether the observed orders of sigma reach k + 1 (issue 27:
-within :data:`ORDER_SLACK` on the last two levels).
+:mod:`ngdual.verification.manufactured` (Example 3.46's box, contact on [-2, 2], sigma_n and
+lambda_n starting like d^2 from its ends) at order k with the multipliers of its default
+family and measures the same errors and the contact set; :func:`order_check` says whether
+the observed orders of sigma reach k + 1 (issue 27: within :data:`ORDER_SLACK` on the last
+two levels). At k = 2 they do not on fine levels: the edge-wise P_2 interpolant of the gap
+differs from its P_2 projection by an odd saw of amplitude h^3 on every edge, which limits
+sigma to h^{5/2} and the pressure to h^2 (docs/theory/order.md, "Verification per order").
 """
 
 from __future__ import annotations
