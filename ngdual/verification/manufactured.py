@@ -240,9 +240,9 @@ def frictionless_case(a: float = 2.0, name: str | None = None,
         triangle, so any p >= 2 verifies any k; there p decides the contact ends instead.
         A margin d^p next to an end (the pressure on the contact side, lambda_n on the
         separated side) must dominate the O(h^{k+1}) errors of the Bernstein coefficients
-        that decide the set: p = 2 recovers the set exactly at k = 0, 1, 2, while p = 3
-        and 4 misclassify one fine edge, and more as h falls, next to each end at k = 1, 2
-        (docs/theory/order.md, "Verification per order"). The default p = 2 is therefore
+        that decide the set: p = 2 recovers the set exactly at k = 0, 1, 2, while at
+        k = 1, 2 p = 3 misclassifies one fine edge next to each end on the finer levels
+        and p = 4 more as h falls (docs/theory/order.md, "Verification per order"). The default p = 2 is therefore
         the onset of every order's verification.
     """
     if onset < 2:
