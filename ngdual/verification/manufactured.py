@@ -242,8 +242,8 @@ def frictionless_case(a: float = 2.0, name: str | None = None,
         separated side) must dominate the O(h^{k+1}) errors of the Bernstein coefficients
         that decide the set: p = 2 recovers the set exactly at k = 0, 1, 2, while at
         k = 1, 2 p = 3 misclassifies one fine edge next to each end on the finer levels
-        and p = 4 more as h falls (docs/theory/order.md, "Verification per order"). The default p = 2 is therefore
-        the onset of every order's verification.
+        and p = 4 more as h falls (docs/theory/order.md, "Verification per order"). The
+        default p = 2 is therefore the onset of every order's verification.
     """
     if onset < 2:
         raise ValueError(f"onset must be >= 2 (sigma_n in C^1), got {onset}")
