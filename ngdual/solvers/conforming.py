@@ -205,31 +205,41 @@ def conforming_active_set(problem: DiscreteProblem, settings: ActiveSetSettings,
         x, state, F, info, factor_s = _on_every_coefficient(problem, law, model.mu_f, bound,
                                                             friction, first,
                                                             settings.max_iter, tol)
-    residuals = _residuals(problem, x, F)
-    if law == "coulomb":
-        t_n = _moments(problem, x)[0]
-        mapped = friction.coulomb_bound_of(t_n, model.mu_f)
-        residuals["coulomb_bound"] = float(np.max(np.abs(mapped - F), initial=0.0) / (
-            model.mu_f * np.max(np.abs(t_n), initial=0.0) or 1.0))
-    bad = {k: v for k, v in residuals.items() if not v <= TOLERANCE}
+    return checked_solution(problem, x, law, model.mu_f, F, "active-set-conforming",
+                            {**info["iterations"], "condensed": info["unknowns"],
+                             "solves": info["solves"]}, info["history"],
+                            {"assemble": problem.assemble_seconds, "factorize": factor_s,
+                             "solve": time.perf_counter() - begin})
+
+
+def checked_solution(problem: DiscreteProblem, x: np.ndarray, law: str, mu_f: float,
+                     F: np.ndarray | None, method: str, iterations: dict, history: list,
+                     seconds: dict) -> Solution:
+    """The solution x of (3.62) with the facet multipliers, once its residuals on
+    ``problem.K`` (:func:`residuals`) are round-off; the friction multiplier nu and the
+    bound reported per fine edge (the h^ edges of ``FacetFrictionForms``).
+
+    Raises
+    ------
+    ConvergenceError
+        Naming every residual above ``TOLERANCE``.
+    """
+    found = residuals(problem, x, law, mu_f, F)
+    bad = {k: v for k, v in found.items() if not v <= TOLERANCE}
     if bad:
         raise ConvergenceError("the active-set solution does not satisfy (3.62) to round-off: "
                                + ", ".join(f"{k} = {v:.1e} > {TOLERANCE:.0e}"
-                                           for k, v in bad.items()), info["history"])
+                                           for k, v in bad.items()), history)
     nu = forms = edge_bound = nu_l2 = None
-    if F is not None:  # reported per fine edge, the h^ edges of FacetFrictionForms
+    if F is not None:
         forms = build_friction_forms(problem)
         edge_bound = forms.edge_bound(F)
-        nu = forms.edge_nu(_moments(problem, x)[1], F)
+        nu = forms.edge_nu(moments(problem, x)[1], F)
         nu_l2 = forms.l2_norm_nu(nu, edge_bound > 0)
-    return Solution(problem, x, True, "active-set-conforming" if law == "none"
-                    else f"active-set-conforming-{law}",
-                    iterations={**info["iterations"], "condensed": info["unknowns"],
-                                "solves": info["solves"]},
-                    residuals=residuals, history=info["history"], nu=nu,
+    return Solution(problem, x, True, method if law == "none" else f"{method}-{law}",
+                    iterations=iterations, residuals=found, history=history, nu=nu,
                     friction_bound=edge_bound, friction_forms=forms, nu_l2=nu_l2,
-                    timings={"assemble": problem.assemble_seconds, "factorize": factor_s,
-                             "solve": time.perf_counter() - begin})
+                    timings=seconds)
 
 
 def _start_state(first, J: np.ndarray, friction: bool, n_rows: int) -> BoundarySolution | None:
@@ -242,9 +252,12 @@ def _start_state(first, J: np.ndarray, friction: bool, n_rows: int) -> BoundaryS
                             False, {})
 
 
-def _solve_condensed(cond: Condensed, law: str, mu_f: float, bound: np.ndarray | None,
-                     friction: MomentFriction, first, max_iter: int, tol: float):
-    """The contact (and friction) problem on J: (state, F on J or None, history, iterations)."""
+def solve_condensed(cond: Condensed, law: str, mu_f: float, bound: np.ndarray | None,
+                    friction: MomentFriction, first, max_iter: int, tol: float):
+    """The contact (and friction) problem t(z) = b - G z on J by the semismooth Newton
+    method (the Coulomb fixed point of Remark 3.45 around it): (state, F on J or None,
+    history, iterations). ``first`` holds a start's (lambda_n, lambda_t) on every
+    coefficient, ``bound`` a Tresca bound on every coefficient."""
     floor = SAFETY * cond.roundoff
     if law == "coulomb":
         noise = floor * mu_f * float(np.max(np.abs(cond.b), initial=0.0))
@@ -277,7 +290,7 @@ def _on_candidates(whole: WholeFactorization, law: str, mu_f: float, bound, fric
         J = np.flatnonzero(candidate)
         cond, H = whole.condensed(J, has_friction)
         if len(J):
-            state, F_J, hist, its = _solve_condensed(cond, law, mu_f, bound, friction, first,
+            state, F_J, hist, its = solve_condensed(cond, law, mu_f, bound, friction, first,
                                                      max_iter, tol)
             t = cond.traction(state)
         else:
@@ -342,7 +355,7 @@ def _on_every_coefficient(problem: DiscreteProblem, law: str, mu_f: float, bound
         G = sla.block_diag(G, np.eye(n_c))
         b = np.concatenate([b, np.zeros(n_c)])
     cond = Condensed(G, b, np.arange(n_c))
-    state, F, history, its = _solve_condensed(cond, law, mu_f, bound, friction, first,
+    state, F, history, its = solve_condensed(cond, law, mu_f, bound, friction, first,
                                               max_iter, tol)
     z = np.concatenate([state.lam_n, state.lam_t])[:len(L)]
     x[rest] -= W @ z
@@ -351,32 +364,49 @@ def _on_every_coefficient(problem: DiscreteProblem, law: str, mu_f: float, bound
                          "unknowns": n_c, "solves": len(L) + 1}, fact.seconds
 
 
-def _moments(problem: DiscreteProblem, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def moments(problem: DiscreteProblem, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """t_n, t_t = C^T sigma - r on every coefficient (the lambda rows of K x - rhs)."""
     residual = problem.K @ x - problem.rhs
     return residual[problem.lam_n], residual[problem.index("lam_t")]
 
 
-def _residuals(problem: DiscreteProblem, x: np.ndarray, F: np.ndarray | None) -> dict:
-    """Relative residuals of (3.103) and, with the bound F on the coefficients, of the
-    friction law: |t_t,i| <= F_i (``friction_bound``) and F_i |lambda_t,i| = lambda_t,i t_t,i
-    (``slip``: stick where |t_t,i| < F_i, slip along t_t,i)."""
+def residuals(problem: DiscreteProblem, x: np.ndarray, law: str, mu_f: float,
+              F: np.ndarray | None) -> dict:
+    """Relative residuals of (3.103) on ``problem.K`` and, with the bound F on the
+    coefficients, of the friction law: |t_t,i| <= F_i (``friction_bound``),
+    F_i |lambda_t,i| = lambda_t,i t_t,i (``slip``: stick where |t_t,i| < F_i, slip along
+    t_t,i) and, for Coulomb, F_i = mu_f (-t_n,i) (``coulomb_bound``).
+
+    The sign conditions and the complementarity of lambda_n are measured against the
+    displacement scale, the largest of lambda_n, lambda_t and u: with g = 0 a whole side
+    is in contact, lambda_n = 0 up to round-off, and relative to its own size that
+    round-off would count as a violation of order one.
+    """
     i_sigma, i_mult, i_lam = problem.sigma, problem.mult, problem.lam_n
     b = problem.rhs[i_mult].copy()
-    t_n, t_t = _moments(problem, x)
+    t_n, t_t = moments(problem, x)
     lam_t_rows = problem.index("lam_t") - len(i_sigma)
     if F is not None:  # the lambda_t rows carry Q_F^T nu = t_t
         b[lam_t_rows] += t_t
-    residuals = contact_problem_residuals(problem.block(i_sigma, i_sigma),
-                                          problem.block(i_sigma, i_mult),
-                                          problem.block(i_sigma, i_lam), problem.rhs[i_sigma],
-                                          b, x[i_sigma], x[i_mult], x[i_lam])
+    found = contact_problem_residuals(problem.block(i_sigma, i_sigma),
+                                      problem.block(i_sigma, i_mult),
+                                      problem.block(i_sigma, i_lam), problem.rhs[i_sigma],
+                                      b, x[i_sigma], x[i_mult], x[i_lam])
+    lam_n, lam_t = x[i_lam], x[problem.index("lam_t")]
+    displacement = float(np.max(np.abs(x[problem.index("u1", "u2", "lam_n", "lam_t")]),
+                                initial=0.0)) or 1.0
+    n_scale = float(np.max(np.abs(t_n), initial=0.0)) or 1.0
+    found["lambda_n_negative"] = float(max(0.0, -lam_n.min(initial=0.0))) / displacement
+    found["complementarity"] = float(np.max(np.abs(lam_n * t_n), initial=0.0)) / (
+        displacement * n_scale)
     if F is not None:
-        lam_t = x[problem.index("lam_t")]
-        t_scale = max(float(np.max(np.abs(t_n), initial=0.0)),
-                      float(np.max(np.abs(t_t), initial=0.0))) or 1.0
+        t_scale = max(n_scale, float(np.max(np.abs(t_t), initial=0.0)))
         work = float(np.max(F, initial=0.0) * np.max(np.abs(lam_t), initial=0.0)) or 1.0
-        residuals["friction_bound"] = float(np.max(np.abs(t_t) - F, initial=0.0)) / t_scale
-        residuals["slip"] = float(np.max(np.abs(F * np.abs(lam_t) - lam_t * t_t),
-                                         initial=0.0)) / work
-    return residuals
+        found["friction_bound"] = float(np.max(np.abs(t_t) - F, initial=0.0)) / t_scale
+        found["slip"] = float(np.max(np.abs(F * np.abs(lam_t) - lam_t * t_t),
+                                     initial=0.0)) / work
+    if law == "coulomb":
+        mapped = MomentFriction().coulomb_bound_of(t_n, mu_f)
+        found["coulomb_bound"] = float(np.max(np.abs(mapped - F), initial=0.0) / (
+            mu_f * np.max(np.abs(t_n), initial=0.0) or 1.0))
+    return found

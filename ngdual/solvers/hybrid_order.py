@@ -58,17 +58,24 @@ from threadpoolctl import threadpool_limits
 
 from .. import peers
 from ..forms import DiscreteProblem
-from ..friction import MomentFriction, build_friction_forms, tresca_moments
+from ..friction import MomentFriction, tresca_moments
 from ..sparse import to_scipy
 from ..tolerances import BLAS_THREADS, COULOMB_FIXED_POINT_TOL
 from .active_set import ContactStart
 from .cholesky import SchurCholesky
-from .conforming import TOLERANCE, Condensed, conforming_active_set
-from .conforming import _moments as moments
-from .conforming import _residuals as conforming_residuals
-from .conforming import _solve_condensed as solve_condensed
-from .result import ConvergenceError, Solution
+from .conforming import (
+    TOLERANCE,
+    Condensed,
+    checked_solution,
+    conforming_active_set,
+    moments,
+    residuals,
+    solve_condensed,
+)
+from .result import Solution
 from .settings import ActiveSetSettings
+
+CONTACT_REFINEMENTS = 2  # corrections of b by the moments on K (hybrid_active_set)
 
 
 class OrderHybridSystem:
@@ -295,13 +302,23 @@ def hybrid_active_set(problem: DiscreteProblem, settings: ActiveSetSettings,
     contact_start = time.perf_counter()
     bound = tresca_moments(problem) if law == "tresca" else None
     friction = MomentFriction()
+    cond = Condensed(0.5 * (G + G.T), b, np.arange(n_c))
+    first_contact = first
     with threadpool_limits(limits=BLAS_THREADS, user_api="blas"):
-        state, F, history, iterations = solve_condensed(
-            Condensed(0.5 * (G + G.T), b, np.arange(n_c)), law, model.mu_f, bound, friction,
-            first, settings.max_iter, tol)
-    back = time.perf_counter()
-    z = state.lam_n if law == "none" else np.concatenate([state.lam_n, state.lam_t])
-    x = hybrid.solve(chol, y, problem.rhs, z)
+        for refinement in range(CONTACT_REFINEMENTS + 1):
+            state, F, history, iterations = solve_condensed(
+                cond, law, model.mu_f, bound, friction, first_contact, settings.max_iter, tol)
+            back = time.perf_counter()
+            z = state.lam_n if law == "none" else np.concatenate([state.lam_n, state.lam_t])
+            x = hybrid.solve(chol, y, problem.rhs, z)
+            if refinement == CONTACT_REFINEMENTS or max(
+                    residuals(problem, x, law, model.mu_f, F).values()) <= TOLERANCE:
+                break
+            # the moments on K are exact for these multipliers, those of the Schur
+            # complement carry the round-off of the Cholesky factors: b takes the difference
+            on_K = np.concatenate(moments(problem, x))[:len(z)]
+            cond.b[:len(z)] += on_K - cond.traction(state)[:len(z)]
+            first_contact = (state.lam_n, state.lam_t)
     end = time.perf_counter()
     # the keys of ngdual.solvers.active_set: "factorize" prepares, "solve" follows it
     seconds = {"assemble": problem.assemble_seconds, "hybrid_assemble": hybrid.seconds["broken"],
@@ -311,39 +328,5 @@ def hybrid_active_set(problem: DiscreteProblem, settings: ActiveSetSettings,
                "total_solver": end - begin}
     seconds["factorize"] = seconds["hybridize"] + seconds["cholesky"]
     return checked_solution(problem, x, law, model.mu_f, F, "active-set-hybrid",
-                            {**iterations, "condensed": n_c}, history, seconds)
-
-
-def checked_solution(problem: DiscreteProblem, x: np.ndarray, law: str, mu_f: float,
-                     F: np.ndarray | None, method: str, iterations: dict, history: list,
-                     seconds: dict) -> Solution:
-    """The solution x of (3.62) with the facet multipliers, once its residuals on
-    ``problem.K`` (and those of the friction law with the bound F on the coefficients) are
-    round-off; the friction multiplier nu and the bound reported per fine edge.
-
-    Raises
-    ------
-    ConvergenceError
-        Naming every residual above :data:`ngdual.solvers.conforming.TOLERANCE`.
-    """
-    residuals = conforming_residuals(problem, x, F)
-    if law == "coulomb":
-        t_n = moments(problem, x)[0]
-        mapped = MomentFriction().coulomb_bound_of(t_n, mu_f)
-        residuals["coulomb_bound"] = float(np.max(np.abs(mapped - F), initial=0.0) / (
-            mu_f * np.max(np.abs(t_n), initial=0.0) or 1.0))
-    bad = {k: v for k, v in residuals.items() if not v <= TOLERANCE}
-    if bad:
-        raise ConvergenceError("the active-set solution does not satisfy (3.62) to round-off: "
-                               + ", ".join(f"{k} = {v:.1e} > {TOLERANCE:.0e}"
-                                           for k, v in bad.items()), history)
-    nu = forms = edge_bound = nu_l2 = None
-    if F is not None:  # reported per fine edge, the h^ edges of FacetFrictionForms
-        forms = build_friction_forms(problem)
-        edge_bound = forms.edge_bound(F)
-        nu = forms.edge_nu(moments(problem, x)[1], F)
-        nu_l2 = forms.l2_norm_nu(nu, edge_bound > 0)
-    return Solution(problem, x, True, method if law == "none" else f"{method}-{law}",
-                    iterations=iterations, residuals=residuals, history=history, nu=nu,
-                    friction_bound=edge_bound, friction_forms=forms, nu_l2=nu_l2,
-                    timings=seconds)
+                            {**iterations, "condensed": n_c, "contact_refinements": refinement},
+                            history, seconds)

@@ -126,17 +126,21 @@ def kkt_residuals(G: np.ndarray, b: np.ndarray, Q: np.ndarray, lam_n: np.ndarray
                   lam_t: np.ndarray, nu: np.ndarray) -> dict:
     """Relative residuals of the conditions above (0 = exact).
 
-    Scales: max |b| for tractions, max |z| for the multipliers, sum |Q| |lambda_t|
-    (the friction work) for the sign condition.
+    Scales: max |b| for tractions; for the multipliers max |z|, at least the displacement
+    s = max |b_i| / G_ii the load produces; sum |Q| |lambda_t| (the friction work), at
+    least sum |Q| s, for the sign condition. The floors matter where z vanishes (a whole
+    side in contact and sticking, z = 0 up to round-off): relative to max |z| the
+    round-off of a zero z would count as a violation of order one.
     """
     z = np.concatenate([lam_n, lam_t])
     t = b - G @ z
     n_c = len(lam_n)
     t_n, t_t = _split(t, n_c)
     t_scale = max(np.max(np.abs(b), initial=0.0), np.max(np.abs(G @ z), initial=0.0)) or 1.0
-    z_scale = np.max(np.abs(z), initial=0.0) or 1.0
+    s = float(np.max(np.abs(b) / np.diag(G), initial=0.0)) if G.size else 0.0
+    z_scale = max(float(np.max(np.abs(z), initial=0.0)), s) or 1.0
     q = Q @ lam_t
-    work = float(np.sum(np.abs(Q) @ np.abs(lam_t)))
+    work = max(float(np.sum(np.abs(Q) @ np.abs(lam_t))), float(np.sum(np.abs(Q))) * s)
     return {
         "lambda_n_negative": float(max(0.0, -lam_n.min(initial=0.0)) / z_scale),
         "sigma_n_positive": float(max(0.0, t_n.max(initial=0.0)) / t_scale),
