@@ -71,7 +71,8 @@ E, NU = 1000.0, 0.3
 PRESSURE = 5.0                  # peak contact pressure |sigma_n|
 LIFT = 0.002                    # peak of lambda_n on the separated parts (see contact_profile)
 SLIDE = 0.005                   # scale of lambda_t = u_1 on Gamma_C
-APPROACH = 0.01                 # u_n = APPROACH (1 - x^2/16)^2 on Gamma_C
+APPROACH = 0.01                 # u_n = APPROACH (1 - x^2/16)^2 on Gamma_C (quartic)
+GAPS = ("quartic", "quadratic")  # the normal displacement u_n of frictionless_case
 ONSET = 2                       # sigma_n, lambda_n, F - |sigma_t| grow like d^ONSET from a set
                                 # end point, lambda_t like d^(ONSET + 1) (lambda_t' enters u_2)
 QUANTITIES = ("sigma", "sigma_hdiv", "u", "eta", "lam_n", "lam_t")
@@ -218,7 +219,7 @@ class ManufacturedCase:
 
 
 def frictionless_case(a: float = 2.0, name: str | None = None,
-                      onset: int = ONSET) -> ManufacturedCase:
+                      onset: int = ONSET, gap: str = "quartic") -> ManufacturedCase:
     """Contact on [-a, a] (sigma_n = -P (1 - x^2/a^2)_+^p), lift-off towards the clamped ends.
 
     Parameters
@@ -227,7 +228,7 @@ def frictionless_case(a: float = 2.0, name: str | None = None,
         Half the length of the contact set.
     name : str, optional
         The case's name (default ``frictionless-a<a>``), followed by ``-onset<p>`` for
-        p != 2.
+        p != 2 and ``-gap-quadratic`` for the quadratic gap.
     onset : int
         p >= 2: sigma_n and lambda_n grow like d^p from the end points +-a, d the distance
         to the nearer one (u_n and lambda_t are polynomials). Their p-th derivatives jump
@@ -244,17 +245,39 @@ def frictionless_case(a: float = 2.0, name: str | None = None,
         k = 1, 2 p = 3 misclassifies one fine edge next to each end on the finer levels
         and p = 4 more as h falls (docs/theory/order.md, "Verification per order"). The
         default p = 2 is therefore the onset of every order's verification.
+    gap : {"quartic", "quadratic"}
+        The normal displacement on Gamma_C: u_n = APPROACH (1 - x^2/16)^2 (quartic, the
+        general case) or u_n = APPROACH (1 - x^2/16) (quadratic). Both vanish at the
+        clamped ends and are positive inside, so g = u_n + lambda_n >= 0; on the contact
+        zone lambda_n = 0 and g = u_n. The facet multipliers of order k see g through its
+        P_k interpolant g_h at the control points of every fine edge e = (x_0, x_1) (at
+        k = 2: x_0, the midpoint x_m and x_1), and sigma sees the gap's error only through
+        int_e (g - g_h) tau_n ds with tau_n in P_k(e), that is through Pi_k g - g_h (Pi_k
+        the L^2(e) projection). At k = 1 the interpolation error
+        -g^(2) (x - x_0)(x_1 - x) / 2 is even about the midpoint: Pi_1 g - g_h =
+        -g^(2) h^2 / 12 + O(h^3), a constant per edge that varies smoothly along Gamma_C,
+        and nothing is lost. At k = 2 the error g^(3) (x - x_0)(x - x_m)(x - x_1) / 6 is
+        odd about the midpoint: Pi_2 g - g_h is a saw of amplitude c g^(3) h^3 that jumps
+        at every vertex, O(h^{5/2}) in H^{1/2}(Gamma_C), which limits sigma to order
+        k + 1/2 and the pressure to k asymptotically (an even k >= 2 loses half an order,
+        an odd k nothing). The quadratic u_n has g^(3) = 0 on the contact zone, so
+        g_h = g there for k >= 2: the case measures the method alone, at order k + 1 for
+        k = 0, 1, 2 (docs/theory/order.md, "What limits k = 2: the interpolated gap").
     """
     if onset < 2:
         raise ValueError(f"onset must be >= 2 (sigma_n in C^1), got {onset}")
+    if gap not in GAPS:
+        raise ValueError(f"gap must be one of {', '.join(GAPS)}, got {gap!r}")
     x = _x()
-    suffix = "" if onset == ONSET else f"-onset{onset}"
+    suffix = ("" if onset == ONSET else f"-onset{onset}") + (
+        "" if gap == "quartic" else f"-gap-{gap}")
+    profile = 1.0 - x * x / 16.0
     return ManufacturedCase(
         name=(name or f"frictionless-a{a:g}") + suffix,
         description=f"frictionless; contact set [-{a:g}, {a:g}]{suffix}",
         law="none",
         lam_t=SLIDE * (x / 4.0) * (1.0 - x * x / 16.0),
-        u_n=APPROACH * (1.0 - x * x / 16.0) ** 2,
+        u_n=APPROACH * (profile ** 2 if gap == "quartic" else profile),
         lam_n=LIFT * (bump(-HALF_WIDTH, -a, onset) + bump(a, HALF_WIDTH, onset)),
         sigma_n=-PRESSURE * cap(a, onset),
         sigma_t=Piecewise.constant(0.0),

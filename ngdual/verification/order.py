@@ -24,11 +24,16 @@ square with the machinery of :mod:`ngdual.verification.infsup`.
 :func:`contact_study` solves the manufactured frictionless contact problem of
 :mod:`ngdual.verification.manufactured` (Example 3.46's box, contact on [-2, 2], sigma_n and
 lambda_n starting like d^2 from its ends) at order k with the multipliers of its default
-family and measures the same errors and the contact set; :func:`order_check` says whether
-the observed orders of sigma reach k + 1 (issue 27: within :data:`ORDER_SLACK` on the last
-two levels). At k = 2 they do not on fine levels: the edge-wise P_2 interpolant of the gap
-differs from its P_2 projection by an odd saw of amplitude h^3 on every edge, which limits
-sigma to h^{5/2} and the pressure to h^2 (docs/theory/order.md, "Verification per order").
+family and measures the same errors and the contact set. Its ``gap`` names the normal
+displacement u_n on Gamma_C. The quadratic one is represented by the gap's P_k
+interpolant on the contact zone (k >= 2), so the case measures the method alone and
+:func:`order_check` holds sigma's observed orders within :data:`ORDER_SLACK` of k + 1 on
+the last two levels (issue 27). The quartic one, the general case, sees the interpolant's
+error: at even k >= 2 an odd saw of amplitude h^3 on every edge, which limits sigma to
+order k + 1/2 and the pressure to k asymptotically (docs/theory/order.md, "What limits
+k = 2: the interpolated gap"); :func:`expected_order` states that prediction and
+``order_check(rows, expected=...)`` fails only below it. :func:`set_check` asks for the
+exact contact set on the last two levels.
 """
 
 from __future__ import annotations
@@ -59,6 +64,7 @@ LAME = (E * NU / ((1 + NU) * (1 - 2 * NU)), E / (2 * (1 + NU)))    # plane strai
 DIRICHLET, NEUMANN = "left|bottom", "right|top"
 QUANTITIES = ("sigma", "u", "eta")
 ORDER_SLACK = 0.15    # the observed order of sigma lies within this of k + 1
+SET_TOLERANCE = 1e-12    # the contact set's error (a length) counted as exact
 
 
 def unit_square(level: int) -> ngs.Mesh:
@@ -322,24 +328,27 @@ def pressure_error(case, solution) -> float:
                                        definedon=region), 0.0))
 
 
-def contact_study(order: int = 0, levels=(1, 2, 3), onset: int = ONSET) -> list[dict]:
+def contact_study(order: int = 0, levels=(1, 2, 3), onset: int = ONSET,
+                  gap: str = "quartic") -> list[dict]:
     """The manufactured frictionless contact case solved at order k on uniform levels.
 
-    ``onset`` is the p of :func:`ngdual.verification.manufactured.frictionless_case`
-    (sigma_n, lambda_n like d^p from the contact ends x = +-2, which are mesh lines):
-    the default p = 2 is the one whose contact set every order recovers exactly.
+    ``onset`` and ``gap`` are the p and the u_n of
+    :func:`ngdual.verification.manufactured.frictionless_case` (sigma_n, lambda_n like d^p
+    from the contact ends x = +-2, which are mesh lines; u_n quartic or quadratic): the
+    default p = 2 is the one whose contact set every order recovers exactly, the
+    quadratic u_n the one whose gap the multipliers represent on the contact zone.
 
     Returns
     -------
     list of dict
-        One row per level: ``problem`` ("contact"), ``order``, ``level``, ``ndof`` (every
+        One row per level: ``problem`` ("contact"), ``gap``, ``order``, ``level``, ``ndof`` (every
         unknown), ``seconds`` (meshing, assembly and solve), the L^2 errors of
         :data:`QUANTITIES` with their observed orders ``<quantity>_order`` (None on the
         first level), the pressure's error ``pressure`` (:func:`pressure_error`) with its
         order, and ``contact_set``: the length of the symmetric difference between
         :func:`contact_set` and the exact contact set [-2, 2].
     """
-    case = frictionless_case(2.0, "frictionless", onset)
+    case = frictionless_case(2.0, "frictionless", onset, gap)
     scene = case.scene(order=order)
     rows = []
     for level in levels:
@@ -347,7 +356,7 @@ def contact_study(order: int = 0, levels=(1, 2, 3), onset: int = ONSET) -> list[
         solution = solve_scene(scene, level)
         seconds = time.perf_counter() - start
         errors = volume_errors(case, solution)
-        rows.append({"problem": "contact", "order": order, "level": level,
+        rows.append({"problem": "contact", "gap": gap, "order": order, "level": level,
                      "ndof": solution.problem.fes.ndof, "seconds": seconds,
                      **{q: errors[q] for q in QUANTITIES},
                      "pressure": pressure_error(case, solution),
@@ -360,17 +369,63 @@ def contact_study(order: int = 0, levels=(1, 2, 3), onset: int = ONSET) -> list[
     return rows
 
 
-def order_check(rows: list[dict], quantity: str = "sigma") -> dict:
+def expected_order(order: int, gap: str) -> float:
+    """The order of sigma that theory predicts for the manufactured contact case of order k
+    with the normal displacement ``gap`` (:func:`contact_study`), as h -> 0.
+
+    k + 1 where the P_k interpolant of the gap costs nothing: at k = 0 and odd k (its
+    error is even about every edge's midpoint) and where it is exact on the contact zone
+    (the quadratic u_n at k >= 2); k + 1/2 at even k >= 2 with the quartic u_n, whose
+    interpolation error is an odd saw of amplitude h^3 on every fine edge (docs/theory/
+    order.md, "What limits k = 2: the interpolated gap"; the derivation in
+    :func:`ngdual.verification.manufactured.frictionless_case`).
+
+    >>> [expected_order(k, "quartic") for k in (0, 1, 2)]
+    [1, 2, 2.5]
+    >>> expected_order(2, "quadratic")
+    3
+    """
+    exact_on_zone = gap == "quadratic" and order >= 2
+    if order == 0 or order % 2 == 1 or exact_on_zone:
+        return order + 1
+    return order + 0.5
+
+
+def order_check(rows: list[dict], quantity: str = "sigma",
+                expected: float | None = None) -> dict:
     """Whether the observed orders of ``quantity`` on the last two levels of a study of one
-    order k (rows of :func:`convergence_study` or :func:`contact_study`) lie within
-    :data:`ORDER_SLACK` of k + 1.
+    order k (rows of :func:`convergence_study` or :func:`contact_study`) reach their target.
+
+    Without ``expected`` the target is k + 1 and the orders must lie within
+    :data:`ORDER_SLACK` of it (rule "within"); with it, an asymptotic prediction
+    (:func:`expected_order`) that the orders on coarse levels may still exceed, and they
+    must not fall more than :data:`ORDER_SLACK` below it (rule "at least").
 
     >>> rows = [{"order": 1, "sigma_order": None}, {"order": 1, "sigma_order": 2.05},
     ...         {"order": 1, "sigma_order": 1.98}]
     >>> order_check(rows)["passed"]
     True
+    >>> rows = [{"order": 2, "sigma_order": r} for r in (None, 2.92, 2.79)]
+    >>> order_check(rows)["passed"], order_check(rows, expected=2.5)["passed"]
+    (False, True)
     """
-    target = rows[0]["order"] + 1
+    target = rows[0]["order"] + 1 if expected is None else expected
     observed = [r[quantity + "_order"] for r in rows[-2:] if r[quantity + "_order"] is not None]
-    return {"quantity": quantity, "target": target, "observed": observed,
-            "passed": bool(observed) and all(abs(a - target) <= ORDER_SLACK for a in observed)}
+    if expected is None:
+        met = all(abs(a - target) <= ORDER_SLACK for a in observed)
+    else:
+        met = all(a >= target - ORDER_SLACK for a in observed)
+    return {"quantity": quantity, "target": target,
+            "rule": "within" if expected is None else "at least", "observed": observed,
+            "passed": bool(observed) and met}
+
+
+def set_check(rows: list[dict]) -> dict:
+    """Whether the contact set is exact (its error below :data:`SET_TOLERANCE`) on the last
+    two levels of a :func:`contact_study`, once h is below the set's feature size.
+
+    >>> set_check([{"contact_set": 4.0}, {"contact_set": 0.0}, {"contact_set": 0.0}])
+    {'errors': [0.0, 0.0], 'passed': True}
+    """
+    errors = [r["contact_set"] for r in rows[-2:]]
+    return {"errors": errors, "passed": all(e <= SET_TOLERANCE for e in errors)}
