@@ -68,8 +68,9 @@ def test_the_thesis_coulomb_normal_stress_is_refused_with_the_facet_multipliers(
     """The facet multipliers bound each Bernstein moment by its own normal moment: the
     choice of |sigma_n| on the h^ edges does nothing there, so it is an error."""
     with pytest.raises(SceneError) as err:
-        load_scene("thesis-3.46-tresca", ["discretisation.order=1"])
-    assert err.value.field == "friction.law"
+        load_scene("thesis-3.46-coulomb", ["discretisation.order=1", "contact.ends='consistent'",
+                                           "friction.normal_stress='fine-edges'"])
+    assert err.value.field == "friction.normal_stress"
 
 
 def test_auto_multipliers_are_the_thesis_hats_at_order_0_and_facets_above():
