@@ -16,7 +16,8 @@ writes them as Jupyter notebooks.
 ``levels``, ``estimator-cost``, ``infsup``, ``primal-peer``.
 ``ngdual verify [--quick] [--orders K ...] [--json FILE]`` prints the errors against exact
 solutions with observed orders, per order k of PEERS_k too (:mod:`ngdual.verification.report`;
-exit status 1 when an observed order misses k + 1).
+exit status 1 when a study misses what it can show: k + 1, k + 1/2 for the general contact
+case at even k >= 2, the exact contact set).
 After the result table ``solve`` prints one ``warning:`` line per failed physics check
 (tension or a force imbalance on Gamma_C, penetration, the friction bound, contact at a
 clamped end, thesis end values that contradict the data; :mod:`ngdual.checks`), also
@@ -275,7 +276,8 @@ def parser() -> argparse.ArgumentParser:
     ve.add_argument("--orders", nargs="+", type=int, default=None, metavar="K",
                     help="only the convergence of PEERS_k for these orders k (0, 1, 2) on "
                          "elasticity and frictionless contact; exit status 1 when sigma's "
-                         "observed order misses k + 1")
+                         "observed order misses k + 1 (the general contact case: its "
+                         "prediction, k + 1/2 at even k >= 2) or the contact set is wrong")
     ve.set_defaults(func=cmd_verify)
     return p
 

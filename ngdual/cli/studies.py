@@ -203,7 +203,8 @@ BENCH_SETTINGS = {"limit-ratio": _limit_ratio_settings, "levels": _levels_settin
 
 def cmd_verify(args) -> int:
     """Print the verification tables (:mod:`ngdual.verification.report`); ``--orders K ...``
-    only those of the orders K of PEERS_k."""
+    only those of the orders K of PEERS_k. Exit status 1 when a study fails its check
+    (:func:`ngdual.verification.report.order_rows`)."""
     from ..io import check_output_file
     from ..scene import ORDERS
     from ..verification.report import run
