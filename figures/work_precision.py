@@ -10,7 +10,11 @@ Methods: uniform refinement (active set) up to the budget level K minus the prob
 ``coarser`` (``--max-level`` K); the adaptive loop as a tolerance run (ngdual.afem.adapt:
 Doerfler theta = 0.8 from level 1) with goal "stress" ((4.50)) and goal "pressure"
 (ngdual.goal; on the flat punch its core |x| < a/2), each run to a relative estimate of
-0.1 % or the budget Plan.reference_elements; the primal peer
+0.1 % or the budget Plan.reference_elements; these are k = 0 with the thesis' coarse
+multipliers. At the orders k = 1, 2 (PEERS_k with the facet P_k multipliers on the fine
+edges, ", k = 1" in the method's name): uniform refinement to k levels fewer and the
+pressure goal's tolerance run to the budget Plan.order_elements; a method that fails on a
+problem is a row "failed: <reason>" of the table. The primal peer
 ngdual.studies.primal_peer (P1 and P2 displacements, Nitsche contact, semismooth Newton)
 on the uniform meshes. Left out, as they add run time and change no verdict: the thesis'
 Uzawa iterations (the same discrete problems as the active set, slower: README, "Solvers")
@@ -48,6 +52,7 @@ import os
 from ngdual import plot
 from ngdual.io import versions
 from ngdual.studies.figures import TRUTH_PROBLEMS, markdown_table, script_main, true_error_study
+from ngdual.studies.figures.plan import ORDERS, order_method
 
 THESIS = "Work-precision (beyond the thesis)"
 STUDIES = ("truth",)
@@ -55,7 +60,12 @@ TARGETS = (0.05, 0.02, 0.01)
 MEASURES = {"pressure": "pressure error on $\\Gamma_C$ (rel. $L^2$) [-]",
             "sigma_energy": "error of $\\sigma$ (rel. compliance norm) [-]"}
 UNIFORM, P2 = "uniform", "primal P2"
-MARKERS = "osD^vP*X"
+# the figure's curves: a colour per order (the peers: grey P1, black P2), a line style and
+# a marker per method
+ORDER_COLOURS = {0: "C0", 1: "C1", 2: "C2"}
+PEER_COLOURS = {"primal P1": "0.55", P2: "k"}
+METHOD_STYLES = {UNIFORM: ("-", "o"), "adaptive, stress goal": ("--", "s"),
+                 "adaptive, pressure goal": ("-.", "D"), "primal": (":", "^")}
 
 
 def is_peer(method: str) -> bool:
@@ -69,22 +79,28 @@ def time_to_accuracy(points: list[dict], measure: str, target: float) -> dict | 
 
 
 def accuracy_table(rows: list[dict], references: dict) -> list[dict]:
-    """Least time (and its unknowns) to each target per problem, measure and method;
-    ``resolved`` whether the reference of the measure resolves the target."""
+    """Least time (and its unknowns) to each target per problem, measure and method, with
+    the method's order k and multiplier family; ``resolved`` whether the reference of the
+    measure resolves the target; ``failed`` the first failure of the method's solves."""
     table = []
     for problem in TRUTH_PROBLEMS:
-        mine = [r for r in rows if r["problem"] == problem and r["status"] == "ok"]
+        mine = [r for r in rows if r["problem"] == problem]
         for measure in MEASURES:
             resolves = references[problem][measure]["resolves"]
             for target in TARGETS:
                 for method in dict.fromkeys(r["method"] for r in mine):
-                    hit = time_to_accuracy([r for r in mine if r["method"] == method],
+                    solves = [r for r in mine if r["method"] == method]
+                    hit = time_to_accuracy([r for r in solves if r["status"] == "ok"],
                                            measure, target)
+                    failed = next((f"{r['status']}: {r.get('message', '')}" for r in solves
+                                   if r["status"] != "ok"), None)
                     table.append({"problem": problem, "measure": measure, "target": target,
-                                  "method": method, "time_s": hit and hit["time_s"],
+                                  "method": method, "order": solves[0]["order"],
+                                  "multipliers": solves[0]["multipliers"],
+                                  "time_s": hit and hit["time_s"],
                                   "ndof": hit and hit["ndof"],
                                   "level_or_step": hit and hit["level_or_step"],
-                                  "resolved": target in resolves})
+                                  "resolved": target in resolves, "failed": failed})
     return table
 
 
@@ -99,7 +115,7 @@ def verdicts(table: list[dict]) -> list[dict]:
     """Per problem, measure and target: the fastest adaptive run against uniform refinement
     (``adaptive_wins``: it reaches the target first, or uniform does not within its budget)
     and the fastest ngdual method against the primal P2 peer (``ratio`` = ngdual time / P2
-    time)."""
+    time), also among the methods of order k >= 1 (``ratio_order_p2``)."""
     out = []
     for problem in TRUTH_PROBLEMS:
         for measure in MEASURES:
@@ -108,6 +124,7 @@ def verdicts(table: list[dict]) -> list[dict]:
                 uniform = _fastest(table, *key, lambda m: m == UNIFORM)
                 adaptive = _fastest(table, *key, lambda m: m.startswith("adaptive"))
                 ngdual = _fastest(table, *key, lambda m: not is_peer(m))
+                higher = _fastest(table, *key, lambda m: not is_peer(m) and ", k = " in m)
                 p2 = _fastest(table, *key, lambda m: m == P2)
                 resolved = next(r["resolved"] for r in table if (r["problem"], r["measure"],
                                                                  r["target"]) == key)
@@ -124,14 +141,19 @@ def verdicts(table: list[dict]) -> list[dict]:
                     "fastest_ngdual": ngdual and ngdual["method"],
                     "ngdual_s": ngdual and ngdual["time_s"], "p2_s": p2 and p2["time_s"],
                     "ratio_ngdual_p2": (ngdual["time_s"] / p2["time_s"]
-                                        if ngdual and p2 else None)})
+                                        if ngdual and p2 else None),
+                    "fastest_order": higher and higher["method"],
+                    "order_s": higher and higher["time_s"],
+                    "ratio_order_p2": (higher["time_s"] / p2["time_s"]
+                                       if higher and p2 else None)})
     return out
 
 
 def effectivities(rows: list[dict]) -> list[dict]:
     """The pressure goal's estimate / the true pressure error on Gamma_C (the flat punch: on
     its core) per adaptive step (a step that is the pressure reference has none)."""
-    return [{"problem": r["problem"], "step": r["level_or_step"], "ndof": r["ndof"],
+    return [{"problem": r["problem"], "method": r["method"], "step": r["level_or_step"],
+             "ndof": r["ndof"],
              "goal_estimate": r["goal_estimate"], "pressure_l2": r["pressure_l2"],
              "effectivity": r["effectivity"]}
             for r in rows if r.get("effectivity") is not None]
@@ -165,27 +187,42 @@ def budgets(rows: list[dict], references: dict) -> list[dict]:
 
 
 def pivot(table: list[dict], verdict: list[dict]) -> list[dict]:
-    """One row per problem, measure and target: per method "time s (unknowns)" or "-", the
-    ratio fastest ngdual / primal P2 and whether the reference resolves the target."""
+    """One row per problem, measure and target: per method "time s (unknowns)", "-" or
+    "failed: <reason>", the ratios fastest ngdual / primal P2 (all orders, k >= 1) and
+    whether the reference resolves the target."""
     out = []
     for v in verdict:
         key = (v["problem"], v["measure"], v["target"])
         row = {"problem": v["problem"], "measure": v["measure"], "target": v["target"]}
         for r in table:
             if (r["problem"], r["measure"], r["target"]) == key:
-                row[r["method"]] = (None if r["time_s"] is None
-                                    else f"{r['time_s']:.3g} s ({r['ndof']})")
-        row.update(ratio=v["ratio_ngdual_p2"], resolved=v["resolved"])
+                row[r["method"]] = (f"{r['time_s']:.3g} s ({r['ndof']})" if r["time_s"]
+                                    else r["failed"] and r["failed"][:80])
+        row.update(ratio=v["ratio_ngdual_p2"], ratio_order=v["ratio_order_p2"],
+                   resolved=v["resolved"])
         out.append(row)
     return out
+
+
+def curve_style(method: str) -> dict:
+    """The colour of the method's order (:data:`ORDER_COLOURS`; the peers
+    :data:`PEER_COLOURS`), the line style and marker of the method (:data:`METHOD_STYLES`).
+
+    >>> curve_style("adaptive, pressure goal, k = 2")
+    {'color': 'C2', 'ls': '-.', 'marker': 'D', 'ms': 4}
+    """
+    if is_peer(method):
+        ls, marker = METHOD_STYLES["primal"]
+        return {"color": PEER_COLOURS[method], "ls": ls, "marker": marker, "ms": 4}
+    base, _, order = method.partition(", k = ")
+    ls, marker = METHOD_STYLES[base]
+    return {"color": ORDER_COLOURS[int(order or 0)], "ls": ls, "marker": marker, "ms": 4}
 
 
 def _panels(rows: list[dict], references: dict) -> list[dict]:
     """One row per problem: pressure and sigma against wall time and against unknowns."""
     methods = list(dict.fromkeys(r["method"] for r in rows))
-    style = {m: {"color": f"C{i % 10}", "marker": MARKERS[i % len(MARKERS)], "ms": 4,
-                 "ls": ":" if is_peer(m) else ("-" if m == UNIFORM else "--")}
-             for i, m in enumerate(methods)}
+    style = {m: curve_style(m) for m in methods}
     panels = []
     for problem, tp in TRUTH_PROBLEMS.items():
         for measure, ylabel in MEASURES.items():
@@ -226,10 +263,15 @@ def _numbers(verdict: list[dict], effectivity: list[dict], budget: list[dict]) -
             numbers[f"{what}, fastest ngdual / primal P2"] = (
                 f"{v['ratio_ngdual_p2']:.2f} ({v['fastest_ngdual']})"
                 if v["ratio_ngdual_p2"] else "not both reached")
+            numbers[f"{what}, fastest ngdual of order k >= 1 / primal P2"] = (
+                f"{v['ratio_order_p2']:.2f} ({v['fastest_order']}, {v['order_s']:.2f} s)"
+                if v["ratio_order_p2"] else "not both reached")
     for problem in TRUTH_PROBLEMS:
-        eff = [e["effectivity"] for e in effectivity if e["problem"] == problem]
-        if eff:
-            numbers[f"{problem}: pressure goal effectivity range"] = [min(eff), max(eff)]
+        for method in dict.fromkeys(e["method"] for e in effectivity):
+            eff = [e["effectivity"] for e in effectivity
+                   if (e["problem"], e["method"]) == (problem, method)]
+            if eff:
+                numbers[f"{problem}: {method} effectivity range"] = [min(eff), max(eff)]
     for b in budget:
         numbers[f"{b['problem']}: uniform stopped by"] = (
             f"{b['stopped_by']} (level {b['uniform_budget_level']}, "
@@ -274,8 +316,9 @@ def run(ctx):
     # PLOT: one row per problem, pressure and sigma against time and unknowns
     fig = plot.plot_curves(_panels(rows, references),
                            "What accuracy costs: true errors against adaptive references; "
-                           "ngdual uniform and adaptive (stress / pressure goal), primal "
-                           "P1/P2 Nitsche peer", ncols=4, panel_size=(4.4, 3.2),
+                           "ngdual uniform and adaptive (stress / pressure goal) at order "
+                           "k = 0 (blue), 1 (orange), 2 (green), primal P1/P2 Nitsche peer",
+                           ncols=4, panel_size=(4.4, 3.2),
                            figure_legend=True)
     figs = plot.save_figure(fig, ctx.figure_stem("work_precision"))
     ctx.entry(THESIS, "Work-precision: true errors against wall time and unknowns",
@@ -286,8 +329,10 @@ def run(ctx):
                   {"problem": "problem", "measure": "measure", "target": "target",
                    UNIFORM: "uniform", "adaptive, stress goal": "adaptive, stress goal",
                    "adaptive, pressure goal": "adaptive, pressure goal",
+                   **{order_method(m, k): f"{m}, k = {k} (facet)" for k in ORDERS
+                      for m in (UNIFORM, "adaptive, pressure goal")},
                    "primal P1": "primal P1", P2: "primal P2", "ratio": "fastest ngdual / P2",
-                   "resolved": "reference resolves"}),
+                   "ratio_order": "fastest k >= 1 / P2", "resolved": "reference resolves"}),
               notes=f"Machine: {machine['cpus']} cores, load average "
                     f"{machine['load_average'][0]:.1f} at the end; sweep tasks run side by "
                     "side, so times carry that noise. Errors against the adaptive references "

@@ -117,6 +117,18 @@ class Plan:
         problem's ``coarser``, the memory and time budget of uniform refinement."""
         return list(range(1, max(2, self.max_level - TRUTH_PROBLEMS[problem].coarser) + 1))
 
+    def order_levels(self, problem: str, order: int) -> list[int]:
+        """The uniform levels of PEERS_``order`` in the true-error studies: ``order`` fewer
+        than :meth:`truth_levels` (a level of order 2 costs about 6 of order 0), at least
+        level 1."""
+        return list(range(1, max(1, self.truth_levels(problem)[-1] - order) + 1))
+
+    def order_elements(self, problem: str, order: int) -> int:
+        """The budget of the adaptive run of PEERS_``order``: :meth:`reference_elements`
+        / 4^order triangles (an unknown of order k costs about one of order 0, and a
+        triangle of PEERS_2 holds about six times the unknowns of one of PEERS_0)."""
+        return self.reference_elements(problem) // 4 ** order
+
     def reference_elements(self, problem: str) -> int:
         """The budget of an adaptive run of the true-error studies: it stops after the first
         step with this many triangles (those of one uniform level beyond the finest, at most
@@ -181,6 +193,33 @@ PEER_ORDERS = (1, 2)
 # 215 072 gives 1 358 854 in 36 s, 0.25 %, the last k = 0 step of 1 638 430 0.73 %)
 REFERENCE_ORDER = 2
 REFERENCE_ORDER_DOFS = 300_000
+# the higher orders of the true-error studies: PEERS_k with the facet P_k multipliers on the
+# fine edges (k = 0 with the coarse multipliers is the thesis' method), per order the
+# pressure goal's tolerance run and the uniform levels up to Plan.order_levels
+ORDERS = (1, 2)
+
+
+def order_overrides(order: int) -> tuple[str, ...]:
+    """The settings of PEERS_``order`` with the facet multipliers (none at order 0: the
+    thesis' method with its coarse multipliers)."""
+    if order == 0:
+        return ()
+    return (setting("discretisation.order", order),
+            setting("discretisation.multipliers", "facet"))
+
+
+def order_method(method: str, order: int) -> str:
+    """The name of ``method`` ("uniform", "adaptive, pressure goal") at ``order``."""
+    return method if order == 0 else f"{method}, k = {order}"
+
+
+def method_order(method: str) -> tuple[int, str]:
+    """The order k and the multiplier family of a method named by :func:`order_method`;
+    a primal peer: the degree of its displacements and its Nitsche contact."""
+    if method.startswith("primal P"):
+        return int(method.removeprefix("primal P")), "Nitsche"
+    head, _, order = method.rpartition(", k = ")
+    return (int(order), "facet") if head else (0, "coarse")
 
 
 GAP_CASES = {

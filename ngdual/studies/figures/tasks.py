@@ -15,6 +15,7 @@ from .plan import (
     ADAPTIVE_RUNS,
     GAP_CASES,
     MANUFACTURED_CASES,
+    ORDERS,
     PEER_ORDERS,
     REFERENCE_ORDER,
     REFERENCE_ORDER_DOFS,
@@ -23,6 +24,8 @@ from .plan import (
     TRUTH_GOALS,
     TRUTH_PROBLEMS,
     Plan,
+    order_method,
+    order_overrides,
 )
 
 
@@ -93,20 +96,24 @@ def adaptive_task(plan: Plan, problem: str, strategy: str) -> Task:
                 f"{scene} {marking} theta={theta}", 4.0 * refinements)
 
 
-def truth_solve(plan: Plan, problem: str, level: int) -> Task:
-    """A uniform solve of a :data:`TRUTH_PROBLEMS` scene that keeps its sample arrays."""
+def truth_solve(plan: Plan, problem: str, level: int, order: int = 0) -> Task:
+    """A uniform solve of a :data:`TRUTH_PROBLEMS` scene that keeps its sample arrays, by
+    PEERS_``order`` (:func:`~.plan.order_overrides`)."""
     tp = TRUTH_PROBLEMS[problem]
-    return Task("solve", {"scene": tp.scene, "level": level, "overrides": list(tp.overrides),
-                          "fields": False, "samples": True}, f"{tp.scene} L{level} samples",
-                _cost(level + 1, problem == "coulomb"))
+    return Task("solve", {"scene": tp.scene, "level": level,
+                          "overrides": [*tp.overrides, *order_overrides(order)],
+                          "fields": False, "samples": True},
+                f"{tp.scene} L{level} samples" + (f" k={order}" if order else ""),
+                _cost(level + 1 + order, problem == "coulomb"))
 
 
-def truth_adapt(plan: Plan, problem: str, goal: str) -> Task:
+def truth_adapt(plan: Plan, problem: str, goal: str, order: int = 0) -> Task:
     """The adaptive run of a :data:`TRUTH_PROBLEMS` scene aiming at ``goal``
     (:data:`TRUTH_GOALS`; the pressure goal on the problem's ``pressure_window``), keeping
     every step's samples: a tolerance run of :func:`ngdual.afem.adapt` (its theta and
-    initial level) to :data:`REFERENCE_TOL` or the budget :meth:`Plan.reference_elements`,
-    at most :data:`ADAPT_STEPS` solves; the stress goal's steps of at most
+    initial level) of PEERS_``order`` to :data:`REFERENCE_TOL` or the budget
+    :meth:`Plan.reference_elements` (:meth:`Plan.order_elements` at order k), at most
+    :data:`ADAPT_STEPS` solves; the stress goal's steps of at most
     :data:`REFERENCE_ORDER_DOFS` unknowns also by PEERS_k, k = :data:`REFERENCE_ORDER`."""
     from ...afem import THETA_TOL
 
@@ -114,15 +121,18 @@ def truth_adapt(plan: Plan, problem: str, goal: str) -> Task:
     window = tp.pressure_window
     return Task("adapt", {"scene": tp.scene, "marking": "dorfler", "theta": THETA_TOL,
                           "steps": ADAPT_STEPS, "level": None,
-                          "overrides": list(tp.overrides), "snapshots": [], "samples": True,
-                          "max_elements": plan.reference_elements(problem), "goal": goal,
-                          "tol": REFERENCE_TOL,
+                          "overrides": [*tp.overrides, *order_overrides(order)],
+                          "snapshots": [], "samples": True,
+                          "max_elements": (plan.order_elements(problem, order) if order
+                                           else plan.reference_elements(problem)),
+                          "goal": goal, "tol": REFERENCE_TOL,
                           "window": ([-window, window] if window and goal == "pressure"
                                      else None),
                           **({"reference_order": REFERENCE_ORDER,
                               "reference_dofs": REFERENCE_ORDER_DOFS} if goal == "stress"
                              else {})},
-                f"{tp.scene} {goal} goal samples", 2.0 * plan.truth_levels(problem)[-1])
+                f"{tp.scene} {goal} goal samples" + (f" k={order}" if order else ""),
+                2.0 * plan.truth_levels(problem)[-1])
 
 
 def peer_solve(plan: Plan, problem: str, level: int, order: int) -> Task:
@@ -138,11 +148,17 @@ def peer_solve(plan: Plan, problem: str, level: int, order: int) -> Task:
 
 def truth_tasks(plan: Plan, problem: str) -> dict[str, list[Task]]:
     """Every task of the true-error study of one problem, by method: uniform refinement
-    (active set), one adaptive run per goal, the primal peers on the uniform levels."""
+    (active set), one adaptive run per goal, at the orders :data:`~.plan.ORDERS` uniform
+    refinement and the pressure goal's run, the primal peers on the uniform levels."""
     levels = plan.truth_levels(problem)
     out = {"uniform": [truth_solve(plan, problem, lv) for lv in levels]}
     for goal in TRUTH_GOALS:
         out[f"adaptive, {goal} goal"] = [truth_adapt(plan, problem, goal)]
+    for order in ORDERS:
+        out[order_method("uniform", order)] = [truth_solve(plan, problem, lv, order)
+                                               for lv in plan.order_levels(problem, order)]
+        out[order_method("adaptive, pressure goal", order)] = [
+            truth_adapt(plan, problem, "pressure", order)]
     for order in PEER_ORDERS:
         out[f"primal P{order}"] = [peer_solve(plan, problem, lv, order) for lv in levels]
     return out

@@ -1,7 +1,8 @@
 """The true-error studies: every method's solutions against adaptive references.
 
 For each problem of :data:`~ngdual.studies.figures.plan.TRUTH_PROBLEMS` the uniform
-solves, the two adaptive runs (one per goal) and the primal peers are compared with a
+solves, the adaptive runs (one per goal at order 0, the pressure goal's at the orders
+:data:`~ngdual.studies.figures.plan.ORDERS`) and the primal peers are compared with a
 reference per measure: the last step of one of the adaptive runs.
 
 The own error of a run's last step is estimated per measure by Richardson
@@ -9,9 +10,9 @@ The own error of a run's last step is estimated per measure by Richardson
 the distances of the two steps before it, each with about 2x the unknowns of the one
 before (a run that stalls, growing by less than :data:`STALLED` per step, has no
 estimate). Where a run gives no such estimate, two independent solutions stand in for it
-(:func:`three_cornered_hat`): the other run's last step and the finest uniform level, on
-meshes of other families, whose three pairwise distances give each one's error if the
-three errors are orthogonal. The stress goal's steps up to a size are solved again by
+(:func:`three_cornered_hat`): the last step of its :func:`partner` and the finest uniform
+level, on meshes of other families, whose three pairwise distances give each one's error
+if the three errors are orthogonal. The stress goal's steps up to a size are solved again by
 PEERS_2 on their meshes (:func:`order_reference`): their last one is the sigma reference
 where its own error, Richardson from the two before it, is smaller. The reference of a
 measure is the step with the smallest own error, and it resolves the targets at least
@@ -43,7 +44,7 @@ import numpy as np
 from ...io import plain, versions, write_json
 from ..sweep import estimator
 from .numbers import aligned_richardson_check, richardson_check
-from .plan import REFERENCE_ORDER, TRUTH_PROBLEMS
+from .plan import REFERENCE_ORDER, TRUTH_PROBLEMS, method_order
 from .tasks import truth_tasks
 
 if TYPE_CHECKING:
@@ -110,17 +111,19 @@ def _candidates(ctx: Context, problem: str) -> list[tuple[dict, dict]]:
     and ``nested`` (its run's last step is the reference of its goal's measure)."""
     out = []
     for method, tasks in truth_tasks(ctx.plan, problem).items():
+        order, family = method_order(method)
         for task, record in zip(tasks, ctx.compute(tasks)):
             if record is None or record.get("status") != "ok":
-                out.append(({"method": method, "status": (record or {}).get("status",
-                                                                           "missing"),
+                out.append(({"method": method, "order": order, "multipliers": family,
+                             "status": (record or {}).get("status", "missing"),
                              "message": (record or {}).get("message", "")[:200]}, {}))
                 continue
             arrays = ctx.arrays(task)
             if task.kind == "adapt":
                 for r in record["history"]:
                     prefix = f"s{r['step']}_"
-                    out.append(({"method": method, "status": "ok", "level_or_step": r["step"],
+                    out.append(({"method": method, "order": order, "multipliers": family,
+                                 "status": "ok", "level_or_step": r["step"],
                                  "ndof": r["dofs"]["total"], "elements": r["elements"],
                                  "time_s": r["cumulative_s"], "estimator": estimator(r),
                                  "goal_estimate": r["goal_estimate"],
@@ -128,7 +131,8 @@ def _candidates(ctx: Context, problem: str) -> list[tuple[dict, dict]]:
                                 {k[len(prefix):]: v for k, v in arrays.items()
                                  if k.startswith(prefix)}))
             else:
-                out.append(({"method": method, "status": "ok",
+                out.append(({"method": method, "order": order, "multipliers": family,
+                             "status": "ok",
                              "level_or_step": task.params["level"], "ndof": record["ndof"],
                              "time_s": record["timings_s"]["total"],
                              "estimator": estimator(record)}, arrays))
@@ -173,29 +177,49 @@ def three_cornered_hat(d_ab: float, d_ac: float, d_bc: float) -> float | None:
     return math.sqrt(square) if square >= 0 else None
 
 
+def partner(method: str, methods: list[str]) -> str | None:
+    """The run whose last step is the second corner of ``method``'s three-cornered hat:
+    the run of the other goal at the same order, else the first of ``methods`` (ordered by
+    the unknowns of their last steps, largest first) of another goal; None without one. A
+    run of another goal refines elsewhere: its error is the nearest to orthogonal.
+
+    >>> partner("adaptive, pressure goal, k = 2", ["adaptive, stress goal",
+    ...         "adaptive, pressure goal", "adaptive, pressure goal, k = 2"])
+    'adaptive, stress goal'
+    """
+    goal, _, order = method.partition(", k = ")
+    others = [m for m in methods if m.partition(", k = ")[0] != goal]
+    same = [m for m in others if m.partition(", k = ")[2] == order]
+    return (same or others or [None])[0]
+
+
 def _hat_checks(checks: list[dict], runs: dict, uniform: tuple[dict, dict] | None,
                 lam: float, mu: float, window) -> None:
     """Add to every run's check, per measure, ``hat``: its last step's error by
-    :func:`three_cornered_hat` with the other run's last step and the finest uniform
-    solution ``uniform`` (the distances under ``hat_distances``); where the run's Richardson
-    estimate is missing, the hat's becomes its ``overkill_error`` (``estimate`` says
-    which)."""
+    :func:`three_cornered_hat` with the last step of its :func:`partner` run (``partner``)
+    and the finest uniform solution ``uniform`` (the distances under ``hat_distances``);
+    where the run's Richardson estimate is missing, the hat's becomes its
+    ``overkill_error`` (``estimate`` says which)."""
     from ...verification.overkill import true_errors
 
-    if len(runs) != 2 or uniform is None:
+    if uniform is None:
         return
-    (a_row, a), (b_row, b) = (runs[c["method"]][-1] for c in checks)
-    finer = a_row["ndof"] >= b_row["ndof"]
-    d_ab = _measures(true_errors(b, a, lam, mu, window) if finer
-                     else true_errors(a, b, lam, mu, window))
-    d_au, d_bu = (_measures(true_errors(uniform[1], x, lam, mu, window)) for x in (a, b))
-    for check, (d_one, d_other) in zip(checks, ((d_au, d_bu), (d_bu, d_au))):
+    by_size = sorted(runs, key=lambda m: -runs[m][-1][0]["ndof"])
+    for check in checks:
+        other = partner(check["method"], by_size)
+        if other is None:
+            continue
+        (a_row, a), (b_row, b) = runs[check["method"]][-1], runs[other][-1]
+        d_ab = _measures(true_errors(b, a, lam, mu, window) if a_row["ndof"] >= b_row["ndof"]
+                         else true_errors(a, b, lam, mu, window))
+        d_au, d_bu = (_measures(true_errors(uniform[1], x, lam, mu, window)) for x in (a, b))
+        check["partner"] = other
         for measure in TRUE_MEASURES:
-            hat = three_cornered_hat(d_ab[measure], d_one[measure], d_other[measure])
+            hat = three_cornered_hat(d_ab[measure], d_au[measure], d_bu[measure])
             entry = check[measure]
             entry.update(hat=hat, hat_distances={"other_run": d_ab[measure],
-                                                 "uniform": d_one[measure],
-                                                 "other_run_to_uniform": d_other[measure]})
+                                                 "uniform": d_au[measure],
+                                                 "other_run_to_uniform": d_bu[measure]})
             if entry["overkill_error"] is None and hat is not None:
                 entry.update(overkill_error=hat, estimate="three-cornered hat")
 
@@ -336,7 +360,7 @@ def true_error_study(ctx: Context, problem: str) -> dict:
     for row, arrays in candidates:
         if arrays:
             row.update(_measures(distance(arrays, reference, lam, mu, tp.pressure_window)))
-            if (row["method"] == "adaptive, pressure goal" and floor is not None
+            if (row["method"].startswith("adaptive, pressure goal") and floor is not None
                     and row["pressure"] >= floor / RESOLVES):
                 row["effectivity"] = row["goal_estimate"] / row["pressure_l2"]
             if row["method"] != chosen["sigma_energy"]["method"]:
