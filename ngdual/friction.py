@@ -32,7 +32,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from . import peers
-from .contact import ContactBoundary
+from .contact import ContactBoundary, curve_normal
 from .expr import Expression
 from .forms import TRACE_RULES, DiscreteProblem, boundary_regex
 from .geometry import tangent
@@ -168,7 +168,10 @@ def _edge_functionals(problem: DiscreteProblem) -> tuple[sp.csr_matrix, sp.csr_m
     trial = dict(zip(problem.names, fes.TrialFunction()))
     test = space.TestFunction()
     traction = peers.stress_traction(trial["r1"], trial["r2"])
-    n = ngs.specialcf.normal(2)
+    # the facet multipliers' d_C acts with the normal of the boundary curve
+    # (ngdual.forms): the traces measured against the moments t = C^T sigma need the same
+    n = curve_normal(problem.scene, fes.mesh) if problem.spaces.family == "facet" \
+        else ngs.specialcf.normal(2)
     t = tangent(n)
     ds = ngs.ds(definedon=fes.mesh.Boundaries(boundary_regex(problem.scene.labels("contact"))))
     n_edges = len(gamma_c)
