@@ -22,6 +22,7 @@ from ngdual.mesh import build_mesh
 from ngdual.scene import load_scene
 from ngdual.solvers import conforming, solve_problem
 from ngdual.solvers.qp import solve_qp, solve_qp_friction
+from ngdual.solvers.semismooth import semismooth_newton
 from ngdual.solvers.settings import Model, solver_settings
 
 QP_AGREEMENT = 1e-8  # Clarabel's interior point, not polished with friction (measured <= 1.1e-9)
@@ -123,3 +124,63 @@ def test_the_conforming_solver_without_friction_is_the_solution_of_the_qp(order)
     solution = _conforming(problem)
     qp = solve_qp(problem, Model.of(problem.scene))
     assert _relative(solution.x, qp.x) < 1e-9
+
+
+FRICTIONAL_SCENES = ["cattaneo-mindlin", "thesis-3.46-tresca", "thesis-3.46-coulomb",
+                     "thesis-3.46-coulomb-gap0", "thesis-3.46-coulomb-gap-abs",
+                     "thesis-3.46-coulomb-gap-3125"]
+
+
+def _frictional(name: str, order: int, level: int):
+    ends = [] if name == "cattaneo-mindlin" else ["contact.ends='consistent'"]
+    scene = load_scene(name, [f"discretisation.order={order}", *ends])
+    return assemble(scene, build_mesh(scene.geometry, level))
+
+
+@pytest.mark.parametrize("order", [1, 2])
+@pytest.mark.parametrize("name", FRICTIONAL_SCENES)
+def test_every_shipped_frictional_scene_solves_at_order_k_with_quiet_physics_checks(name,
+                                                                                      order):
+    """Both solvers of order k solve every frictional scene on level 1 to round-off (their
+    residuals on K are checked), the same solution (to 1e-8: 1.7e-9 on Cattaneo-Mindlin
+    at k = 2, nu = 0.4999), and no physics check warns."""
+    problem = _frictional(name, order, 1)
+    default = solve_problem(problem)
+    assert default.warnings == []
+    assert _relative(_conforming(problem).x, default.x) < 1e-8
+
+
+@pytest.mark.parametrize("name, order", [("thesis-3.46-coulomb-gap0", 1),
+                                         ("thesis-3.46-coulomb-gap0", 2),
+                                         ("thesis-3.46-coulomb-gap-abs", 1),
+                                         ("thesis-3.46-coulomb-gap-abs", 2),
+                                         ("cattaneo-mindlin", 1)])
+def test_full_contact_and_stick_are_the_solution_of_the_qp(name, order):
+    """g = 0 (a whole side in contact, lambda_n = 0), g = |x| (the contact zone two
+    coefficients wide, both sticking: lambda = 0 on them) and Cattaneo-Mindlin: the default
+    solver and Clarabel's fixed point of Tresca QPs. lambda_n and lambda_t are compared
+    on the displacement scale (lambda_n vanishes on Gamma_C with g = 0); sigma to 1e-5
+    only, the accuracy of the QP, which is not polished with friction: its slip residual
+    on K is 1.1e-7 on g = |x| at k = 1 (the active set's 4.6e-13) and 9.4e-9 on
+    Cattaneo-Mindlin, where nu = 0.4999 turns it into a stress difference of 4.5e-6."""
+    problem = _frictional(name, order, 1)
+    solution = solve_problem(problem)
+    qp = solve_qp_friction(problem, Model.of(problem.scene), tol=1e-9)
+    displacement = np.max(np.abs(qp.x[problem.index("u1", "u2", "lam_n", "lam_t")]))
+    for part in (problem.lam_n, problem.index("lam_t")):
+        assert np.max(np.abs(solution.x[part] - qp.x[part])) < QP_AGREEMENT * displacement
+    assert _relative(solution.x[problem.sigma], qp.x[problem.sigma]) < 1e-5
+
+
+def test_a_side_in_contact_and_sticking_is_solved_with_vanishing_multipliers():
+    """t(z) = b - G z with t_n < 0 and |t_t| < F at z = 0: the solution is z = 0 (contact
+    and stick on every coefficient), which the semismooth Newton method reaches in one
+    step; the round-off of a zero z is no violation of the sign conditions."""
+    rng = np.random.default_rng(3)
+    A = rng.standard_normal((4, 4))
+    G = 1e4 * (A @ A.T + 4 * np.eye(4))
+    b = np.array([-600.0, -640.0, 150.0, -190.0])
+    F = np.array([300.0, 310.0])
+    state = semismooth_newton(G, b, 2, np.diag(F))
+    assert np.max(np.abs(np.concatenate([state.lam_n, state.lam_t]))) < 1e-15
+    assert np.allclose(state.nu, b[2:] / F, rtol=1e-12)
