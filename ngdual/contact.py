@@ -26,6 +26,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .boundary import CoarseMesh, FacetMesh, edge_normals, host_space
+from .boundary.coarse_order import CoarseOrderMesh
 from .expr import Expression
 from .geometry import Side, tangent
 from .scene import Scene, gap_at
@@ -142,7 +143,7 @@ class ContactBoundary:
               space: ngs.FESpace) -> ContactBoundary:
         """Gamma_C from its coarse meshes and the fine trace space (:func:`trace_space`)."""
         vertices, htilde_edge = coarse.fine_edges()
-        if isinstance(coarse, FacetMesh):
+        if isinstance(coarse, (FacetMesh, CoarseOrderMesh)):
             host = coarse.host_dofs(space)
             edge_dofs, bubble_dofs = host[:, :2], host[:, 2:]
         else:
@@ -244,7 +245,12 @@ class ContactBoundary:
             # the facet multipliers: g of the boundary curve interpolated on every fine edge
             return prolongation @ self.coarse.interpolant(
                 lambda points, edges: gap_at(self.scene.contact, *self.on_curve(points, edges)))
-        at_dofs, at_ends = self.gap_at_nodes()
+        if isinstance(self.coarse, CoarseOrderMesh):
+            # degree k + 1 on every h~ edge, g of the boundary curve at its control points
+            at_dofs, at_ends = self.coarse.interpolant(
+                lambda points, edges: gap_at(self.scene.contact, *self.on_curve(points, edges)))
+        else:
+            at_dofs, at_ends = self.gap_at_nodes()
         return prolongation @ at_dofs + end_hats @ at_ends
 
     def on_curve(self, points: np.ndarray, edges: np.ndarray

@@ -26,6 +26,7 @@ import scipy.sparse as sp
 
 from . import peers
 from .boundary import BoundaryMeshes, CoarseMesh, FacetMesh, end_rule, host_space
+from .boundary.coarse_order import CoarseOrderMesh
 from .contact import ContactBoundary, curve_normal, gap_coefficient, trace_space
 from .expr import Expression
 from .geometry import tangent
@@ -137,6 +138,8 @@ class Spaces:
         (the facet multipliers live on the fine edges of ``mesh`` and need none)."""
         if scene.discretisation.family == "facet":
             return cls._facet(scene, mesh)
+        if scene.discretisation.order > 0:
+            return cls._coarse_order(scene, mesh, coarse or BoundaryMeshes.for_scene(scene, mesh))
         comps = peers.peers_spaces(mesh)
         coarse = coarse or BoundaryMeshes.for_scene(scene, mesh)
         neumann = contact = friction = None
@@ -182,6 +185,29 @@ class Spaces:
             gamma_c = ContactBoundary.build(scene, meshes["contact"], None, comps["lam_n"])
         return cls(mesh, comps, meshes.get("neumann"), meshes.get("contact"), None, prolong,
                    end_hats, gamma_c, order, "facet")
+
+    @classmethod
+    def _coarse_order(cls, scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes) -> Spaces:
+        """PEERS_k with the coarse multipliers of degree k + 1 on the h~ meshes
+        (:mod:`ngdual.boundary.coarse_order`), fixed at the fixed ends as the P1 hats are."""
+        order = scene.discretisation.order
+        comps = peers.peers_spaces(mesh, order)
+        meshes, prolong, end_hats = {}, {}, {}
+        for role, names in (("neumann", ("phi1", "phi2")), ("contact", ("lam_t", "lam_n"))):
+            labels = scene.labels(role)
+            if not labels:
+                continue
+            meshes[role] = CoarseOrderMesh.of(getattr(coarse, role), order + 1)
+            space = host_space(mesh, labels, order + 1)
+            p = meshes[role].prolongation(space, labels)
+            ends = meshes[role].prolongation(space, labels, ends=True)
+            for name in names:
+                comps[name], prolong[name], end_hats[name] = space, p, ends
+        gamma_c = None
+        if "contact" in meshes:
+            gamma_c = ContactBoundary.build(scene, meshes["contact"], None, comps["lam_n"])
+        return cls(mesh, comps, meshes.get("neumann"), meshes.get("contact"), None, prolong,
+                   end_hats, gamma_c, order, "coarse")
 
     def coarse_ndof(self, name: str) -> int:
         if name in self.prolongations:
@@ -436,7 +462,7 @@ def _forms(scene: Scene, fes: ngs.FESpace, names: list[str]):
     if "lam_n" in names:
         ds_c = ngs.ds(definedon=mesh.Boundaries(boundary_regex(scene.labels("contact"))),
                       intrules=TRACE_RULES)
-        if scene.discretisation.family == "facet":
+        if scene.discretisation.family == "facet" or scene.discretisation.order > 0:
             # the normal and tangent of the boundary curve, not of its chords (curve_normal)
             n = curve_normal(scene, mesh)
             t = tangent(n)

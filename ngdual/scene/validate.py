@@ -180,8 +180,16 @@ def _validate_discretisation(scene: Scene) -> None:
                                                    "use one of " + ", ".join(MULTIPLIER_FAMILIES))
     problems.raise_any()
     if disc.family == "coarse" and disc.order > 0:
-        problems.add("discretisation.multipliers", f"the coarse multipliers are the thesis' P1 "
-                     f"on h~, of order 0 only; at order {disc.order} use \"facet\" (or \"auto\")")
+        if scene.friction.law != "none":
+            problems.add("friction.law", f"friction at order {disc.order} bounds lambda_t by the "
+                         "normal moments of the facet multipliers on the fine edges; the coarse "
+                         "multipliers of degree k + 1 have no friction bound nu on the h^ mesh "
+                         "of that degree: use discretisation.multipliers = \"facet\" (or "
+                         "\"auto\") for friction at order k")
+        if scene.solver.method == "uzawa":
+            problems.add("solver.method", "the Uzawa algorithms iterate in the P1 metrics of "
+                         "the h~ mesh; the coarse multipliers of order k are solved by "
+                         "\"active-set\" (or \"auto\")")
     if disc.family == "facet":
         if scene.friction.law == "coulomb" and "normal_stress" in _given(scene, "friction"):
             problems.add("friction.normal_stress", "chooses the |sigma_n| of the thesis' "

@@ -221,7 +221,8 @@ def solve_problem(problem: DiscreteProblem, settings: Settings | None = None,
     if start is not None and not isinstance(settings, ActiveSetSettings):
         raise ValueError(f"a warm start is for the active-set method, not "
                          f"{type(settings).__name__}")
-    if isinstance(settings, ActiveSetSettings) and problem.spaces.family == "facet":
+    if isinstance(settings, ActiveSetSettings) and (problem.spaces.family == "facet"
+                                                    or problem.spaces.order > 0):
         solution = hybrid_active_set(problem, settings, start=start)
     elif isinstance(settings, ActiveSetSettings):
         solution = active_set_solve(problem, settings, progress=progress, start=start)
