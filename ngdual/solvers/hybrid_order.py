@@ -38,7 +38,13 @@ gives the Schur complement G on them for free, and the lambda rows of (3.62) rea
 the moments of :mod:`ngdual.solvers.conforming` on every coefficient: the contact and
 friction problem of the semismooth Newton method, on the exact discrete problem (3.62).
 One back substitution, the element solves and one step of iterative refinement against
-the residual of ``problem.K`` (:meth:`OrderHybridSystem.solve`) give every unknown.
+the residual of ``problem.K`` (:meth:`OrderHybridSystem.solve`) give every unknown. G and b
+carry the round-off of the Cholesky factors, which a nearly incompressible body amplifies
+(Cattaneo-Mindlin, nu = 0.4999, k = 1, level 2: the slip residual of the friction law on K
+2.0e-9, its tolerance 1e-9): where the residuals on K are not round-off, b takes the
+difference between the moments on K and t(z), and the contact problem is solved again
+(at most ``CONTACT_REFINEMENTS`` times; once there). The solution is checked on K by
+:func:`~ngdual.solvers.conforming.checked_solution`, as the conforming solver's is.
 
 Where K is singular (a body held by Gamma_C alone floats when nothing touches) H is too,
 and :func:`~ngdual.solvers.conforming.conforming_active_set` solves the problem instead.
@@ -262,16 +268,10 @@ def hybrid_active_set(problem: DiscreteProblem, settings: ActiveSetSettings,
 
     Parameters
     ----------
-    problem : DiscreteProblem
-        An assembled problem with a contact boundary and the facet multipliers.
-    settings : ActiveSetSettings
-        The model (friction law, mu_f) and ``max_iter`` (bound on the Coulomb fixed-point
-        steps).
-    start : ContactStart, optional
-        The multipliers of a coarser solution: the Newton method starts at their values at
-        this problem's control points.
-    tol : float
-        Relative change of F at which the Coulomb fixed point stops (or its round-off).
+    problem, settings, start, tol
+        As for :func:`~ngdual.solvers.conforming.conforming_active_set`: the problem with
+        the facet multipliers, the model and the bound on the Coulomb fixed-point steps, a
+        coarser solution to start the Newton method from, the fixed point's tolerance.
     ordering : {"amd", "metis"}
         Fill-reducing ordering of H.
 
