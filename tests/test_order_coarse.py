@@ -1,0 +1,93 @@
+"""The coarse multipliers of order k: continuous P_{k+1} on h~ in the Bernstein basis
+(``discretisation.multipliers = "coarse"`` at k = 1, 2, :mod:`ngdual.boundary.coarse_order`)."""
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from ngdual.boundary.coarse_order import CoarseOrderMesh
+from ngdual.forms import assemble
+from ngdual.mesh import build_mesh
+from ngdual.scene import SceneError, load_scene
+from ngdual.solvers.conforming import conforming_active_set
+from ngdual.solvers.dispatch import solve_problem
+from ngdual.solvers.qp import solve_qp
+from ngdual.solvers.settings import Model, solver_settings
+
+
+def _scene(name: str, order: int, *more: str):
+    ends = ["contact.ends='consistent'"] if name.startswith("thesis") else []
+    return load_scene(name, [f"discretisation.order={order}",
+                             "discretisation.multipliers='coarse'", *ends, *more])
+
+
+def _problem(name: str, order: int, level: int):
+    scene = _scene(name, order)
+    return scene, assemble(scene, build_mesh(scene.geometry, level))
+
+
+@pytest.mark.parametrize("order", [1, 2])
+def test_the_coarse_bernstein_functions_sum_to_one_and_are_continuous_along_gamma_c(order):
+    """Unknowns and fixed-end coefficients all one give mu = 1 on every fine edge: the
+    Bernstein basis of degree k + 1 is a partition of unity on every h~ edge, and the shared
+    node coefficients make it continuous (P reproduces the constant exactly)."""
+    scene, problem = _problem("thesis-3.46-frictionless", order, 2)
+    spaces = problem.spaces
+    assert isinstance(spaces.contact, CoarseOrderMesh)
+    ones = (spaces.prolongations["lam_n"] @ np.ones(spaces.coarse_ndof("lam_n"))
+            + spaces.end_hats["lam_n"] @ np.ones(spaces.end_hats["lam_n"].shape[1]))
+    means = spaces.gamma_c.hat_means(sp.csr_matrix(ones[:, None])).toarray().ravel()
+    assert np.allclose(means, 1.0, rtol=0, atol=1e-13)
+    # any coefficients: the end value of every fine edge is the start value of the next
+    mu = spaces.prolongations["lam_n"] @ np.random.default_rng(0).random(
+        spaces.coarse_ndof("lam_n"))
+    edge_dofs = spaces.gamma_c.edge_dofs
+    assert np.allclose(mu[edge_dofs[:-1, 1]], mu[edge_dofs[1:, 0]], rtol=0, atol=1e-13)
+    # (k + 1) coefficients per h~ edge, the nodes shared: N_C = (k + 1) n_edges - fixed ends + 1
+    contact = spaces.contact
+    assert spaces.dofs()["C"] == (order + 1) * contact.n_edges + 1 - len(contact.end_points())
+
+
+@pytest.mark.parametrize("order", [1, 2])
+def test_the_gap_interpolant_of_degree_k_plus_1_reproduces_a_polynomial_gap(order):
+    """The gap of Example 3.46 is a polynomial of degree <= 2 in x on the straight Gamma_C:
+    its interpolant of degree k + 1 >= 2 on every h~ edge is the gap itself."""
+    scene, problem = _problem("thesis-3.46-frictionless", order, 2)
+    gamma_c = problem.spaces.gamma_c
+    coefficients = gamma_c.gap_interpolant(problem.spaces.prolongations["lam_n"],
+                                           problem.spaces.end_hats["lam_n"])
+    exact = gamma_c.gap_at_vertices()
+    assert np.allclose(gamma_c.vertex_values(coefficients), exact, rtol=0,
+                       atol=1e-12 * np.max(np.abs(exact)))
+
+
+@pytest.mark.parametrize("name, order, level", [
+    ("thesis-3.46-frictionless", 1, 1), ("thesis-3.46-frictionless", 1, 2),
+    ("thesis-3.46-frictionless", 2, 1), ("thesis-3.46-frictionless", 2, 2),
+    ("hertz-cylinder", 1, 1), ("hertz-cylinder", 2, 1),
+])
+def test_both_active_set_solvers_give_the_qp_solution_with_the_coarse_multipliers(
+        name, order, level):
+    """The hybridised solver (the default), the conforming one and Clarabel's QP solve the
+    same frictionless problem to round-off, with lambda_n >= 0 on the Bernstein unknowns."""
+    scene, problem = _problem(name, order, level)
+    settings = solver_settings(scene)
+    hybrid = solve_problem(problem, settings)
+    conforming = conforming_active_set(problem, settings)
+    qp = solve_qp(problem, Model.of(scene))
+    scale = np.max(np.abs(hybrid.x))
+    assert hybrid.method == "active-set-hybrid"
+    assert np.max(np.abs(hybrid.x - qp.x)) <= 1e-9 * scale
+    assert np.max(np.abs(conforming.x - qp.x)) <= 1e-9 * scale
+    assert max(hybrid.residuals.values()) < 1e-11
+    assert np.min(hybrid.x[problem.lam_n]) >= -1e-12 * np.max(hybrid.x[problem.lam_n])
+
+
+@pytest.mark.parametrize("overrides, field", [
+    (["friction.law='coulomb'", "friction.mu=0.5"], "friction.law"),
+    (["solver.method='uzawa'"], "solver.method"),
+])
+def test_what_the_coarse_multipliers_cannot_solve_at_order_k_is_a_scene_error(overrides, field):
+    with pytest.raises(SceneError) as err:
+        _scene("thesis-3.46-frictionless", 1, *overrides)
+    assert err.value.field == field
