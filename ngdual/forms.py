@@ -5,7 +5,9 @@ lambda_t, lambda_n are assembled in the fine P1 trace spaces and restricted to
 their coarse meshes by the prolongation of :mod:`ngdual.boundary`
 (``K = P^T K_fine P``); at order k (``[discretisation]``) the facet P_k multipliers are
 assembled in the same way on their host space and mapped from their Bernstein
-coefficients (:mod:`ngdual.boundary.facet`). The unknown vector is ordered
+coefficients (:mod:`ngdual.boundary.facet`), and the coarse multipliers of degree k + 1
+from theirs on the h~ mesh (:mod:`ngdual.boundary.coarse_order`). The unknown vector is
+ordered
 
     [sigma | u, eta, phi, lambda_t | lambda_n]
 
@@ -117,8 +119,9 @@ class Spaces:
 
     Building this object assembles nothing: it is all that DOF counting needs. ``order`` is
     the order k of PEERS_k, ``family`` that of the multipliers (``discretisation``: the
-    thesis' P1 on h~, ``"coarse"``, or P_k on the fine edges in the Bernstein basis,
-    ``"facet"``, :mod:`ngdual.boundary.facet`).
+    thesis' P1 on h~ at k = 0 and continuous P_{k+1} on h~ at k >= 1 in the Bernstein basis,
+    ``"coarse"``, :mod:`ngdual.boundary.coarse_order`; or P_k on the fine edges in the
+    Bernstein basis, ``"facet"``, :mod:`ngdual.boundary.facet`).
     """
 
     mesh: ngs.Mesh

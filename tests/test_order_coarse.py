@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
+from ngdual.afem import adapt
 from ngdual.boundary.coarse_order import CoarseOrderMesh
 from ngdual.forms import assemble
 from ngdual.mesh import build_mesh
@@ -91,3 +92,13 @@ def test_what_the_coarse_multipliers_cannot_solve_at_order_k_is_a_scene_error(ov
     with pytest.raises(SceneError) as err:
         _scene("thesis-3.46-frictionless", 1, *overrides)
     assert err.value.field == field
+
+
+@pytest.mark.parametrize("goal", ["stress", "pressure"])
+def test_adapt_runs_with_the_coarse_multipliers_of_order_1_and_keeps_their_mesh_nested(goal):
+    """The adaptive loop carries the h~ mesh over (CoarseMesh.follow) and the estimator and
+    the goal read the multipliers of degree k + 1 through their prolongation."""
+    history = adapt(_scene("hertz-cylinder", 1), steps=2, level=1, goal=goal)
+    assert len(history) == 2
+    assert all(np.isfinite(r["estimator"]) and r["estimator"] > 0 for r in history)
+    assert history[1]["elements"] > history[0]["elements"]

@@ -15,7 +15,8 @@ afresh, which keeps them nested from one adaptive step to the next.
 A coarse P1 function is represented by its values at both ends of every fine boundary
 edge: :meth:`CoarseMesh.p1_prolongation` is the matrix mapping coarse nodal values to the
 coefficients of a fine P1 trace space, through which all forms assembled by NGSolve on the
-fine trace are restricted to the coarse space.
+fine trace are restricted to the coarse space. At order k >= 1 the same coarse meshes carry
+continuous polynomials of degree k + 1 (:mod:`ngdual.boundary.coarse_order`).
 """
 
 from __future__ import annotations
