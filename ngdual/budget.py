@@ -126,7 +126,9 @@ def estimate(geo: Geometry, level: int | None = None, method: str = "auto", orde
                 elements += 4.0 * lengths[label] / h * max(1.0, math.log2(geo.maxh / h))
         elements *= refinements
     unknowns = unknowns_per_element(order) * elements
-    edges = contact_edges(geo, contact, level) if multipliers == "facet" else 0.0
+    # the solvers of order k hold the same arrays for either family (the coarse one's fewer
+    # coefficients per fine edge make this an upper bound for it)
+    edges = contact_edges(geo, contact, level) if multipliers == "facet" or order > 0 else 0.0
     memory = solve_memory(elements, method, order, multipliers, edges)
     mesh_memory = BASE_BYTES + BYTES_PER_ELEMENT_MESH * elements * (
         unknowns_per_element(order) / UNKNOWNS_PER_ELEMENT)
@@ -139,7 +141,7 @@ def solve_memory(elements: float, method: str = "auto", order: int = 0,
     family ``multipliers`` on a mesh of ``elements`` triangles, ``contact_edges`` of whose
     edges lie on Gamma_C (the facet family's condensation holds dense arrays of the
     unknowns times the contact coefficients)."""
-    if multipliers == "facet":
+    if multipliers == "facet" or order > 0:
         unknowns = unknowns_per_element(order) * elements
         dense = 16.0 * unknowns * (order + 1) * contact_edges
         return BASE_BYTES + BYTES_PER_UNKNOWN_CONFORMING[order] * unknowns + dense
