@@ -139,10 +139,8 @@ class Spaces:
     def build(cls, scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes | None = None) -> Spaces:
         """Spaces on ``mesh``; ``coarse`` carries coarse meshes over from an adaptive step
         (the facet multipliers live on the fine edges of ``mesh`` and need none)."""
-        if scene.discretisation.family == "facet":
-            return cls._facet(scene, mesh)
-        if scene.discretisation.order > 0:
-            return cls._coarse_order(scene, mesh, coarse or BoundaryMeshes.for_scene(scene, mesh))
+        if scene.discretisation.family == "facet" or scene.discretisation.order > 0:
+            return cls._order_k(scene, mesh, coarse)
         comps = peers.peers_spaces(mesh)
         coarse = coarse or BoundaryMeshes.for_scene(scene, mesh)
         neumann = contact = friction = None
@@ -168,49 +166,35 @@ class Spaces:
         return cls(mesh, comps, neumann, contact, friction, prolong, end_hats, gamma_c)
 
     @classmethod
-    def _facet(cls, scene: Scene, mesh: ngs.Mesh) -> Spaces:
-        """PEERS_k with the facet P_k multipliers: no end is fixed, so nothing is lifted."""
-        order = scene.discretisation.order
+    def _order_k(cls, scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes | None) -> Spaces:
+        """PEERS_k with the multipliers of its family: the facet P_k on the fine edges (no
+        end is fixed, so nothing is lifted), or the coarse P_{k+1} on the h~ meshes
+        (``coarse``, or grouped afresh), fixed at the fixed ends as the P1 hats are."""
+        order, family = scene.discretisation.order, scene.discretisation.family
         comps = peers.peers_spaces(mesh, order)
+        if family == "coarse":
+            coarse = coarse or BoundaryMeshes.for_scene(scene, mesh)
         meshes, prolong, end_hats = {}, {}, {}
         for role, names in (("neumann", ("phi1", "phi2")), ("contact", ("lam_t", "lam_n"))):
             labels = scene.labels(role)
             if not labels:
                 continue
-            meshes[role] = FacetMesh.on_fine(mesh, labels, order, end_rule(scene, mesh, role))
-            space = host_space(mesh, labels, order)
+            if family == "facet":
+                meshes[role] = FacetMesh.on_fine(mesh, labels, order, end_rule(scene, mesh, role))
+                space = host_space(mesh, labels, order)
+                ends = sp.csr_matrix((space.ndof, 0))
+            else:
+                meshes[role] = CoarseOrderMesh.of(getattr(coarse, role), order + 1)
+                space = host_space(mesh, labels, order + 1)
+                ends = meshes[role].prolongation(space, labels, ends=True)
             p = meshes[role].prolongation(space, labels)
-            for name in names:
-                comps[name], prolong[name] = space, p
-                end_hats[name] = sp.csr_matrix((space.ndof, 0))
-        gamma_c = None
-        if "contact" in meshes:
-            gamma_c = ContactBoundary.build(scene, meshes["contact"], None, comps["lam_n"])
-        return cls(mesh, comps, meshes.get("neumann"), meshes.get("contact"), None, prolong,
-                   end_hats, gamma_c, order, "facet")
-
-    @classmethod
-    def _coarse_order(cls, scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes) -> Spaces:
-        """PEERS_k with the coarse multipliers of degree k + 1 on the h~ meshes
-        (:mod:`ngdual.boundary.coarse_order`), fixed at the fixed ends as the P1 hats are."""
-        order = scene.discretisation.order
-        comps = peers.peers_spaces(mesh, order)
-        meshes, prolong, end_hats = {}, {}, {}
-        for role, names in (("neumann", ("phi1", "phi2")), ("contact", ("lam_t", "lam_n"))):
-            labels = scene.labels(role)
-            if not labels:
-                continue
-            meshes[role] = CoarseOrderMesh.of(getattr(coarse, role), order + 1)
-            space = host_space(mesh, labels, order + 1)
-            p = meshes[role].prolongation(space, labels)
-            ends = meshes[role].prolongation(space, labels, ends=True)
             for name in names:
                 comps[name], prolong[name], end_hats[name] = space, p, ends
         gamma_c = None
         if "contact" in meshes:
             gamma_c = ContactBoundary.build(scene, meshes["contact"], None, comps["lam_n"])
         return cls(mesh, comps, meshes.get("neumann"), meshes.get("contact"), None, prolong,
-                   end_hats, gamma_c, order, "coarse")
+                   end_hats, gamma_c, order, family)
 
     def coarse_ndof(self, name: str) -> int:
         if name in self.prolongations:
