@@ -25,11 +25,13 @@ References: no analytic solution is exact for these finite bodies (the Hertz, Sa
 Cattaneo-Mindlin pressures are half-space formulas), and a uniform overkill two levels
 beyond the budget would not fit. Each adaptive run's last step is the reference of its
 goal's measure (ngdual.studies.figures.truth): per measure the run's last step with the
-smaller own error. A reference's own error is Richardson-estimated from the two steps
+smallest own error. A reference's own error is Richardson-estimated from the two steps
 before it (nested meshes, exact distances); where the steps give no converging sequence,
-by the three-cornered hat: the pairwise distances of the two runs' last steps and the
-finest uniform level, three mesh families whose errors are taken as orthogonal (the JSON's
-``estimate`` says which). A target is resolved when that error is at most a third of it
+by the three-cornered hat: the pairwise distances of the run's last step, the last step of
+a run of the other goal (of the same order, else of order 0) and the finest uniform level,
+three mesh families whose errors are taken as orthogonal (the JSON's ``estimate`` says
+which). The pressure goal's runs of order 1 and 2 are candidates too: their pressure
+converges faster than that of order 0. A target is resolved when that error is at most a third of it
 (the JSON's ``resolves``). Candidates whose meshes are not nested in the reference's
 (uniform, the peers, the other goal's steps) carry a quadrature error; it is measured by
 integrating again on the reference's triangles split in four (``quadrature``).
@@ -113,9 +115,9 @@ def _fastest(table: list[dict], problem: str, measure: str, target: float, which
 
 def verdicts(table: list[dict]) -> list[dict]:
     """Per problem, measure and target: the fastest adaptive run of order 0 against uniform
-    refinement (``adaptive_wins``: it reaches the target first, or uniform does not within its budget)
-    and the fastest ngdual method against the primal P2 peer (``ratio`` = ngdual time / P2
-    time), also among the methods of order k >= 1 (``ratio_order_p2``)."""
+    refinement (``adaptive_wins``: it reaches the target first, or uniform does not within
+    its budget) and the fastest ngdual method against the primal P2 peer (``ratio`` =
+    ngdual time / P2 time), also among the methods of order k >= 1 (``ratio_order_p2``)."""
     out = []
     for problem in TRUTH_PROBLEMS:
         for measure in MEASURES:
