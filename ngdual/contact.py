@@ -12,7 +12,8 @@ estimator read Gamma_C from it instead of deriving it again:
   NGSolve coefficient, at points, and its P1 interpolant g_h on the h~ mesh (the gap of
   ``contact.discrete_gap = "nodal"``), or with the facet multipliers its P_k interpolant on
   every fine edge, taken on the boundary curve the edge is a chord of, along the curve's
-  normal (:meth:`on_curve`, :func:`curve_normal`);
+  normal (:meth:`on_curve`, :func:`curve_normal`), and with the coarse multipliers of order
+  k its P_{k+1} interpolant on every h~ edge, taken on the curve in the same way;
 * the prescribed end values of lambda_n = g - u_n and lambda_t = -u_t where Gamma_C meets
   Gamma_D (``contact.ends = "consistent"``): g - u_D.n and -u_D.t; zero for ``"thesis"``.
 """

@@ -47,6 +47,13 @@ def test_the_coarse_bernstein_functions_sum_to_one_and_are_continuous_along_gamm
     # (k + 1) coefficients per h~ edge, the nodes shared: N_C = (k + 1) n_edges - fixed ends + 1
     contact = spaces.contact
     assert spaces.dofs()["C"] == (order + 1) * contact.n_edges + 1 - len(contact.end_points())
+    # every unknown has a node view: a chain vertex within a fine edge of its control point
+    positions = np.concatenate([contact.dof_positions(c) for c in range(len(contact.chains))])
+    points = np.vstack([chain.path_points[contact.dof_positions(c)]
+                        for c, chain in enumerate(contact.chains)])
+    assert len(positions) == spaces.dofs()["C"]
+    assert np.max(np.linalg.norm(points - contact.node_points(), axis=1)) \
+        <= 0.5 * np.max(spaces.gamma_c.lengths) + 1e-12
 
 
 @pytest.mark.parametrize("order", [1, 2])

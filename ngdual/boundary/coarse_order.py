@@ -98,6 +98,20 @@ class CoarseOrderMesh(CoarseMesh):
     def p1_mass_stiffness(self):
         raise TypeError("the coarse multipliers of order k have no P1 space (CoarseOrderMesh)")
 
+    def dof_positions(self, c: int) -> np.ndarray:
+        """For every unknown of chain c (unknown order) the chain vertex nearest its control
+        point in arc length: the node views of Gamma_C (post-processing, the checks) read
+        the coefficients there, as for the facet family."""
+        p, s, nodes = self.degree, self.chains[c].arclength, self.nodes[c]
+        tables, n, _ = self.numbering()
+        targets = (s[nodes[:-1], None]
+                   + np.arange(p + 1)[None, :] / p * np.diff(s[nodes])[:, None]).ravel()
+        columns = tables[c].ravel()
+        nearest = np.abs(s[None, :] - targets[:, None]).argmin(axis=1)
+        own = columns < n
+        _, first = np.unique(columns[own], return_index=True)
+        return nearest[own][first]
+
     def fine_facets(self) -> FacetMesh:
         """The fine edges of this mesh's chains as the facet mesh of degree p (the host)."""
         return FacetMesh(self.chains, tuple(np.arange(c.n_edges + 1) for c in self.chains),
