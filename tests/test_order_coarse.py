@@ -6,7 +6,9 @@ import pytest
 import scipy.sparse as sp
 
 from ngdual.afem import adapt
+from ngdual.boundary import CoarseMesh
 from ngdual.boundary.coarse_order import CoarseOrderMesh
+from ngdual.boundary.facet import bernstein_values
 from ngdual.forms import assemble
 from ngdual.mesh import build_mesh
 from ngdual.scene import SceneError, load_scene
@@ -14,6 +16,7 @@ from ngdual.solvers.conforming import conforming_active_set
 from ngdual.solvers.dispatch import solve_problem
 from ngdual.solvers.qp import solve_qp
 from ngdual.solvers.settings import Model, solver_settings
+from ngdual.verification.multipliers import coarse_basis
 
 
 def _scene(name: str, order: int, *more: str):
@@ -54,6 +57,28 @@ def test_the_coarse_bernstein_functions_sum_to_one_and_are_continuous_along_gamm
     assert len(positions) == spaces.dofs()["C"]
     assert np.max(np.linalg.norm(points - contact.node_points(), axis=1)) \
         <= 0.5 * np.max(spaces.gamma_c.lengths) + 1e-12
+
+
+@pytest.mark.parametrize("order", [1, 2])
+def test_the_coarse_space_is_the_one_whose_inf_sup_constants_docs_tabulate(order):
+    """The Bernstein unknowns span the same space as the hats and Legendre bubbles of
+    ngdual.verification.multipliers.coarse_basis (built independently, for the inf-sup
+    table of docs/theory/order.md): equal dimensions, and the values of either basis on
+    every fine edge are combinations of the other's."""
+    scene, problem = _problem("thesis-3.46-frictionless", order, 2)
+    mine = problem.spaces.contact
+    basis = coarse_basis(CoarseMesh(mine.chains, mine.nodes, mine.free, mine.breaks), order)
+    n, p = mine.n_coefficients, order + 1
+    t = np.linspace(0, 1, 2 * p + 1)
+    R = mine.restriction()[:, :n].toarray()
+    ours = np.vstack([bernstein_values(p, t) @ R[p_e:p_e + p + 1]
+                      for p_e in range(0, R.shape[0], p + 1)])
+    theirs = np.zeros((len(ours), basis.n_dofs))
+    for e, dofs in enumerate(basis.dofs):
+        theirs[e * len(t):(e + 1) * len(t), dofs] = basis.values(e, t).T
+    assert basis.n_dofs == n
+    rank = np.linalg.matrix_rank
+    assert rank(ours) == rank(theirs) == rank(np.hstack([ours, theirs])) == n
 
 
 @pytest.mark.parametrize("order", [1, 2])
