@@ -318,12 +318,10 @@ def _check_refinement_size(scene: Scene, solution: Solution, marked: np.ndarray,
                            allow_large: bool) -> None:
     """Refuse a refinement of the solution's mesh whose solve would not fit in memory at the
     scene's order k (bisection of the marked triangles and their closure: at most about 4
-    new triangles per marked one, and each edge of Gamma_C bisected at most once)."""
+    new triangles per marked one)."""
     elements = solution.problem.fes.mesh.ne + 4.0 * int(np.sum(marked))
-    gamma_c = solution.problem.spaces.gamma_c
     disc = scene.discretisation
-    need = budget.solve_memory(elements, scene.solver.method, disc.order, disc.family,
-                               2.0 * len(gamma_c) if gamma_c is not None else 0.0)
+    need = budget.solve_memory(elements, scene.solver.method, disc.order, disc.family)
     have = budget.available_memory()
     if need > have and not allow_large:
         raise SceneError("steps", f"the next refinement would have about {elements:.3g} "

@@ -9,10 +9,9 @@ smaller ``side_maxh``), the unknowns of (3.62) at the order k of PEERS_k
 solve. The thesis' pairing (k = 0, coarse multipliers) peaks at about 2.5 kB per unknown
 with the active-set solver (Example 3.46 with Coulomb friction on level 8, 3.9e6 unknowns:
 9 GB) and 8.5 kB with the Uzawa algorithms and their saddle-point factorisation (0.6 GB on
-level 5 and 2.2 GB on level 6). The facet multipliers (every order k >= 1) are solved on
-the conforming K condensed onto Gamma_C (:mod:`ngdual.solvers.conforming`): a sparse LU of
-about :data:`BYTES_PER_UNKNOWN_CONFORMING` per unknown and two dense N x N_C arrays (C and
-K^-1 C), N_C = (k + 1) times the fine edges of Gamma_C (:func:`contact_edges`).
+level 5 and 2.2 GB on level 6). Order k >= 1 and the facet multipliers are solved by the
+hybridised system of order k (:mod:`ngdual.solvers.hybrid_order`), whose peak per unknown
+:data:`BYTES_PER_UNKNOWN_ORDER` grows with the size of its element blocks.
 :func:`check` refuses a run whose estimate exceeds the memory this process may use
 (:func:`available_memory`: the smallest of the machine's available memory, the address
 space left under ``ulimit -v`` and the room left in the process's cgroup), with the
@@ -39,12 +38,12 @@ from .scene import Geometry, Scene, SceneError
 UNKNOWNS_PER_ELEMENT = 7.5    # PEERS_0 (3.61): unknowns_per_element(0)
 # peak of a solve per unknown (factorisation, condensation, records), by solver.method
 BYTES_PER_UNKNOWN = {"auto": 2500.0, "active-set": 2500.0, "uzawa": 8500.0}
-# the sparse LU of the conforming K and the records per unknown, by order k, beyond the
-# dense arrays of the condensation; measured peaks on Example 3.46 without friction
-# (tests/test_budget_order.py): k = 0 level 5 0.65 GB, k = 1 level 4 0.74 GB and level 5
-# 3.04 GB (4.6, 8.2 and 10.1 kB per unknown: the fill of the LU grows with N), k = 2
-# level 4 1.54 GB (10.2 kB)
-BYTES_PER_UNKNOWN_CONFORMING = {0: 5000.0, 1: 10000.0, 2: 11000.0}
+# peak of a solve of order k (or with the facet multipliers) per unknown: the hybridised
+# system of order k; measured peaks of nd.solve on Example 3.46 without friction, consistent
+# ends (tests/test_budget_order.py): k = 0 facet level 5 0.36 GB; k = 1 level 4 0.37 GB,
+# level 5 0.79 GB; k = 2 level 4 0.69 GB, level 5 1.97 GB, level 6 7.9 GB (4.9 kB per
+# unknown); hertz-cylinder k = 2 level 4 3.2-3.4 GB (4.3 kB)
+BYTES_PER_UNKNOWN_ORDER = {0: 2500.0, 1: 3000.0, 2: 5500.0}
 BYTES_PER_ELEMENT_MESH = 2000.0  # mesh and spaces only (``ngdual dofs``)
 BASE_BYTES = 400e6              # Python, NGSolve, SciPy, cvxpy loaded
 
@@ -92,26 +91,11 @@ def _mesh_lengths(geo: Geometry) -> dict[str, float]:
     return lengths
 
 
-def contact_edges(geo: Geometry, labels, level: int | None = None) -> float:
-    """The number of fine edges on the sides ``labels`` (Gamma_C) on ``level``: their length
-    over the mesh size there (1 on level 1 of Example 3.46, else ``side_maxh`` or ``maxh``),
-    halved by every refinement."""
-    level = geo.level if level is None else level
-    lengths = _mesh_lengths(geo)
-    edges = 0.0
-    for label in labels:
-        h = 1.0 if geo.kind == "thesis-3.46" else min(geo.maxh,
-                                                       geo.side_maxh.get(label, geo.maxh))
-        edges += lengths.get(label, 0.0) / h
-    return edges * 2.0 ** min(level - 1, 400)
-
-
 def estimate(geo: Geometry, level: int | None = None, method: str = "auto", order: int = 0,
-             multipliers: str = "coarse", contact=()) -> Estimate:
+             multipliers: str = "coarse") -> Estimate:
     """The predicted size of the mesh of ``geo`` on ``level`` (default: its own level) and
     of a solve with ``method`` (``solver.method``) of PEERS_``order`` with the multiplier
-    family ``multipliers`` (``discretisation.family``: "coarse" or "facet") and Gamma_C on
-    the sides ``contact`` (labels)."""
+    family ``multipliers`` (``discretisation.family``: "coarse" or "facet")."""
     level = geo.level if level is None else level
     refinements = 4.0 ** min(level - 1, 400)  # beyond, the estimate is "too large" anyway
     if geo.kind == "thesis-3.46":
@@ -126,25 +110,19 @@ def estimate(geo: Geometry, level: int | None = None, method: str = "auto", orde
                 elements += 4.0 * lengths[label] / h * max(1.0, math.log2(geo.maxh / h))
         elements *= refinements
     unknowns = unknowns_per_element(order) * elements
-    # the solvers of order k hold the same arrays for either family (the coarse one's fewer
-    # coefficients per fine edge make this an upper bound for it)
-    edges = contact_edges(geo, contact, level) if multipliers == "facet" or order > 0 else 0.0
-    memory = solve_memory(elements, method, order, multipliers, edges)
+    memory = solve_memory(elements, method, order, multipliers)
     mesh_memory = BASE_BYTES + BYTES_PER_ELEMENT_MESH * elements * (
         unknowns_per_element(order) / UNKNOWNS_PER_ELEMENT)
     return Estimate(elements, unknowns, memory, mesh_memory)
 
 
 def solve_memory(elements: float, method: str = "auto", order: int = 0,
-                 multipliers: str = "coarse", contact_edges: float = 0.0) -> float:
+                 multipliers: str = "coarse") -> float:
     """Predicted peak bytes of a solve with ``method`` of PEERS_``order`` with the multiplier
-    family ``multipliers`` on a mesh of ``elements`` triangles, ``contact_edges`` of whose
-    edges lie on Gamma_C (the facet family's condensation holds dense arrays of the
-    unknowns times the contact coefficients)."""
+    family ``multipliers`` on a mesh of ``elements`` triangles (either family at order
+    k >= 1 and the facet family at k = 0: the hybridised system of order k)."""
     if multipliers == "facet" or order > 0:
-        unknowns = unknowns_per_element(order) * elements
-        dense = 16.0 * unknowns * (order + 1) * contact_edges
-        return BASE_BYTES + BYTES_PER_UNKNOWN_CONFORMING[order] * unknowns + dense
+        return BASE_BYTES + BYTES_PER_UNKNOWN_ORDER[order] * unknowns_per_element(order) * elements
     per_unknown = BYTES_PER_UNKNOWN.get(method, max(BYTES_PER_UNKNOWN.values()))
     return BASE_BYTES + per_unknown * UNKNOWNS_PER_ELEMENT * elements
 
@@ -257,11 +235,11 @@ def describe_available(have: float | None = None) -> str:
 
 def check(geo: Geometry, level: int | None = None, field_name: str = "geometry.level",
           allow_large: bool = False, mesh_only: bool = False, method: str = "auto",
-          order: int = 0, multipliers: str = "coarse", contact=()) -> Estimate:
+          order: int = 0, multipliers: str = "coarse") -> Estimate:
     """The estimate of ``geo`` on ``level`` (:func:`estimate`, with ``method``, ``order``,
-    ``multipliers`` and ``contact``); a SceneError naming ``field_name`` if it does not fit
+    ``multipliers``); a SceneError naming ``field_name`` if it does not fit
     in the available memory (unless ``allow_large``)."""
-    size = estimate(geo, level, method, order, multipliers, contact)
+    size = estimate(geo, level, method, order, multipliers)
     need = size.mesh_memory if mesh_only else size.memory
     have = available_memory()
     if need > have and not allow_large:
@@ -270,7 +248,7 @@ def check(geo: Geometry, level: int | None = None, field_name: str = "geometry.l
         if geo.kind == "polygon":
             where += f" with maxh = {geo.maxh:g}" + "".join(
                 f", side_maxh.{label} = {h:g}" for label, h in geo.side_maxh.items())
-            first = estimate(geo, 1, method, order, multipliers, contact)
+            first = estimate(geo, 1, method, order, multipliers)
             if (first.mesh_memory if mesh_only else first.memory) > have:
                 # too fine before any refinement: blame the size that makes it so
                 field_name, remedy = _finest_size(geo)
@@ -283,10 +261,10 @@ def check(geo: Geometry, level: int | None = None, field_name: str = "geometry.l
 def check_scene(scene: Scene, level: int | None = None, field_name: str = "geometry.level",
                 allow_large: bool = False, mesh_only: bool = False) -> Estimate:
     """:func:`check` for the run ``scene`` asks for: its geometry, ``solver.method``, the
-    order k and the multiplier family of ``[discretisation]`` and its Gamma_C."""
+    order k and the multiplier family of ``[discretisation]``."""
     disc = scene.discretisation
     return check(scene.geometry, level, field_name, allow_large, mesh_only,
-                 scene.solver.method, disc.order, disc.family, scene.labels("contact"))
+                 scene.solver.method, disc.order, disc.family)
 
 
 def _finest_size(geo: Geometry) -> tuple[str, str]:

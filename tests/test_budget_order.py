@@ -1,7 +1,6 @@
 """The size of a run at order k (:mod:`ngdual.budget`): the unknowns of PEERS_k per triangle
-counted against NGSolve's spaces, the fine edges of Gamma_C against the assembled
-problem, the memory estimate against the peak of real solves, and the refusal of a level
-that fits at order 0 but not at order 2."""
+counted against NGSolve's spaces, the memory estimate against the peak of real solves, and
+the refusal of a level that fits at order 0 but not at order 2."""
 
 import json
 import subprocess
@@ -12,7 +11,6 @@ import pytest
 import ngdual as nd
 from ngdual import budget, peers
 from ngdual.cli import main
-from ngdual.forms import assemble
 from ngdual.mesh import build_mesh
 from ngdual.scene import Geometry, SceneError
 
@@ -32,29 +30,11 @@ def test_unknowns_per_element_are_those_of_ngsolves_spaces_on_a_large_mesh():
         assert 0 < shares[k, 4] < 0.04 and shares[k, 4] < 0.6 * shares[k, 3], shares
 
 
-@pytest.mark.parametrize("order", [1, 2])
-def test_the_fine_edges_of_gamma_c_are_those_of_the_assembled_problem(order):
-    scene = nd.load_scene("thesis-3.46-frictionless",
-                          [f"discretisation.order={order}", CONSISTENT])
-    problem = nd.solve(scene, 2).problem
-    edges = budget.contact_edges(scene.geometry, scene.labels("contact"), 2)
-    assert len(problem.lam_n) == (order + 1) * edges
-
-
-def test_the_fine_edges_of_an_arc_of_gamma_c_are_counted_from_its_mesh_size():
-    """hertz-cylinder (Gamma_C an arc, netgen, side_maxh): 32.9 estimated, 32 meshed."""
-    scene = nd.load_scene("hertz-cylinder", ["discretisation.order=1"])
-    problem = assemble(scene, build_mesh(scene.geometry, 1))
-    edges = budget.contact_edges(scene.geometry, scene.labels("contact"), 1)
-    assert edges == pytest.approx(len(problem.lam_n) / 2, rel=0.05)
-
-
 def test_a_level_that_fits_at_order_0_is_refused_at_order_2_naming_the_level(monkeypatch):
     scene = nd.load_scene("thesis-3.46-frictionless", [CONSISTENT])
-    sizes = [budget.estimate(scene.geometry, 6, order=k, multipliers=family,
-                             contact=scene.labels("contact")).memory
+    sizes = [budget.estimate(scene.geometry, 6, order=k, multipliers=family).memory
              for k, family in ((0, "coarse"), (2, "facet"))]
-    assert sizes[1] > 10 * sizes[0]
+    assert sizes[1] > 5 * sizes[0]
     monkeypatch.setattr(budget, "available_memory", lambda: 2 * sizes[0])
     with pytest.raises(SceneError) as caught:
         nd.solve(scene, 6, order=2)
@@ -84,15 +64,14 @@ print(json.dumps(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024))
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("order, level", [(1, 4), (2, 4)])
+@pytest.mark.parametrize("order, level", [(1, 4), (1, 5), (2, 4)])
 def test_the_memory_estimate_bounds_the_peak_of_a_solve_at_order_k(order, level):
-    """Measured peaks (Example 3.46 without friction, level 4): k = 1 0.74 GB against an
-    estimate of 0.99 GB, k = 2 1.54 GB against 1.77 GB (k = 1 on level 5, 412 s: 3.04 GB
-    against 3.17 GB)."""
+    """Measured peaks of the hybridised solver (Example 3.46 without friction): k = 1 level
+    4 0.37 GB against an estimate of 0.55 GB, level 5 0.79 GB against 0.99 GB; k = 2
+    level 4 0.69 GB against 0.94 GB."""
     out = subprocess.run([sys.executable, "-c", PEAK.format(order=order, level=level)],
                          capture_output=True, text=True, check=True).stdout
     peak = json.loads(out.strip().splitlines()[-1])
     scene = nd.load_scene("thesis-3.46-frictionless", [CONSISTENT])
-    estimate = budget.estimate(scene.geometry, level, order=order, multipliers="facet",
-                               contact=scene.labels("contact")).memory
+    estimate = budget.estimate(scene.geometry, level, order=order, multipliers="facet").memory
     assert peak <= estimate <= 1.6 * peak, (peak, estimate)
