@@ -1,11 +1,12 @@
-"""The hybridised system at order k: PEERS_k with the facet multipliers as a symmetric positive
-definite matrix whose last unknowns are the contact multipliers.
+"""The hybridised system at order k: PEERS_k with its boundary multipliers as a symmetric
+positive definite matrix whose last unknowns are the contact multipliers.
 
 :mod:`ngdual.solvers.hybrid` hybridises the thesis' method (k = 0, multipliers on the coarse
-h~ mesh). With the facet multipliers (:mod:`ngdual.boundary.facet`) the same construction
-holds at every order k, and is simpler, because the boundary multipliers already live where
+h~ mesh). At every order k with the facet multipliers (:mod:`ngdual.boundary.facet`) the
+same construction holds and is simpler, because the boundary multipliers already live where
 the hybridisation puts its own: on the fine edges, P_k per edge, the space of the normal
-traces of RT_k.
+traces of RT_k. It takes the boundary couplings from K as they are, so the coarse
+multipliers of order k >= 1 (:mod:`ngdual.boundary.coarse_order`) are solved by it too.
 
 The Raviart-Thomas rows of sigma are broken (``problem.broken``,
 :func:`ngdual.forms.broken_peers`: every triangle has its own RT_k functions), and the
@@ -85,12 +86,12 @@ CONTACT_REFINEMENTS = 2  # corrections of b by the moments on K (hybrid_active_s
 
 
 class OrderHybridSystem:
-    """The hybridised system of (3.62) at order k with the facet multipliers, H x_I = r.
+    """The hybridised system of (3.62) at order k, H x_I = r.
 
     Parameters
     ----------
     problem : DiscreteProblem
-        An assembled problem with the facet multipliers (``spaces.family == "facet"``).
+        An assembled problem of order k >= 1, or of order 0 with the facet multipliers.
     friction : bool
         Whether lambda_t is a contact unknown (ordered last with lambda_n) or eliminated
         with the other multipliers (no friction: t_t = 0).
@@ -259,7 +260,7 @@ def _block_inverse(A: sp.csr_matrix, size: int) -> sp.bsr_matrix:
 def hybrid_active_set(problem: DiscreteProblem, settings: ActiveSetSettings,
                       start: ContactStart | None = None, tol: float = COULOMB_FIXED_POINT_TOL,
                       ordering: str = "amd") -> Solution:
-    """Solve (3.62) at order k with the facet multipliers on the hybridised system: one
+    """Solve (3.62) at order k on the hybridised system: one
     Cholesky factorisation, semismooth Newton on the Schur complement of the contact
     multipliers, one back substitution (module docstring).
 
