@@ -20,7 +20,7 @@
 # $h^{k+1}$, i.e. like $N^{-(k+1)/2}$ in the number $N$ of unknowns: refining the mesh
 # buys accuracy at a rate fixed by $k$, raising $k$ changes the rate. One idea: to reach a
 # given accuracy, a higher order needs far fewer unknowns and less time than a finer mesh,
-# although every unknown costs more (denser matrices, the condensation onto $\Gamma_C$).
+# although every unknown costs more (larger element blocks, denser matrices).
 # And why adaptive refinement adds nothing on a smooth solution: the uniform mesh is
 # already optimal for it.
 #
@@ -213,9 +213,9 @@ for k, c in costs.items():
 # The lowest order pays for its accuracy with unknowns: halving its error takes four
 # times as many, so a small target needs a very fine mesh (a 1 % stress error about
 # $10^5$ unknowns). Each order more divides the unknowns needed by a large factor, and
-# the time with them, although an unknown of PEERS$_1$ or PEERS$_2$ costs 3 to 8 times one
-# of PEERS$_0$ on these levels, more on finer ones (denser matrices, and the contact
-# problem condensed onto $\Gamma_C$ with one solve per multiplier in contact). For a rough
+# the time with them, although an unknown of PEERS$_1$ or PEERS$_2$ costs 0.9 to 2.2 times
+# one of PEERS$_0$ (the hybridised system of order $k$ eliminates larger element blocks and
+# factorises a denser matrix; `docs/theory/order.md`). For a rough
 # target, 10 % and more, the lowest order is as cheap as any: order pays where accuracy is
 # asked for.
 #

@@ -61,8 +61,8 @@ for k, rows in runs.items():
 #
 # The $P_0$ multipliers on the fine edges pair with the normal traces of $RT_0$ edge by
 # edge. The stress in the volume hardly changes — its error is that of $RT_0$ — while
-# the solver changes: the facet multipliers are solved on the conforming system,
-# condensed onto $\Gamma_C$, which costs more time than the thesis' hybridised system.
+# the solver changes: the facet multipliers are solved by the hybridised system of order
+# $k$ (`ngdual.solvers.hybrid_order`), the thesis' multipliers by the thesis' one.
 
 # %%
 pairings = {"coarse": study(FACET_LEVELS),
