@@ -322,6 +322,23 @@ class CoarseMesh:
         return mass, stiff
 
 
+class WithoutP1:
+    """A :class:`CoarseMesh` whose multipliers are not the P1 hats on its nodes (the facet
+    multipliers, the coarse ones of degree k + 1): the P1 space of the base class is refused,
+    its own ``prolongation`` maps the unknowns. Listed before :class:`CoarseMesh`."""
+
+    @property
+    def n_p1_dofs(self) -> int:
+        raise TypeError(f"{type(self).__name__} has no coarse P1 space")
+
+    def p1_prolongation(self, edge_dofs, n_fine, ends=False):
+        raise TypeError(f"{type(self).__name__} has no coarse P1 hats; use "
+                        f"{type(self).__name__}.prolongation")
+
+    def p1_mass_stiffness(self):
+        raise TypeError(f"{type(self).__name__} has no coarse P1 space")
+
+
 @dataclass(frozen=True)
 class BoundaryMeshes:
     """The coarse meshes of a scene: h~ on Gamma_N and Gamma_C, h^ on Gamma_C (or None).

@@ -30,12 +30,12 @@ import ngsolve as ngs
 import numpy as np
 import scipy.sparse as sp
 
-from .coarse import CoarseMesh
+from .coarse import CoarseMesh, WithoutP1
 from .facet import FacetMesh, bernstein_values
 
 
 @dataclass(frozen=True)
-class CoarseOrderMesh(CoarseMesh):
+class CoarseOrderMesh(WithoutP1, CoarseMesh):
     """A coarse h~ mesh carrying continuous Bernstein polynomials of degree ``degree`` = k + 1.
 
     The unknowns run chain by chain along the chain: the coefficient of a coarse node that
@@ -86,17 +86,6 @@ class CoarseOrderMesh(CoarseMesh):
     def n_coefficients(self) -> int:
         """The unknowns: the coefficients of the nodes with a dof and the inner ones."""
         return self.numbering()[1]
-
-    @property
-    def n_p1_dofs(self) -> int:
-        raise TypeError("the coarse multipliers of order k have no P1 space (CoarseOrderMesh)")
-
-    def p1_prolongation(self, edge_dofs, n_fine, ends=False):
-        raise TypeError("the coarse multipliers of order k have no P1 hats; use "
-                        "CoarseOrderMesh.prolongation")
-
-    def p1_mass_stiffness(self):
-        raise TypeError("the coarse multipliers of order k have no P1 space (CoarseOrderMesh)")
 
     def dof_positions(self, c: int) -> np.ndarray:
         """For every unknown of chain c (unknown order) the chain vertex nearest its control

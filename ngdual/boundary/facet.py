@@ -33,7 +33,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .chains import EndRule, boundary_chains
-from .coarse import CoarseMesh
+from .coarse import CoarseMesh, WithoutP1
 
 
 def host_space(mesh: ngs.Mesh, labels: list[str], order: int) -> ngs.FESpace:
@@ -63,7 +63,7 @@ def bernstein_values(order: int, t: np.ndarray) -> np.ndarray:
 
 
 @dataclass(frozen=True)
-class FacetMesh(CoarseMesh):
+class FacetMesh(WithoutP1, CoarseMesh):
     """The fine edges of a boundary part as the mesh of the facet P_k multipliers.
 
     A :class:`CoarseMesh` whose edges are the fine edges themselves (every chain vertex is a
@@ -106,17 +106,6 @@ class FacetMesh(CoarseMesh):
         t = control_parameters(self.order)
         edges = np.arange(self.chains[c].n_edges)
         return (edges[:, None] + (t > 0.5)[None, :]).ravel()
-
-    @property
-    def n_p1_dofs(self) -> int:
-        raise TypeError("the facet multipliers have no coarse P1 space (FacetMesh)")
-
-    def p1_prolongation(self, edge_dofs, n_fine, ends=False):
-        raise TypeError("the facet multipliers have no coarse P1 hats; use "
-                        "FacetMesh.prolongation")
-
-    def p1_mass_stiffness(self):
-        raise TypeError("the facet multipliers have no coarse P1 space (FacetMesh)")
 
     def host_dofs(self, space: ngs.FESpace) -> np.ndarray:
         """(n_edges, max(k, 1) + 1) dofs of the host ``space`` on every fine edge, in the order
