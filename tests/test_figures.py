@@ -36,6 +36,7 @@ from ngdual.cli import main
 from ngdual.rates import extrapolated_norms, observed_rates
 from ngdual.scene import load_scene
 from ngdual.studies.figures import Plan, best, errors, markdown_table
+from ngdual.studies.figures.plan import COARSE_ORDER_PROBLEMS
 from ngdual.studies.sweep import Task, estimator, execute, load_record, run_task
 
 SMOKE = "3"     # the smoke run of every script
@@ -175,8 +176,9 @@ def test_a_rerun_computes_nothing(coarse_run, capsys):
 def test_work_precision_measures_true_errors_against_references_it_checks(coarse_run):
     """Every solution of the six problems carries a finite true error against the adaptive
     references (a reference none in its own measure), uniform, both adaptive goals and the
-    primal P1 / P2 peer are there, uniform and the pressure goal at orders 1 and 2 too (a
-    solve of order k that fails is a row with its reason, and so is its table entry), the
+    primal P1 / P2 peer are there, uniform and both goals at orders 1 and 2 too, on the
+    frictionless problems uniform refinement at orders 1 and 2 with the coarse multipliers
+    (a solve of order k that fails is a row with its reason, and so is its table entry), the
     table names every method's order and multiplier family, the uniform stress error falls
     from level to level, a
     reference resolves only targets at least three times its own (Richardson, or the
@@ -201,10 +203,13 @@ def test_work_precision_measures_true_errors_against_references_it_checks(coarse
                 r["problem"], r["method"], r["level_or_step"], key)
     for problem in problems:
         mine = [r for r in rows if r["problem"] == problem]
+        coarse = ({"uniform, k = 1, coarse", "uniform, k = 2, coarse"}
+                  if problem in COARSE_ORDER_PROBLEMS else set())
         assert {r["method"] for r in every if r["problem"] == problem} == {
             "uniform", "adaptive, stress goal", "adaptive, pressure goal", "primal P1",
-            "primal P2", "uniform, k = 1", "adaptive, pressure goal, k = 1", "uniform, k = 2",
-            "adaptive, pressure goal, k = 2"}
+            "primal P2", "uniform, k = 1", "adaptive, stress goal, k = 1",
+            "adaptive, pressure goal, k = 1", "uniform, k = 2", "adaptive, stress goal, k = 2",
+            "adaptive, pressure goal, k = 2", *coarse}
         uniform = [float(r["sigma_energy"]) for r in mine if r["method"] == "uniform"]
         assert len(uniform) >= 2 and all(b < a for a, b in zip(uniform, uniform[1:]))
         for measure in ("pressure", "sigma_energy"):
@@ -236,13 +241,17 @@ def test_work_precision_measures_true_errors_against_references_it_checks(coarse
             "adaptive, pressure goal, k = 1"} <= labels, labels
     table = read_csv(coarse_run / "data" / "work_precision_table.csv")
     assert {(r["order"], r["multipliers"]) for r in table if "primal" not in r["method"]} == {
-        ("0", "coarse"), ("1", "facet"), ("2", "facet")}
+        ("0", "coarse"), ("1", "facet"), ("2", "facet"), ("1", "coarse"), ("2", "coarse")}
     for r in table:
         assert bool(r["failed"]) == any(s["status"] != "ok" for s in every if (
             s["problem"], s["method"]) == (r["problem"], r["method"])), r
     assert not any(r["failed"] for r in table if ", k = " not in r["method"])
     assert any(r["time_s"] != "" and r["order"] == "2" for r in table)
     assert {v["target"] for v in result["verdicts"]} == {0.05, 0.02, 0.01}
+    for v in result["verdicts"]:
+        # the fastest adaptive run of any order is at least as fast as that of order 0
+        if v["adaptive_s"] is not None:
+            assert v["adaptive_any_s"] <= v["adaptive_s"]
 
 
 @pytest.mark.slow

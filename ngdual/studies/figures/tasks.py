@@ -13,6 +13,8 @@ from ..variants import UZAWA, setting
 from .plan import (
     ADAPT_STEPS,
     ADAPTIVE_RUNS,
+    COARSE_ORDER_PROBLEMS,
+    COARSE_ORDERS,
     GAP_CASES,
     MANUFACTURED_CASES,
     ORDERS,
@@ -96,14 +98,16 @@ def adaptive_task(plan: Plan, problem: str, strategy: str) -> Task:
                 f"{scene} {marking} theta={theta}", 4.0 * refinements)
 
 
-def truth_solve(plan: Plan, problem: str, level: int, order: int = 0) -> Task:
+def truth_solve(plan: Plan, problem: str, level: int, order: int = 0,
+                family: str = "facet") -> Task:
     """A uniform solve of a :data:`TRUTH_PROBLEMS` scene that keeps its sample arrays, by
-    PEERS_``order`` (:func:`~.plan.order_overrides`)."""
+    PEERS_``order`` with the multipliers ``family`` (:func:`~.plan.order_overrides`)."""
     tp = TRUTH_PROBLEMS[problem]
     return Task("solve", {"scene": tp.scene, "level": level,
-                          "overrides": [*tp.overrides, *order_overrides(order)],
+                          "overrides": [*tp.overrides, *order_overrides(order, family)],
                           "fields": False, "samples": True},
-                f"{tp.scene} L{level} samples" + (f" k={order}" if order else ""),
+                f"{tp.scene} L{level} samples"
+                + (f" k={order}" if order else "") + (" coarse" if family == "coarse" else ""),
                 _cost(level + 1 + order, problem == "coulomb"))
 
 
@@ -113,8 +117,9 @@ def truth_adapt(plan: Plan, problem: str, goal: str, order: int = 0) -> Task:
     every step's samples: a tolerance run of :func:`ngdual.afem.adapt` (its theta and
     initial level) of PEERS_``order`` to :data:`REFERENCE_TOL` or the budget
     :meth:`Plan.reference_elements` (:meth:`Plan.order_elements` at order k), at most
-    :data:`ADAPT_STEPS` solves; the stress goal's steps of at most
-    :data:`REFERENCE_ORDER_DOFS` unknowns also by PEERS_k, k = :data:`REFERENCE_ORDER`."""
+    :data:`ADAPT_STEPS` solves; below order :data:`REFERENCE_ORDER` the stress goal's steps
+    of at most :data:`REFERENCE_ORDER_DOFS` unknowns also by PEERS_k, k =
+    :data:`REFERENCE_ORDER`."""
     from ...afem import THETA_TOL
 
     tp = TRUTH_PROBLEMS[problem]
@@ -129,8 +134,8 @@ def truth_adapt(plan: Plan, problem: str, goal: str, order: int = 0) -> Task:
                           "window": ([-window, window] if window and goal == "pressure"
                                      else None),
                           **({"reference_order": REFERENCE_ORDER,
-                              "reference_dofs": REFERENCE_ORDER_DOFS} if goal == "stress"
-                             else {})},
+                              "reference_dofs": REFERENCE_ORDER_DOFS}
+                             if goal == "stress" and order < REFERENCE_ORDER else {})},
                 f"{tp.scene} {goal} goal samples" + (f" k={order}" if order else ""),
                 2.0 * plan.truth_levels(problem)[-1])
 
@@ -149,7 +154,10 @@ def peer_solve(plan: Plan, problem: str, level: int, order: int) -> Task:
 def truth_tasks(plan: Plan, problem: str) -> dict[str, list[Task]]:
     """Every task of the true-error study of one problem, by method: uniform refinement
     (active set), one adaptive run per goal, at the orders :data:`~.plan.ORDERS` uniform
-    refinement and the pressure goal's run, the primal peers on the uniform levels."""
+    refinement and both goals' runs, on the frictionless problems
+    :data:`~.plan.COARSE_ORDER_PROBLEMS` uniform refinement at the orders
+    :data:`~.plan.COARSE_ORDERS` with the coarse multipliers, the primal peers on the
+    uniform levels."""
     levels = plan.truth_levels(problem)
     out = {"uniform": [truth_solve(plan, problem, lv) for lv in levels]}
     for goal in TRUTH_GOALS:
@@ -157,8 +165,13 @@ def truth_tasks(plan: Plan, problem: str) -> dict[str, list[Task]]:
     for order in ORDERS:
         out[order_method("uniform", order)] = [truth_solve(plan, problem, lv, order)
                                                for lv in plan.order_levels(problem, order)]
-        out[order_method("adaptive, pressure goal", order)] = [
-            truth_adapt(plan, problem, "pressure", order)]
+        for goal in TRUTH_GOALS:
+            out[order_method(f"adaptive, {goal} goal", order)] = [
+                truth_adapt(plan, problem, goal, order)]
+    for order in COARSE_ORDERS if problem in COARSE_ORDER_PROBLEMS else ():
+        out[order_method("uniform", order, "coarse")] = [
+            truth_solve(plan, problem, lv, order, "coarse")
+            for lv in plan.order_levels(problem, order)]
     for order in PEER_ORDERS:
         out[f"primal P{order}"] = [peer_solve(plan, problem, lv, order) for lv in levels]
     return out
