@@ -141,17 +141,18 @@ def quadrature_bonus(order: int = 0) -> int:
     return 2 * peers.stress_degree("peers", order)
 
 
-def _interpolate(mesh: ngs.Mesh, cfs, order: int = 0) -> list[ngs.GridFunction]:
-    """Element-wise L2 projections onto P_{k+2} (exact for the fields of PEERS_k), to
-    differentiate them."""
-    space = ngs.L2(mesh, order=peers.stress_degree("peers", order))
-    out = []
+def _interpolate(mesh: ngs.Mesh, cf, order: int = 0) -> ngs.GridFunction:
+    """The element-wise L2 projection of the vector-valued ``cf`` onto P_{k+2}^dim (exact for
+    the fields of PEERS_k), to differentiate its components.
+
+    One vector-valued projection evaluates the discrete fields behind ``cf`` once per
+    integration point, where one projection per component evaluated them for each (a fifth
+    of the time for w_h and as(sigma_h); the coefficients differ from those by rounding)."""
+    space = ngs.L2(mesh, order=peers.stress_degree("peers", order), dim=cf.dim)
+    gf = ngs.GridFunction(space)
     with parallel_tasks(mesh):
-        for cf in cfs:
-            gf = ngs.GridFunction(space)
-            gf.Set(cf.Compile())  # the same values, in half the time of the uncompiled tree
-            out.append(gf)
-    return out
+        gf.Set(cf.Compile())
+    return gf
 
 
 def _element_integrals(cf, mesh: ngs.Mesh, bonus: int) -> np.ndarray:
@@ -257,21 +258,23 @@ def estimate(solution: Solution, asymmetry: str = "l2") -> Estimate:
     n = ngs.specialcf.normal(2)
     t = tangent(n)
 
-    # w_h = C^{-1} sigma_h + eta_h and a_h = (sigma_12 - sigma_21) / 2, as P_{k+2} functions
-    # per element
+    # w_h = C^{-1} sigma_h + eta_h (row by row) and a_h = (sigma_12 - sigma_21) / 2, as one
+    # P_{k+2}^5 function per element; grad_w[j, i] is the x_j derivative of its component i
     w_cf = peers.compliance(f.sigma, lam, mu) + ngs.CF((0, f.eta, -f.eta, 0), dims=(2, 2))
-    *w_parts, a = _interpolate(mesh, [w_cf[0, 0], w_cf[0, 1], w_cf[1, 0], w_cf[1, 1],
-                                      0.5 * peers.asym(f.sigma)], order)
-    w = ngs.CF(tuple(w_parts), dims=(2, 2))
-    curl_w = ngs.CF((ngs.grad(w_parts[1])[0] - ngs.grad(w_parts[0])[1],
-                     ngs.grad(w_parts[3])[0] - ngs.grad(w_parts[2])[1]))
+    projected = _interpolate(mesh, ngs.CF((w_cf[0, 0], w_cf[0, 1], w_cf[1, 0], w_cf[1, 1],
+                                           0.5 * peers.asym(f.sigma))), order)
+    w = ngs.CF(tuple(projected[i] for i in range(4)), dims=(2, 2))
+    a = projected[4]
+    grad_w = ngs.grad(projected)
+    curl_w = ngs.CF((grad_w[0, 1] - grad_w[1, 0], grad_w[0, 3] - grad_w[1, 2]))
     body = ngs.CF(tuple(Expression(e).coefficient() for e in scene.loads.body_force))
     residual = body + f.div_sigma
 
     terms = dict.fromkeys(TERMS)
     terms["residual"] = _element_integrals(residual * residual, mesh, bonus)
     as_l2 = 2 * a * a                           # |[[0, a], [-a, 0]]|^2
-    as_div = ngs.grad(a) * ngs.grad(a)          # |div [[0, a], [-a, 0]]|^2 = |grad a|^2
+    grad_a = ngs.CF((grad_w[0, 4], grad_w[1, 4]))
+    as_div = grad_a * grad_a                    # |div [[0, a], [-a, 0]]|^2 = |grad a|^2
     terms["asymmetry"] = _element_integrals(as_l2 + as_div if asymmetry == "hdiv" else as_l2,
                                             mesh, bonus)
     terms["curl"] = h**2 * _element_integrals(curl_w * curl_w, mesh, bonus)
@@ -281,7 +284,8 @@ def estimate(solution: Solution, asymmetry: str = "l2") -> Estimate:
     terms["u_volume"] = h**2 * _element_integrals(ngs.InnerProduct(w_u, w_u), mesh, bonus)
 
     h_int = _interior_edge_lengths(mesh)
-    w_other = ngs.CF(tuple(p.Other() for p in w_parts), dims=(2, 2))
+    other = projected.Other()
+    w_other = ngs.CF(tuple(other[i] for i in range(4)), dims=(2, 2))
     jump = (w - w_other) * t
     terms["jump_interior"] = ngs.Integrate(
         (h_int * (jump * jump)).Compile()

@@ -72,6 +72,23 @@ def parallel_tasks(mesh: ngs.Mesh):
     return ngs.TaskManager() if mesh.ne >= PARALLEL_ELEMENTS else contextlib.nullcontext()
 
 
+@contextlib.contextmanager
+def differentiated_integrands():
+    """NGSolve's symbolic integrators added to a form and assembled inside (both: an integrator
+    made inside and assembled outside gives another matrix) take their element matrices from
+    the derivatives of the integrand with respect to the test functions
+    (``ngsglobals.symbolic_integrator_uses_diff``), instead of evaluating the integrand once
+    per pair of trial and test function components: the broken PEERS block
+    (:func:`broken_peers`) of hertz-cylinder, level 5, assembles in 1.2 s instead of 1.6 s
+    (one thread), to the same bits (every shipped scene at k = 0, hertz-cylinder at k = 1)."""
+    default = ngs.ngsglobals.symbolic_integrator_uses_diff
+    ngs.ngsglobals.symbolic_integrator_uses_diff = True
+    try:
+        yield
+    finally:
+        ngs.ngsglobals.symbolic_integrator_uses_diff = default
+
+
 def peers_form(trial: dict, test: dict, lame: tuple[float, float], order: int = 0,
                family: str = "peers") -> ngs.comp.SumOfIntegrals:
     """The PEERS block of (3.62) on T_h, with its exact volume rule (:func:`volume_rules`):
@@ -273,10 +290,11 @@ def broken_peers(spaces: Spaces, lame: tuple[float, float]) -> BrokenPeers:
              for name in peers.PEERS}
     fes = ngs.FESpace(list(comps.values()))
     a = ngs.BilinearForm(fes)
-    a += peers_form(dict(zip(peers.PEERS, fes.TrialFunction())),
-                    dict(zip(peers.PEERS, fes.TestFunction())), lame, order)
-    with parallel_tasks(mesh):
-        a.Assemble()
+    with differentiated_integrands():
+        a += peers_form(dict(zip(peers.PEERS, fes.TrialFunction())),
+                        dict(zip(peers.PEERS, fes.TestFunction())), lame, order)
+        with parallel_tasks(mesh):
+            a.Assemble()
     edge = _edge_of_broken(spaces.components["r1"], broken_rt) if order == 0 else \
         _restricted_dofs(spaces.components["r1"], broken_rt)
     conforming, offset = [], 0
@@ -293,10 +311,11 @@ def conforming_peers(spaces: Spaces, lame: tuple[float, float], size: int) -> sp
     comps = [spaces.components[name] for name in peers.PEERS]
     fes = ngs.FESpace(comps)
     a = ngs.BilinearForm(fes)
-    a += peers_form(dict(zip(peers.PEERS, fes.TrialFunction())),
-                    dict(zip(peers.PEERS, fes.TestFunction())), lame, spaces.order)
-    with parallel_tasks(spaces.mesh):
-        a.Assemble()
+    with differentiated_integrands():
+        a += peers_form(dict(zip(peers.PEERS, fes.TrialFunction())),
+                        dict(zip(peers.PEERS, fes.TestFunction())), lame, spaces.order)
+        with parallel_tasks(spaces.mesh):
+            a.Assemble()
     K = to_scipy(a.mat).tocoo()
     return sp.csr_matrix((K.data, (K.row, K.col)), shape=(size, size))
 
