@@ -153,9 +153,13 @@ def moved_mesh(mesh: ngs.Mesh, matrix, shift=(0.0, 0.0)) -> ngs.Mesh:
 
 
 def mesh_arrays(mesh: ngs.Mesh) -> tuple[np.ndarray, np.ndarray]:
-    """Vertex coordinates (n, 2) and the vertex numbers of every triangle (ne, 3)."""
-    points = np.array([v.point for v in mesh.vertices])
-    triangles = np.array([[v.nr for v in el.vertices] for el in mesh.Elements(ngs.VOL)])
+    """Vertex coordinates (n, 2) and the vertex numbers of every triangle (ne, 3).
+
+    Read from netgen's arrays (its triangles are NGSolve's elements, in the same order, with
+    1-based vertex numbers): a loop over the elements costs 0.15 s per 50 000 triangles.
+    """
+    points = np.array(mesh.ngmesh.Coordinates(), dtype=float)
+    triangles = mesh.ngmesh.Elements2D().NumPy()["nodes"][:, :3].astype(np.int64) - 1
     return points, triangles
 
 
