@@ -29,11 +29,13 @@ beyond the budget would not fit. Each adaptive run's last step is the reference 
 goal's measure (ngdual.studies.figures.truth): per measure the run's last step with the
 smallest own error. A reference's own error is Richardson-estimated from the two steps
 before it (nested meshes, exact distances); where the steps give no converging sequence,
-by the three-cornered hat: the pairwise distances of the run's last step, the last step of
-a run of the other goal (of the same order, else of order 0) and the finest uniform level,
-three mesh families whose errors are taken as orthogonal (the JSON's ``estimate`` says
-which). The pressure goal's runs of order 1 and 2 are candidates too: their pressure
-converges faster than that of order 0. A target is resolved when that error is at most a third of it
+by the three-cornered hat: the pairwise distances of three solutions whose errors are
+taken as orthogonal (the JSON's ``estimate`` says which) -- for sigma the run's last step,
+the last step of a run of the other goal (of the same order, else of order 0) and the
+finest uniform level; for the pressure the run's last step and the two solutions nearest
+to it among the other runs' last steps and the finest uniform level (corners far from the
+truth would make the hat a difference of large squares). The runs of order 1 and 2 are
+candidates too: their pressure and sigma converge faster than those of order 0. A target is resolved when that error is at most a third of it
 (the JSON's ``resolves``). Candidates whose meshes are not nested in the reference's
 (uniform, the peers, the other goal's steps) carry a quadrature error; it is measured by
 integrating again on the reference's triangles split in four (``quadrature``).

@@ -330,12 +330,19 @@ def true_errors(candidate: dict, reference: dict, lam: float, mu: float,
     quadrature samples in x with arc-length weights (``p_x``, ``p_w``, ``p``: any method)."""
     out = field_errors(candidate, reference, lam, mu)
     if "p" in candidate and "p" in reference:
-        ref = pressure_of(reference)
-        if "p_w" in candidate:
-            x, w, p = candidate["p_x"], candidate["p_w"], candidate["p"]
-        else:
-            x, w, p = nodes_to_samples(candidate["p_nodes"], candidate["p"], ref,
-                                       candidate.get("p_edges"))
-        e = pressure_error(x, w, p, ref, window)
-        out.update(pressure_rel=e["rel"], pressure_l2=e["l2"], pressure_max=e["max"])
+        out.update(pressure_errors(candidate, reference, window))
     return out
+
+
+def pressure_errors(candidate: dict, reference: dict, window: float | None = None) -> dict:
+    """The pressure error of a candidate against a reference (sample arrays, as for
+    :func:`true_errors`) on Gamma_C (on |x| <= ``window``): ``pressure_rel`` (relative
+    L2), ``pressure_l2`` and ``pressure_max`` (:func:`pressure_error`)."""
+    ref = pressure_of(reference)
+    if "p_w" in candidate:
+        x, w, p = candidate["p_x"], candidate["p_w"], candidate["p"]
+    else:
+        x, w, p = nodes_to_samples(candidate["p_nodes"], candidate["p"], ref,
+                                   candidate.get("p_edges"))
+    e = pressure_error(x, w, p, ref, window)
+    return {"pressure_rel": e["rel"], "pressure_l2": e["l2"], "pressure_max": e["max"]}

@@ -1,7 +1,7 @@
 """The true-error studies: every method's solutions against adaptive references.
 
 For each problem of :data:`~ngdual.studies.figures.plan.TRUTH_PROBLEMS` the uniform
-solves, the adaptive runs (one per goal at order 0, the pressure goal's at the orders
+solves, the adaptive runs (one per goal at order 0 and at the orders
 :data:`~ngdual.studies.figures.plan.ORDERS`) and the primal peers are compared with a
 reference per measure: the last step of one of the adaptive runs.
 
@@ -10,9 +10,11 @@ The own error of a run's last step is estimated per measure by Richardson
 the distances of the two steps before it, each with about 2x the unknowns of the one
 before (a run that stalls, growing by less than :data:`STALLED` per step, has no
 estimate). Where a run gives no such estimate, two independent solutions stand in for it
-(:func:`three_cornered_hat`): the last step of its :func:`partner` and the finest uniform
-level, on meshes of other families, whose three pairwise distances give each one's error
-if the three errors are orthogonal. The stress goal's steps up to a size are solved again by
+(:func:`three_cornered_hat`), whose three pairwise distances give each one's error if the
+three errors are orthogonal: for sigma the last step of its :func:`partner` and the finest
+uniform level, on meshes of other families; for the pressure the two solutions nearest to
+it (:func:`nearest_corners`) among the other runs' last steps and the finest uniform
+level. The stress goal's steps up to a size are solved again by
 PEERS_2 on their meshes (:func:`order_reference`): their last one is the sigma reference
 where its own error, Richardson from the two before it, is smaller. The reference of a
 measure is the step with the smallest own error, and it resolves the targets at least
@@ -193,33 +195,69 @@ def partner(method: str, methods: list[str]) -> str | None:
     return (same or others or [None])[0]
 
 
+def pressure_distance(candidate: dict, reference: dict, window: float | None = None
+                      ) -> float:
+    """The relative L2 distance of two solutions' pressures on Gamma_C (on |x| <=
+    ``window``; :func:`ngdual.verification.overkill.pressure_errors`)."""
+    from ...verification.overkill import pressure_errors
+
+    return pressure_errors(candidate, reference, window)["pressure_rel"]
+
+
+def nearest_corners(name: str, names: list[str], distance) -> tuple[str, str] | None:
+    """The two of ``names`` nearest to ``name`` by ``distance(a, b)``, nearest first: the
+    other corners of its three-cornered hat. The nearest solutions are the most accurate
+    ones, so that the hat subtracts squares of small distances (a corner far from the
+    truth makes it the difference of two large, nearly equal squares). None with fewer
+    than three names.
+
+    >>> at = {"a": 0.0, "b": 5.0, "c": 1.0, "d": 2.0}
+    >>> nearest_corners("a", list(at), lambda x, y: abs(at[x] - at[y]))
+    ('c', 'd')
+    """
+    others = sorted((distance(name, m), m) for m in names if m != name)
+    return tuple(m for _, m in others[:2]) if len(others) >= 2 else None
+
+
 def _hat_checks(checks: list[dict], runs: dict, uniform: tuple[dict, dict] | None,
                 lam: float, mu: float, window) -> None:
     """Add to every run's check, per measure, ``hat``: its last step's error by
-    :func:`three_cornered_hat` with the last step of its :func:`partner` run (``partner``)
-    and the finest uniform solution ``uniform`` (the distances under ``hat_distances``);
-    where the run's Richardson estimate is missing, the hat's becomes its
-    ``overkill_error`` (``estimate`` says which)."""
+    :func:`three_cornered_hat` (the distances under ``hat_distances``, the corners under
+    ``corners``); where the run's Richardson estimate is missing, the hat's becomes its
+    ``overkill_error`` (``estimate`` says which). The corners of sigma: the last step of
+    its :func:`partner` run and the finest uniform solution ``uniform``; of the pressure,
+    whose distances cost little: the two :func:`nearest_corners` among the other runs'
+    last steps and ``uniform``."""
     from ...verification.overkill import true_errors
 
     if uniform is None:
         return
     by_size = sorted(runs, key=lambda m: -runs[m][-1][0]["ndof"])
+    last = {**{m: runs[m][-1][1] for m in runs}, "uniform": uniform[1]}
+
+    def sigma(a: str, b: str) -> float:
+        x, y = last[a], last[b]
+        if len(x["triangles"]) < len(y["triangles"]):
+            x, y = y, x
+        return _measures(true_errors(y, x, lam, mu, window))["sigma_energy"]
+
+    def pressure(a: str, b: str) -> float:
+        return pressure_distance(last[a], last[b], window)
+
     for check in checks:
-        other = partner(check["method"], by_size)
-        if other is None:
-            continue
-        (a_row, a), (b_row, b) = runs[check["method"]][-1], runs[other][-1]
-        d_ab = _measures(true_errors(b, a, lam, mu, window) if a_row["ndof"] >= b_row["ndof"]
-                         else true_errors(a, b, lam, mu, window))
-        d_au, d_bu = (_measures(true_errors(uniform[1], x, lam, mu, window)) for x in (a, b))
-        check["partner"] = other
-        for measure in TRUE_MEASURES:
-            hat = three_cornered_hat(d_ab[measure], d_au[measure], d_bu[measure])
+        name = check["method"]
+        other = partner(name, by_size)
+        corners = {"sigma_energy": other and (other, "uniform"),
+                   "pressure": nearest_corners(name, list(last), pressure)}
+        for measure, distance in (("sigma_energy", sigma), ("pressure", pressure)):
+            if corners[measure] is None:
+                continue
+            b, c = corners[measure]
+            d_ab, d_ac, d_bc = distance(name, b), distance(name, c), distance(b, c)
+            hat = three_cornered_hat(d_ab, d_ac, d_bc)
             entry = check[measure]
-            entry.update(hat=hat, hat_distances={"other_run": d_ab[measure],
-                                                 "uniform": d_au[measure],
-                                                 "other_run_to_uniform": d_bu[measure]})
+            entry.update(hat=hat, corners=[b, c],
+                         hat_distances={"to_b": d_ab, "to_c": d_ac, "b_to_c": d_bc})
             if entry["overkill_error"] is None and hat is not None:
                 entry.update(overkill_error=hat, estimate="three-cornered hat")
 
