@@ -146,8 +146,8 @@ def _interpolate(mesh: ngs.Mesh, cf, order: int = 0) -> ngs.GridFunction:
     the fields of PEERS_k), to differentiate its components.
 
     One vector-valued projection evaluates the discrete fields behind ``cf`` once per
-    integration point, where one projection per component evaluated them for each (a fifth
-    of the time for w_h and as(sigma_h); the coefficients differ from those by rounding)."""
+    integration point; a projection per component would evaluate them once per component
+    (five times the work for w_h and as(sigma_h), with coefficients equal to rounding)."""
     space = ngs.L2(mesh, order=peers.stress_degree("peers", order), dim=cf.dim)
     gf = ngs.GridFunction(space)
     with parallel_tasks(mesh):
