@@ -35,10 +35,11 @@ the last step of a run of the other goal (of the same order, else of order 0) an
 finest uniform level; for the pressure the run's last step and the two solutions nearest
 to it among the other runs' last steps and the finest uniform level (corners far from the
 truth would make the hat a difference of large squares). The runs of order 1 and 2 are
-candidates too: their pressure and sigma converge faster than those of order 0. A target is resolved when that error is at most a third of it
-(the JSON's ``resolves``). Candidates whose meshes are not nested in the reference's
-(uniform, the peers, the other goal's steps) carry a quadrature error; it is measured by
-integrating again on the reference's triangles split in four (``quadrature``).
+candidates too: their pressure and sigma converge faster than those of order 0. A target
+is resolved when that error is at most a third of it (the JSON's ``resolves``).
+Candidates whose meshes are not nested in the reference's (uniform, the peers, the other
+runs' steps) carry a quadrature error; it is measured by integrating again on the
+reference's triangles split in four (``quadrature``).
 
 Measures: the relative L2 error of the contact pressure on Gamma_C (ngdual: -sigma_n^h
 projected onto the h~ hats; the peer: its Nitsche pressure; the flat punch: on the core
