@@ -137,12 +137,14 @@ def contact_traces(solution: Solution) -> ContactTraces:
                       else np.zeros(0),
                       hat_projection(means, gamma_c.lengths, s_t) if means.shape[1]
                       else np.zeros(0)]
-    facet = {}
+    # at order k the traces are polynomials of degree k on every fine edge: sampled, for
+    # either multiplier family (the coarse family's multipliers do not live on the fine edges)
+    facet = (dict(zip(("trace_xy", "trace_sigma_n", "trace_sigma_t"), _trace_samples(solution)))
+             if pb.spaces.order > 0 else {})
     if isinstance(contact, FacetMesh):
         projected[:2] = _facet_moments(solution)
         active = in_contact.reshape(-1, contact.order + 1).any(axis=1)
-        facet = dict(zip(("trace_xy", "trace_sigma_n", "trace_sigma_t"),
-                         _trace_samples(solution)), node_kind="control point")
+        facet["node_kind"] = "control point"
     if solution.nu is not None:
         status = friction_diagnostics(solution).node_status
     else:

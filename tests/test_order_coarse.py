@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
+import ngdual as nd
 from ngdual.afem import adapt
 from ngdual.boundary import CoarseMesh
 from ngdual.boundary.coarse_order import CoarseOrderMesh
@@ -142,3 +143,26 @@ def test_adapt_runs_with_the_coarse_multipliers_of_order_1_and_keeps_their_mesh_
     assert len(history) == 2
     assert all(np.isfinite(r["estimator"]) and r["estimator"] > 0 for r in history)
     assert history[1]["elements"] > history[0]["elements"]
+
+
+def test_the_coarse_family_is_measured_by_its_traces_which_converge():
+    """At order k the pressure samples of the coarse family are the traces -sigma_nn^h
+    (4k + 2 per fine edge; its unknowns are Bernstein coefficients on h~, not nodal
+    values), and they approach a finer facet solution of Example 3.46 level by level."""
+    from ngdual.studies.figures.truth import pressure_distance
+    from ngdual.verification.overkill import solution_samples
+
+    def samples(level, family):
+        scene = load_scene("thesis-3.46-frictionless",
+                           ["contact.ends=consistent", f"geometry.level={level}",
+                            "discretisation.order=1", f"discretisation.multipliers={family}"])
+        solution = nd.solve(scene)
+        return solution, solution_samples(solution)
+
+    _, reference = samples(3, "facet")
+    distances = []
+    for level in (1, 2):
+        solution, coarse = samples(level, "coarse")
+        assert len(coarse["p"]) == 6 * len(solution.problem.spaces.gamma_c.lengths)
+        distances.append(pressure_distance(coarse, reference))
+    assert distances[1] < 0.7 * distances[0] and distances[1] < 0.2, distances

@@ -278,8 +278,8 @@ def field_errors(candidate: dict, reference: dict, lam: float, mu: float,
 def solution_samples(solution) -> dict:
     """A discrete ngdual solution as arrays: :func:`element_samples` of sigma (4 components,
     row-major), u and the rotation eta, and the Gamma_C pressure (``p_nodes``, ``p``: P1 on
-    the h~ mesh, with the facet multipliers of order k linear between the trace samples of
-    every fine edge, discontinuous from edge to edge; ``p_edges``: the fine edges of
+    the h~ mesh; at order k >= 1, either multiplier family, linear between the trace samples
+    of every fine edge, discontinuous from edge to edge; ``p_edges``: the fine edges of
     Gamma_C, (m, 2, 2), for the arc-length weights) when the scene has a contact
     boundary."""
     from ..boundary.facet import FacetMesh
@@ -295,9 +295,9 @@ def solution_samples(solution) -> dict:
         # an h~ node with a prescribed lambda (a clamped end of Gamma_C) has no contact
         # condition: its hat moment is the support's reaction, not a pressure; the scenes
         # measured here leave a gap open at their clamped ends, so the pressure there is 0
-        # (the facet multipliers of order k prescribe no value: their profile is the traces)
+        # (at order k the profile is the traces, which no multiplier prescribes)
         coarse = pb.spaces.contact
-        if not isinstance(coarse, FacetMesh):
+        if pb.spaces.order == 0 and not isinstance(coarse, FacetMesh):
             fixed = np.concatenate([
                 [int(q) not in {int(d) for d in coarse.dof_positions(c)}
                  for q in (coarse.nodes[c][:-1] if chain.closed else coarse.nodes[c])]

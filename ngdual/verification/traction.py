@@ -38,7 +38,6 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
-from ..boundary import FacetMesh
 from ..friction import hat_projection
 from ..geometry import tangent
 from ..post import contact_traces, force_balance
@@ -135,12 +134,12 @@ def _plane_coordinate(solution: Solution, points: np.ndarray) -> np.ndarray:
 
 def traction_profile(solution: Solution) -> TractionProfile:
     """The lumped L2 projections of -sigma_n^h and sigma_t^h onto the h~ hats (see the module
-    docstring for why these are the compared tractions); with the facet multipliers of order
-    k the traces themselves (:func:`_facet_profile`)."""
+    docstring for why these are the compared tractions); at order k >= 1 (either multiplier
+    family) the traces themselves (:func:`_facet_profile`)."""
     pb = solution.problem
     gamma_c, coarse = pb.spaces.gamma_c, pb.spaces.contact
     traces = contact_traces(solution)
-    if isinstance(coarse, FacetMesh):
+    if pb.spaces.order > 0:
         return _facet_profile(solution, traces)
     hats = gamma_c.hat_means(pb.spaces.prolongations["lam_n"])          # dof hats
     end_hats = gamma_c.hat_means(pb.spaces.end_hats["lam_n"])           # fixed-end hats
@@ -175,7 +174,9 @@ def traction_profile(solution: Solution) -> TractionProfile:
 def _facet_profile(solution: Solution, traces) -> TractionProfile:
     """The traces -sigma_n^h, sigma_t^h of order k as the profile: the facet multipliers are
     the trace space of RT_k, so the traces are what the contact conditions control, with
-    nothing orthogonal to project away. Linear between the samples of
+    nothing orthogonal to project away; the coarse ones of degree k + 1 control moments on
+    h~ and leave no profile at the h~ nodes (their unknowns are Bernstein coefficients),
+    so they are measured by the same traces. Linear between the samples of
     :func:`ngdual.post.contact_traces` (4k + 2 per fine edge, end points included: exact at
     k <= 1); every edge is a piece of its own (the traces are discontinuous)."""
     pb = solution.problem
