@@ -42,9 +42,9 @@ runs' steps) carry a quadrature error; it is measured by integrating again on th
 reference's triangles split in four (``quadrature``).
 
 Measures: the relative L2 error of the contact pressure on Gamma_C (ngdual: -sigma_n^h
-projected onto the h~ hats; the peer: its Nitsche pressure; the flat punch: on the core
-|x| < a/2, its pressure is not in L2 at the punch edges) and the relative error of sigma in
-the compliance norm (int A tau : tau)^(1/2).
+projected onto the h~ hats at k = 0, the traces -sigma_nn^h at k >= 1; the peer: its
+Nitsche pressure; the flat punch: on the core |x| < a/2, its pressure is not in L2 at the
+punch edges) and the relative error of sigma in the compliance norm (int A tau : tau)^(1/2).
 
 Time: uniform and peer -- the wall time of one solve (mesh, assembly, solve; not the
 estimator); adaptive -- cumulative over all SOLVE-ESTIMATE-MARK-REFINE steps to that mesh.

@@ -65,8 +65,9 @@ class ContactTraces:
     basis functions psi_i over int psi_i ds: what the sign conditions of the facet family
     control. ``sigma_n``, ``sigma_t`` are the means of the P_k traces on the fine edges;
     ``trace_xy``, ``trace_sigma_n``, ``trace_sigma_t`` (n_edges, m) sample the traces
-    themselves along every edge, end points included (None for the thesis' RT_0 traces,
-    constant per edge). ``edge_active``: the edges with an unknown in contact.
+    themselves along every edge, end points included, at every order k >= 1 and with either
+    multiplier family (None at k = 0: the RT_0 traces are constant per edge).
+    ``edge_active``: the edges with an unknown in contact.
     """
 
     edge_xy: np.ndarray
@@ -137,8 +138,8 @@ def contact_traces(solution: Solution) -> ContactTraces:
                       else np.zeros(0),
                       hat_projection(means, gamma_c.lengths, s_t) if means.shape[1]
                       else np.zeros(0)]
-    # at order k the traces are polynomials of degree k on every fine edge: sampled, for
-    # either multiplier family (the coarse family's multipliers do not live on the fine edges)
+    # at order k the traces are polynomials of degree k on every fine edge, sampled for
+    # either multiplier family: the profile of order k is the traces (verification.traction)
     facet = (dict(zip(("trace_xy", "trace_sigma_n", "trace_sigma_t"), _trace_samples(solution)))
              if pb.spaces.order > 0 else {})
     if isinstance(contact, FacetMesh):
