@@ -195,6 +195,15 @@ def partner(method: str, methods: list[str]) -> str | None:
     return (same or others or [None])[0]
 
 
+def same_mesh(a: dict, b: dict) -> bool:
+    """Whether two solutions' sample arrays lie on the same triangles (a run that stopped on
+    the mesh of a uniform level): no quadrature error to measure between them."""
+    return (a["vertices"].shape == b["vertices"].shape
+            and a["triangles"].shape == b["triangles"].shape
+            and np.array_equal(a["vertices"], b["vertices"])
+            and np.array_equal(a["triangles"], b["triangles"]))
+
+
 def pressure_distance(candidate: dict, reference: dict, window: float | None = None
                       ) -> float:
     """The relative L2 distance of two solutions' pressures on Gamma_C (on |x| <=
@@ -208,15 +217,20 @@ def nearest_corners(name: str, names: list[str], distance) -> tuple[str, str] | 
     """The two of ``names`` nearest to ``name`` by ``distance(a, b)``, nearest first: the
     other corners of its three-cornered hat. The nearest solutions are the most accurate
     ones, so that the hat subtracts squares of small distances (a corner far from the
-    truth makes it the difference of two large, nearly equal squares). None with fewer
-    than three names.
+    truth makes it the difference of two large, nearly equal squares). A solution at
+    distance 0 is the same solution (two runs that stopped on the same mesh), no
+    independent corner; the two corners must differ from each other too. None without
+    two such corners.
 
-    >>> at = {"a": 0.0, "b": 5.0, "c": 1.0, "d": 2.0}
+    >>> at = {"a": 0.0, "b": 5.0, "c": 1.0, "d": 2.0, "e": 0.0, "f": 1.0}
     >>> nearest_corners("a", list(at), lambda x, y: abs(at[x] - at[y]))
     ('c', 'd')
     """
     others = sorted((distance(name, m), m) for m in names if m != name)
-    return tuple(m for _, m in others[:2]) if len(others) >= 2 else None
+    first = next((m for d, m in others if d > 0), None)
+    second = next((m for d, m in others if d > 0 and m != first
+                   and distance(first, m) > 0), None)
+    return (first, second) if second is not None else None
 
 
 def _hat_checks(checks: list[dict], runs: dict, uniform: tuple[dict, dict] | None,
@@ -398,10 +412,11 @@ def true_error_study(ctx: Context, problem: str) -> dict:
     for row, arrays in candidates:
         if arrays:
             row.update(_measures(distance(arrays, reference, lam, mu, tp.pressure_window)))
-            if (row["method"].startswith("adaptive, pressure goal") and floor is not None
+            if (row["method"].startswith("adaptive, pressure goal") and floor
                     and row["pressure"] >= floor / RESOLVES):
                 row["effectivity"] = row["goal_estimate"] / row["pressure_l2"]
-            if row["method"] != chosen["sigma_energy"]["method"]:
+            if (row["method"] != chosen["sigma_energy"]["method"]
+                    and not same_mesh(arrays, reference)):
                 crossing[row["method"]] = (row, arrays)     # the finest of each method
         for measure, (ref_row, _) in last.items():
             if row is ref_row:
