@@ -35,6 +35,7 @@ squared error itself.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import math
@@ -46,7 +47,7 @@ import numpy as np
 from ...io import plain, versions, write_json
 from ..sweep import estimator
 from .numbers import aligned_richardson_check, richardson_check
-from .plan import REFERENCE_ORDER, TRUTH_PROBLEMS, method_order
+from .plan import REFERENCE_ORDER, TRUTH_PROBLEMS, method_base, method_order
 from .tasks import truth_tasks
 
 if TYPE_CHECKING:
@@ -189,18 +190,15 @@ def partner(method: str, methods: list[str]) -> str | None:
     ...         "adaptive, pressure goal", "adaptive, pressure goal, k = 2"])
     'adaptive, stress goal'
     """
-    goal, _, order = method.partition(", k = ")
-    others = [m for m in methods if m.partition(", k = ")[0] != goal]
-    same = [m for m in others if m.partition(", k = ")[2] == order]
+    others = [m for m in methods if method_base(m) != method_base(method)]
+    same = [m for m in others if method_order(m) == method_order(method)]
     return (same or others or [None])[0]
 
 
 def same_mesh(a: dict, b: dict) -> bool:
     """Whether two solutions' sample arrays lie on the same triangles (a run that stopped on
     the mesh of a uniform level): no quadrature error to measure between them."""
-    return (a["vertices"].shape == b["vertices"].shape
-            and a["triangles"].shape == b["triangles"].shape
-            and np.array_equal(a["vertices"], b["vertices"])
+    return (np.array_equal(a["vertices"], b["vertices"])
             and np.array_equal(a["triangles"], b["triangles"]))
 
 
@@ -249,12 +247,15 @@ def _hat_checks(checks: list[dict], runs: dict, uniform: tuple[dict, dict] | Non
     by_size = sorted(runs, key=lambda m: -runs[m][-1][0]["ndof"])
     last = {**{m: runs[m][-1][1] for m in runs}, "uniform": uniform[1]}
 
+    # the same pairs come back in later checks (the partner, the finest uniform level)
+    @functools.cache
     def sigma(a: str, b: str) -> float:
         x, y = last[a], last[b]
         if len(x["triangles"]) < len(y["triangles"]):
             x, y = y, x
         return _measures(true_errors(y, x, lam, mu, window))["sigma_energy"]
 
+    @functools.cache
     def pressure(a: str, b: str) -> float:
         return pressure_distance(last[a], last[b], window)
 
