@@ -32,7 +32,8 @@ its goal is the error on a window W of Gamma_C away from the singular points (``
 e.g. the core |x| < a/2 the true errors of :mod:`ngdual.verification.traction` use): the
 edge terms count on the edges in W only, and ``far`` takes the decay of a dipole's traction
 on W, eta_{sigma,T}^2 h_T^2 / ((h_T + d)^2 (h~_W + d)) with d = dist(T, W), h_T the
-element's diameter and h~_W the h~ of the nearest edge of W.
+element's diameter and h~_W the h~ of the nearest edge of W; at order k the power of
+h_T / (h_T + d) is 2 (k + 1).
 """
 
 from __future__ import annotations
@@ -186,21 +187,26 @@ def goal_estimate(solution: Solution, estimated: Estimate,
     if window is None:
         terms["far"] = eta_sigma * h_near / (h_near + distance)**2
     else:
-        terms["far"] = eta_sigma * _dipole_weight(corners, distance, h_near)
+        terms["far"] = eta_sigma * _dipole_weight(corners, distance, h_near, spaces.order)
     # the facet multipliers of order k have their own constant
     return PressureEstimate(terms, size, CALIBRATION_ORDER_K if spaces.family == "facet"
                             else CALIBRATION)
 
 
-def _dipole_weight(corners: np.ndarray, distance: np.ndarray, h_near: np.ndarray
-                   ) -> np.ndarray:
-    """h_T^2 / ((h_T + d)^2 (h~_W + d)) per element (``corners``: ne x 3 x 2), d its
-    distance to the window W: the L2(W) norm^2 of a dipole's traction, (eta_T h_T)^2 d^-3,
-    for an element of diameter h_T far from W; 1 / h~_W on W, as the weight without a
-    window. Outside a window lie singular points of Gamma_C (the punch edges), whose tiny
-    elements the weight h~_W / (h~_W + d)^2 counted as if as large as W's edges."""
+def _dipole_weight(corners: np.ndarray, distance: np.ndarray, h_near: np.ndarray,
+                   order: int = 0) -> np.ndarray:
+    """(h_T / (h_T + d))^(2 (k + 1)) / (h~_W + d) per element (``corners``: ne x 3 x 2), d
+    its distance to the window W, k the ``order`` of PEERS_k: the L2(W) norm^2 of a
+    dipole's traction, (eta_T h_T)^2 d^-3, for an element of diameter h_T far from W at
+    k = 0; 1 / h~_W on W, as the weight without a window. Outside a window lie singular
+    points of Gamma_C (the punch edges), whose tiny elements the weight
+    h~_W / (h~_W + d)^2 counted as if as large as W's edges. At order k the dual weight
+    that the element's residual meets is approximated to h_T^(k+1) by PEERS_k, and the
+    dual solution, smooth away from W, has (k+1)-th derivatives ~ d^-(k+1): k more powers
+    of h_T / d than at k = 0 (docs/theory/estimator.md, "The pressure goal at order k")."""
     h_t = np.max(np.linalg.norm(corners - np.roll(corners, 1, axis=1), axis=2), axis=1)
-    return h_t**2 / ((h_t + distance)**2 * (h_near + distance))
+    power = 2 * (order + 1)   # at k = 0 the dipole's h_T^2, to the bit
+    return h_t**power / ((h_t + distance)**power * (h_near + distance))
 
 
 def _in_window(x: np.ndarray, window: tuple[float, float] | None) -> np.ndarray:
