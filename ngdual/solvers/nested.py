@@ -34,7 +34,6 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 
-import cvxpy as cp
 import numpy as np
 import scipy.sparse as sp
 
@@ -49,6 +48,8 @@ from .uzawa import ContactLoop
 
 def box_projection_qp(c: np.ndarray, mass: np.ndarray) -> np.ndarray:
     """argmin_{|psi_j| <= 1} 1/2 psi^T M psi - c^T psi as a cvxpy QP (Remark 3.44)."""
+    import cvxpy as cp  # 0.9 s to import: only when a QP is solved
+
     psi = cp.Variable(len(c))
     scale = float(mass.max())
     objective = 0.5 * cp.sum(cp.multiply(mass / scale, cp.square(psi))) - (c / scale) @ psi

@@ -25,7 +25,6 @@ E = 2e5 and E = 2e11.
 
 from __future__ import annotations
 
-import cvxpy as cp
 import numpy as np
 import scipy.linalg as sla
 import scipy.optimize as spo
@@ -76,6 +75,8 @@ class NonnegativeProjection:
         self._scale = float(np.max(np.abs(np.diag(self.W))))
         self._root = sla.cholesky(self.W / self._scale, lower=False)
         if solver == "cvxpy":
+            import cvxpy as cp  # 0.9 s to import: only when a QP is solved
+
             n = self.W.shape[0]
             self._chi = cp.Variable(n)
             self._c = cp.Parameter(n)
@@ -93,6 +94,8 @@ class NonnegativeProjection:
         if self.solver == "nnls":
             rhs = sla.solve_triangular(self._root, c / self._scale, trans="T")
             return spo.nnls(self._root, rhs, maxiter=50 * len(c))[0]
+        import cvxpy as cp
+
         self._c.value = c / self._scale
         self._problem.solve(solver=cp.CLARABEL, **CLARABEL_TOLERANCES)
         chi = np.maximum(np.asarray(self._chi.value, dtype=float), 0.0)

@@ -28,7 +28,6 @@ from __future__ import annotations
 import time
 import warnings
 
-import cvxpy as cp
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
@@ -73,6 +72,8 @@ def _solve_qp(problem: DiscreteProblem, modulus: float,
         the equality residual, the three contact residuals of (3.103) and
         ``polished`` (1.0 if the active-set polish was accepted).
     """
+    import cvxpy as cp  # 0.9 s to import: only when a QP is solved
+
     i_sigma, i_mult, i_lam = problem.sigma, problem.mult, problem.lam_n
     A = problem.block(i_sigma, i_sigma)
     B = problem.block(i_sigma, i_mult)
@@ -241,6 +242,8 @@ def contact_qp(G: np.ndarray, b: np.ndarray, Q: np.ndarray, n_c: int
     multipliers of |Q lambda_t| <= s clipped to [-1, 1], or None if Clarabel returns no
     solution. It starts the Newton polish, so it is solved to CLARABEL_TOLERANCES only.
     """
+    import cvxpy as cp  # 0.9 s to import: only when a QP is solved
+
     scale_t = np.max(np.abs(b), initial=0.0) or 1.0
     d = np.sqrt(np.diag(G))
     Gs = G / np.outer(d, d)  # z = y / d: unit diagonal
