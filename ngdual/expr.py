@@ -18,6 +18,7 @@ array([3., 4.])
 from __future__ import annotations
 
 import ast
+import functools
 import math
 import operator
 import sys
@@ -165,6 +166,25 @@ def _ngsolve_namespace() -> dict:
     }
 
 
+@functools.lru_cache(maxsize=1024)
+def _compiled(text: str) -> tuple[float | None, object]:
+    """(the constant value or None, the code object) of a stripped formula, checked; cached
+    by its text: the scene's formulas are read again on every mesh of an adaptive run."""
+    if len(text) > MAX_LENGTH:
+        raise ExpressionError(f"formula too long ({len(text)} characters, at most "
+                              f"{MAX_LENGTH})")
+    try:
+        with warnings.catch_warnings():  # "invalid decimal literal" for 2x: an error below
+            warnings.simplefilter("ignore", SyntaxWarning)
+            tree = ast.parse(text, mode="eval")
+    except SyntaxError as err:
+        raise ExpressionError(f"cannot parse {quote(text)}: {err.msg}") from None
+    except (RecursionError, MemoryError, ValueError):
+        raise ExpressionError(f"formula too large to parse: {quote(text)}") from None
+    _check(tree, text)
+    return _fold(tree, text), compile(tree, "<scene expression>", "eval")
+
+
 @dataclass(frozen=True)
 class Expression:
     """A validated scalar formula in ``x`` and ``y``.
@@ -184,21 +204,10 @@ class Expression:
             raise ExpressionError(f"a formula must be a string or a number, got "
                                   f"{repr(self.text)[:60]}")
         text = str(self.text).strip()
-        if len(text) > MAX_LENGTH:
-            raise ExpressionError(f"formula too long ({len(text)} characters, at most "
-                                  f"{MAX_LENGTH})")
-        try:
-            with warnings.catch_warnings():  # "invalid decimal literal" for 2x: an error below
-                warnings.simplefilter("ignore", SyntaxWarning)
-                tree = ast.parse(text, mode="eval")
-        except SyntaxError as err:
-            raise ExpressionError(f"cannot parse {quote(text)}: {err.msg}") from None
-        except (RecursionError, MemoryError, ValueError):
-            raise ExpressionError(f"formula too large to parse: {quote(text)}") from None
-        _check(tree, text)
-        object.__setattr__(self, "constant", _fold(tree, text))
+        constant, code = _compiled(text)
+        object.__setattr__(self, "constant", constant)
         object.__setattr__(self, "text", text)
-        object.__setattr__(self, "_code", compile(tree, "<scene expression>", "eval"))
+        object.__setattr__(self, "_code", code)
 
     def numpy(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
         """Evaluate at the points ``(x, y)``; returns an array of ``x``'s shape.
