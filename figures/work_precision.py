@@ -146,11 +146,12 @@ def verdicts(table: list[dict]) -> list[dict]:
                 key = (problem, measure, target)
                 uniform = _fastest(table, *key, lambda m: m == UNIFORM)
                 adaptive = _fastest(table, *key, lambda m: m.startswith("adaptive")
-                                    and ", k = " not in m)
+                                    and method_order(m)[0] == 0)
                 uniform_any = _fastest(table, *key, lambda m: method_base(m) == UNIFORM)
                 adaptive_any = _fastest(table, *key, lambda m: m.startswith("adaptive"))
                 ngdual = _fastest(table, *key, lambda m: not is_peer(m))
-                higher = _fastest(table, *key, lambda m: not is_peer(m) and ", k = " in m)
+                higher = _fastest(table, *key,
+                                  lambda m: not is_peer(m) and method_order(m)[0] >= 1)
                 p2 = _fastest(table, *key, lambda m: m == P2)
                 resolved = next(r["resolved"] for r in table if (r["problem"], r["measure"],
                                                                  r["target"]) == key)
