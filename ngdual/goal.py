@@ -194,7 +194,7 @@ def goal_estimate(solution: Solution, estimated: Estimate,
 
 
 def _dipole_weight(corners: np.ndarray, distance: np.ndarray, h_near: np.ndarray,
-                   order: int = 0) -> np.ndarray:
+                   order: int) -> np.ndarray:
     """(h_T / (h_T + d))^(2 (k + 1)) / (h~_W + d) per element (``corners``: ne x 3 x 2), d
     its distance to the window W, k the ``order`` of PEERS_k: the L2(W) norm^2 of a
     dipole's traction, (eta_T h_T)^2 d^-3, for an element of diameter h_T far from W at
