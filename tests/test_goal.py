@@ -270,8 +270,9 @@ def test_the_punch_core_estimate_of_order_k_is_within_a_factor_3_from_the_third_
     (PEERS_k approximates the smooth dual solution to h_T^(k + 1)). Measured against the
     study's reference, k = 1: 4.81, 3.66, 2.49, 1.95, 1.90, 1.64; k = 2: 4.48, 2.51, 1.09,
     0.88; with the dipole weight of k = 0 12.1-4.8 and 28.0-16.9 (docs/theory/estimator.md).
-    The first two solves, on the initial mesh and one step on, overestimate up to 5 times:
-    their tolerance runs stop late, never early."""
+    The first two solves, on the initial mesh and one step on, overestimate up to 5 times
+    (the punch edges' singular triangles carry most of the far field): their tolerance runs
+    stop late, never early."""
     from ngdual.verification.overkill import pressure_errors as sample_pressure_errors
     from ngdual.verification.overkill import solution_samples
 
