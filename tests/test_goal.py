@@ -14,7 +14,8 @@ from ngdual.mesh import build_mesh
 from ngdual.scene import SceneError, SceneTypeError, load_scene
 from ngdual.solvers import solve_on_mesh
 from ngdual.verification.benchmark import center_coordinate, exact_solution
-from ngdual.verification.overkill import nodes_to_samples, pressure_error
+from ngdual.verification.overkill import nodes_to_samples, pressure_error, solution_samples
+from ngdual.verification.overkill import pressure_errors as sample_pressure_errors
 from ngdual.verification.traction import pressure_errors, traction_profile
 
 
@@ -273,9 +274,6 @@ def test_the_punch_core_estimate_of_order_k_is_within_a_factor_3_from_the_third_
     The first two solves, on the initial mesh and one step on, overestimate up to 5 times
     (the punch edges' singular triangles carry most of the far field): their tolerance runs
     stop late, never early."""
-    from ngdual.verification.overkill import pressure_errors as sample_pressure_errors
-    from ngdual.verification.overkill import solution_samples
-
     scene = load_scene("flat-punch", [f"discretisation.order={order}",
                                       "discretisation.multipliers=facet"])
     steps = []
