@@ -197,9 +197,26 @@ def check_order_against_mesh_size(r: dict) -> None:
         assert kept["sigma"][-1] < kept["sigma"][0] and kept["ndof"][-1] > kept["ndof"][0], k
 
 
+
+def check_goal_and_tolerance(r: dict) -> None:
+    """Both goals stop by the tolerance; the pressure goal refines along Gamma_C, reaches a
+    smaller true pressure error than uniform refinement with fewer unknowns, and its
+    estimate is within a factor 4 of the true error on the steps above the reference's
+    accuracy."""
+    runs, uniform = r["runs"], r["uniform"]
+    assert all(run["stopped_by"] == "tol" for run in runs.values()), runs
+    pressure, stress = runs["pressure"], runs["stress"]
+    assert r["near_contact"]["pressure"] > 1.5 * r["near_contact"]["stress"], r["near_contact"]
+    assert pressure["error"][-1] < 3 * r["tol"], pressure["error"]
+    assert pressure["error"][-1] < stress["error"][-1]
+    finest = uniform[-1]
+    assert pressure["error"][-1] < finest["error"] and pressure["ndof"][-1] < 2 * finest["ndof"]
+    assert all(0.25 <= e <= 4 for e in r["effectivity"]), r["effectivity"]
+
 CHECKS = {1: check_peers_spaces, 2: check_locking, 3: check_signorini_uzawa,
           4: check_friction, 5: check_friction_inf_sup, 6: check_estimator,
-          7: check_adaptivity, 8: check_your_own_scene, 9: check_order_against_mesh_size}
+          7: check_adaptivity, 8: check_your_own_scene, 9: check_order_against_mesh_size,
+          10: check_goal_and_tolerance}
 
 
 def check_solutions(number: int, r: dict) -> None:
@@ -252,6 +269,14 @@ def check_solutions(number: int, r: dict) -> None:
         assert r["touching"]["0.95"] == 0 and r["touching"]["1.05"] >= 1, r["touching"]
         assert sorted(r["arch_errors"].values()) == ["contact.ends", "geometry.points"]
         assert r["arch_contact"] >= 1
+    elif number == 10:
+        assert r["window"]["stopped_by"] == "tol" and r["window"]["core_share"] >= 0.5
+        assert min(r["no_window_estimates"]) > 0.05                 # not in L2: no decay
+        assert all(o["stopped_by"] == "tol" for o in r["orders"].values()), r["orders"]
+        assert r["orders"]["2"]["ndof"] < r["orders"]["0"]["ndof"]
+        growth = r["growth"]
+        assert growth["0.5"]["solves"] > growth["0.8"]["solves"] >= growth["0.95"]["solves"]
+        assert growth["0.5"]["growth"] < growth["0.8"]["growth"] < growth["0.95"]["growth"]
     elif number == 9:
         for k, observed in r["orders"].items():
             assert abs(observed["u"] - (int(k) + 1)) <= 0.2, r["orders"]
@@ -263,7 +288,7 @@ def check_solutions(number: int, r: dict) -> None:
 
 def test_tutorials_are_found_and_numbered():
     numbers = [t.number for t in TUTORIALS]
-    assert set(numbers) == set(range(1, 10)) and numbers == sorted(set(numbers))
+    assert set(numbers) == set(range(1, 11)) and numbers == sorted(set(numbers))
 
 
 def test_every_tutorial_has_a_check_and_solutions():
