@@ -110,8 +110,9 @@ def hertz_pressure_error(solution) -> float:
 @pytest.mark.slow
 def test_the_pressure_goal_of_order_1_stops_below_one_percent_on_hertz():
     """adapt(hertz, goal="pressure", tol=0.01) at k = 1 stops at a true pressure error below
-    1 % (measured: 0.93 % after 7 solves), its estimate within a factor 3.5 of the error on
-    the way (CALIBRATION_ORDER_K; measured 0.45-3.2)."""
+    1 % (measured: 0.78 % after 8 solves), its estimate within [0.5, 2.5] times the error on
+    the way (CALIBRATION_ORDER_K and the vertex jumps; measured 0.81-1.57, 0.45-3.2 without
+    the jumps)."""
     scene = load_scene("hertz-cylinder", ["discretisation.order=1"])
     errors = []
     history = adapt(scene, goal="pressure", tol=0.01,
@@ -122,4 +123,4 @@ def test_the_pressure_goal_of_order_1_stops_below_one_percent_on_hertz():
           f"{np.round(effectivity, 2).tolist()}")
     assert history[-1]["stopped_by"] == "tol"
     assert errors[-1] < 0.01
-    assert 1 / 3.5 <= min(effectivity) and max(effectivity) <= 3.5
+    assert 0.5 <= min(effectivity) and max(effectivity) <= 2.5
