@@ -281,8 +281,10 @@ def _vertex_jumps(p: ngs.CoefficientFunction, mesh: ngs.Mesh, gamma_c) -> np.nda
     nr = np.array([number[frozenset(pair)] for pair in gamma_c.vertices.tolist()])
     start = np.vstack([chain.path_points[:-1] for chain in gamma_c.coarse.chains])
     # which end of a segment's reference interval is its fine edge's start
-    first = (np.linalg.norm(at[nr, 0] - start, axis=1)
-             < np.linalg.norm(at[nr, 1] - start, axis=1))
+    off = np.linalg.norm(at[nr] - start[:, None, :], axis=2)
+    if np.any(off.min(axis=1) > 1e-8 * gamma_c.lengths):
+        raise RuntimeError("NGSolve's boundary elements are not netgen's segments")
+    first = off[:, 0] < off[:, 1]
     p_start = np.where(first, values[nr, 0], values[nr, 1])
     p_end = np.where(first, values[nr, 1], values[nr, 0])
     out, offset = np.zeros(len(nr)), 0

@@ -304,3 +304,45 @@ def test_a_one_percent_pressure_tolerance_with_clamped_ends_stops_by_itself(name
     assert history[-1]["stopped_by"] == "tol"
     dofs = [r["dofs"]["total"] for r in history]
     assert all(b >= 1.2 * a for a, b in zip(dofs, dofs[1:]))
+
+
+def test_the_vertex_jumps_of_the_order_k_pressure_are_those_read_on_each_side():
+    """goal._vertex_jumps reads p_h at both ends of every Gamma_C segment without a point
+    search; against p_h read by NGSolve's point search a thousandth of an edge from every
+    interior vertex on either side (p_h is P_1 on every edge: the offset moves it by a
+    thousandth of its change along the edge)."""
+    from ngdual.goal import _pressure, _vertex_jumps
+
+    scene = load_scene("hertz-cylinder", ["discretisation.order=1"])
+    mesh = build_mesh(scene.geometry, 2)
+    solution = solve_on_mesh(scene, mesh)
+    gamma_c = solution.problem.spaces.gamma_c
+    p = _pressure(solution)
+    got = _vertex_jumps(p, mesh, gamma_c)
+    expected, offset = np.zeros(len(gamma_c)), 0
+    for chain in gamma_c.coarse.chains:
+        pts = chain.path_points
+        vertex = pts[1:-1]
+        sides = [vertex + 1e-3 * (pts[:-2] - vertex), vertex + 1e-3 * (pts[2:] - vertex)]
+        before, after = (np.asarray(p(mesh(q[:, 0], q[:, 1], VOL_or_BND=ngs.BND))).ravel()
+                         for q in sides)
+        jump2 = (after - before)**2
+        lengths = gamma_c.lengths[offset:offset + chain.n_edges]
+        expected[offset:offset + chain.n_edges - 1] += 0.5 * lengths[:-1] * jump2
+        expected[offset + 1:offset + chain.n_edges] += 0.5 * lengths[1:] * jump2
+        offset += chain.n_edges
+    assert expected.max() > 0
+    assert np.allclose(got, expected, rtol=0.05, atol=1e-6 * expected.max())
+
+
+def test_the_pressure_goal_has_no_jump_term_at_order_0_and_one_at_order_1(hertz):
+    """At k = 0 p_h is the hat projection, continuous along a chain: ``jump`` is zero and the
+    estimate that of the other terms; at k = 1 the trace jumps inside the contact zone."""
+    mesh = build_mesh(hertz.geometry, 2)
+    for order, has_jumps in ((0, False), (1, True)):
+        scene = load_scene("hertz-cylinder", [f"discretisation.order={order}"])
+        solution = solve_on_mesh(scene, mesh)
+        summed = goal_estimate(solution, estimate(solution)).summed()
+        assert (summed["jump"] > 0.05 * max(summed.values())) is has_jumps
+        if not has_jumps:
+            assert summed["jump"] == 0.0
