@@ -336,3 +336,26 @@ def test_dependent_stick_rows_leave_z_unique():
     Q = np.vstack([Q, Q[:1]])
     sol = semismooth_newton(G, b, 8, Q * 1e3)
     assert max(kkt_residuals(G, b, Q * 1e3, sol.lam_n, sol.lam_t, sol.nu).values()) <= 1e-10
+
+
+def test_the_solvers_blas_limit_covers_every_blas_the_process_has_loaded():
+    """blas_threads() scans the BLAS libraries once (threadpoolctl's scan costs about 1.4 ms,
+    twice per solve), after loading cvxopt's own; inside it every BLAS threadpoolctl finds
+    now runs BLAS_THREADS threads, and outside it the threads are as before."""
+    from threadpoolctl import threadpool_info
+
+    from ngdual.solvers.linear import blas_threads
+    from ngdual.tolerances import BLAS_THREADS
+
+    with blas_threads():   # the first call loads what the solvers use
+        pass
+    before = {pool["filepath"]: pool["num_threads"] for pool in threadpool_info()
+              if pool["user_api"] == "blas"}
+    with blas_threads():
+        inside = {pool["filepath"]: pool["num_threads"] for pool in threadpool_info()
+                  if pool["user_api"] == "blas"}
+    after = {pool["filepath"]: pool["num_threads"] for pool in threadpool_info()
+             if pool["user_api"] == "blas"}
+    assert inside and set(inside) == set(before)
+    assert all(threads == BLAS_THREADS for threads in inside.values())
+    assert after == before

@@ -59,13 +59,13 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
-from threadpoolctl import threadpool_limits
 
 from ..forms import DiscreteProblem
 from ..friction import FrictionForms, build_friction_forms, tresca_bound
-from ..tolerances import BLAS_THREADS, COULOMB_FIXED_POINT_TOL, friction_vanishes
+from ..tolerances import COULOMB_FIXED_POINT_TOL, friction_vanishes
 from .cholesky import SchurCholesky
 from .hybrid import HybridSystem
+from .linear import blas_threads
 from .nested import friction_residuals
 from .projections import NonnegativeProjection, metric_matrix
 from .result import ConvergenceError, Solution
@@ -229,7 +229,7 @@ def active_set_solve(problem: DiscreteProblem, settings: ActiveSetSettings,
     model = settings.model
     # the dense work is small (at most a few thousand unknowns): one BLAS thread is as fast
     # and immune to the spin-waiting of threaded BLAS on busy cores
-    with threadpool_limits(limits=BLAS_THREADS, user_api="blas"):
+    with blas_threads():
         try:
             return _active_set_solve(problem, settings, tol, ordering, progress, start)
         except ConvergenceError as err:

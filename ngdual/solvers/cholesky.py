@@ -22,10 +22,9 @@ import time
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
-from threadpoolctl import threadpool_limits
 
 from ..extras import require
-from ..tolerances import BLAS_THREADS
+from .linear import blas_threads
 
 ORDERINGS = ("amd", "metis")
 
@@ -109,7 +108,7 @@ class SchurCholesky:
         # unknowns I stay last and the factor's trailing block is the Schur complement
         cholmod.options.update({"nmethods": 1, "postorder": False, "supernodal": 2})
         try:
-            with threadpool_limits(limits=BLAS_THREADS, user_api="blas"):
+            with blas_threads():
                 F = cholmod.symbolic(A, p=cvxopt.matrix(np.arange(n, dtype=np.int32)))
                 cholmod.numeric(A, F)
         except ArithmeticError as err:

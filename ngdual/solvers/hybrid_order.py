@@ -61,13 +61,12 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
-from threadpoolctl import threadpool_limits
 
 from .. import peers
 from ..forms import DiscreteProblem
 from ..friction import MomentFriction, tresca_moments
 from ..sparse import to_scipy
-from ..tolerances import BLAS_THREADS, COULOMB_FIXED_POINT_TOL
+from ..tolerances import COULOMB_FIXED_POINT_TOL
 from .active_set import ContactStart
 from .cholesky import SchurCholesky
 from .conforming import (
@@ -79,6 +78,7 @@ from .conforming import (
     residuals,
     solve_condensed,
 )
+from .linear import blas_threads
 from .result import Solution
 from .settings import ActiveSetSettings
 
@@ -305,7 +305,7 @@ def hybrid_active_set(problem: DiscreteProblem, settings: ActiveSetSettings,
     friction = MomentFriction()
     cond = Condensed(0.5 * (G + G.T), b, np.arange(n_c))
     first_contact = first
-    with threadpool_limits(limits=BLAS_THREADS, user_api="blas"):
+    with blas_threads():
         for refinement in range(CONTACT_REFINEMENTS + 1):
             state, F, history, iterations = solve_condensed(
                 cond, law, model.mu_f, bound, friction, first_contact, settings.max_iter, tol)

@@ -8,16 +8,32 @@ forward/back solve. UMFPACK runs with ``BLAS_THREADS`` (:mod:`ngdual.tolerances`
 
 from __future__ import annotations
 
+import functools
 import time
 
 import numpy as np
 import scipy.sparse as sp
-from threadpoolctl import threadpool_limits
+from threadpoolctl import ThreadpoolController
 
 from ..forms import DiscreteProblem
 from ..sparse import to_ngsolve
 from ..tolerances import BLAS_THREADS
 from .result import Solution
+
+
+@functools.cache
+def _blas_controller() -> ThreadpoolController:
+    """threadpoolctl's view of the process's BLAS libraries, scanned once: a scan costs about
+    1.4 ms, and every solve limits the threads twice. cvxopt and scipy.linalg are imported
+    first, so that every BLAS a solver can call is loaded when the scan looks."""
+    import cvxopt  # noqa: F401  (CHOLMOD's BLAS)
+    import scipy.linalg  # noqa: F401
+    return ThreadpoolController()
+
+
+def blas_threads():
+    """A context in which every loaded BLAS runs ``BLAS_THREADS`` threads (restored on exit)."""
+    return _blas_controller().limit(limits=BLAS_THREADS, user_api="blas")
 
 
 class Factorization:
@@ -32,7 +48,7 @@ class Factorization:
         start = time.perf_counter()
         self.shape = matrix.shape
         self._mat = to_ngsolve(matrix)
-        with threadpool_limits(limits=BLAS_THREADS, user_api="blas"):
+        with blas_threads():
             self._inv = self._mat.Inverse(inverse="umfpack")
         self._rhs, self._sol = self._mat.CreateColVector(), self._mat.CreateColVector()
         self.seconds = time.perf_counter() - start
@@ -42,12 +58,12 @@ class Factorization:
         rhs = np.asarray(rhs, dtype=float)
         if rhs.shape[1] == 0:
             return np.zeros(rhs.shape)
-        with threadpool_limits(limits=BLAS_THREADS, user_api="blas"):
+        with blas_threads():
             return np.column_stack([self._umfpack_solve(col) for col in rhs.T])
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
         """Solve with the stored factors."""
-        with threadpool_limits(limits=BLAS_THREADS, user_api="blas"):
+        with blas_threads():
             return self._umfpack_solve(rhs)
 
     def _umfpack_solve(self, rhs: np.ndarray) -> np.ndarray:
