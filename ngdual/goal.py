@@ -54,7 +54,7 @@ from scipy.spatial import cKDTree
 from .checks import friction_forms_of
 from .estimator import BoundaryEdges, Estimate
 from .friction import hat_projection
-from .mesh import mesh_arrays
+from .mesh import boundary_segments, mesh_arrays
 from .quantities import fields  # the trace of sigma_h at order k
 from .scene import SceneError
 from .solvers.result import Solution
@@ -268,16 +268,14 @@ def _vertex_jumps(p: ngs.CoefficientFunction, mesh: ngs.Mesh, gamma_c) -> np.nda
     [p_h]_v the jump of the pressure ``p`` (:func:`_pressure`) between the two edges.
 
     p_h is read at both ends of every boundary segment (the points 0 and 1 of its reference
-    interval, each mapped into the segment's own triangle: no point search); netgen's
-    segments are NGSolve's boundary elements, in the same order.
+    interval, each mapped into the segment's own triangle: no point search).
     """
     rule = ngs.IntegrationRule([(0.0,), (1.0,)], [0.5, 0.5])
     points = mesh.MapToAllElements(rule, ngs.BND)
     values = np.asarray(p(points)).reshape(-1, 2)
     at = np.column_stack([np.asarray(ngs.x(points)).ravel(),
                           np.asarray(ngs.y(points)).ravel()]).reshape(-1, 2, 2)
-    segments = mesh.ngmesh.Elements1D().NumPy()["nodes"][:, :2].astype(np.int64) - 1
-    number = {frozenset(pair): nr for nr, pair in enumerate(segments.tolist())}
+    _, number = boundary_segments(mesh)
     nr = np.array([number[frozenset(pair)] for pair in gamma_c.vertices.tolist()])
     start = np.vstack([chain.path_points[:-1] for chain in gamma_c.coarse.chains])
     # which end of a segment's reference interval is its fine edge's start

@@ -152,6 +152,19 @@ def moved_mesh(mesh: ngs.Mesh, matrix, shift=(0.0, 0.0)) -> ngs.Mesh:
     return ngs.Mesh(copy)
 
 
+def boundary_segments(mesh: ngs.Mesh) -> tuple[np.ndarray, dict[frozenset, int]]:
+    """The vertex numbers (n, 2) of every boundary element, in NGSolve's order of its
+    vertices, and the number of the boundary element on every boundary edge, keyed by the
+    edge's two vertex numbers.
+
+    Read from netgen's segments, which are NGSolve's boundary elements, in the same order and
+    with the same order of their vertices: a loop over ``mesh.Elements(BND)`` reading
+    ``el.vertices`` costs a Python object per element.
+    """
+    ends = mesh.ngmesh.Elements1D().NumPy()["nodes"][:, :2].astype(np.int64) - 1
+    return ends, {frozenset(pair): nr for nr, pair in enumerate(ends.tolist())}
+
+
 def mesh_arrays(mesh: ngs.Mesh) -> tuple[np.ndarray, np.ndarray]:
     """Vertex coordinates (n, 2) and the vertex numbers of every triangle (ne, 3).
 

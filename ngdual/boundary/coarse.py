@@ -28,6 +28,7 @@ import ngsolve as ngs
 import numpy as np
 import scipy.sparse as sp
 
+from ..mesh import boundary_segments
 from .chains import Chain, EndRule, boundary_chains, edge_normals, end_rule
 
 
@@ -242,18 +243,22 @@ class CoarseMesh:
         """(n, 2) dofs of the fine P1 trace ``space`` at the start and the end of every fine
         edge, in the order of :meth:`fine_edges`.
 
-        Read from the boundary elements by ``ElementId``: ``GetDofNrs`` of a compressed space
-        by element object or vertex ``NodeId`` costs ten times as much, seconds on level 8.
+        Read from the boundary elements of the fine edges by ``ElementId`` (found by their
+        vertices, :func:`ngdual.mesh.boundary_segments`): ``GetDofNrs`` of a compressed
+        space by element object or vertex ``NodeId`` costs ten times as much, seconds on
+        level 8.
         """
-        dofs_of = {}
-        for el in space.mesh.Elements(ngs.BND):
-            a, b = (v.nr for v in el.vertices)
-            dofs = space.GetDofNrs(ngs.ElementId(ngs.BND, el.nr))
-            if len(dofs) == 2 and min(dofs) >= 0:  # an edge of the space's boundary part
-                dofs_of[(a, b)], dofs_of[(b, a)] = tuple(dofs), tuple(dofs[::-1])
+        ends, number = boundary_segments(space.mesh)
         vertices, _ = self.fine_edges()
-        return np.array([dofs_of[(int(a), int(b))] for a, b in vertices],
-                        dtype=int).reshape(-1, 2)
+        out = np.empty((len(vertices), 2), dtype=int)
+        for i, (a, b) in enumerate(vertices.tolist()):
+            nr = number[frozenset((a, b))]
+            dofs = space.GetDofNrs(ngs.ElementId(ngs.BND, nr))
+            if len(dofs) != 2 or min(dofs) < 0:
+                raise RuntimeError(f"the fine edge ({a}, {b}) has no two dofs of the trace "
+                                   "space")
+            out[i] = dofs if ends[nr, 0] == a else dofs[::-1]
+        return out
 
     def p1_prolongation(self, edge_dofs: np.ndarray, n_fine: int, ends: bool = False
                         ) -> sp.csr_matrix:
