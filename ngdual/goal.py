@@ -204,24 +204,23 @@ def goal_estimate(solution: Solution, estimated: Estimate,
     if window is None:
         terms["far"] = eta_sigma * h_near / (h_near + distance)**2
     else:
-        terms["far"] = eta_sigma * _dipole_weight(corners, distance, h_near, spaces.order)
+        terms["far"] = eta_sigma * _dipole_weight(estimated.h, distance, h_near, spaces.order)
     # the facet multipliers of order k have their own constant
     return PressureEstimate(terms, size, CALIBRATION_ORDER_K if spaces.family == "facet"
                             else CALIBRATION)
 
 
-def _dipole_weight(corners: np.ndarray, distance: np.ndarray, h_near: np.ndarray,
+def _dipole_weight(h_t: np.ndarray, distance: np.ndarray, h_near: np.ndarray,
                    order: int) -> np.ndarray:
-    """(h_T / (h_T + d))^(2 (k + 1)) / (h~_W + d) per element (``corners``: ne x 3 x 2), d
-    its distance to the window W, k the ``order`` of PEERS_k: the L2(W) norm^2 of a
-    dipole's traction, (eta_T h_T)^2 d^-3, for an element of diameter h_T far from W at
-    k = 0; 1 / h~_W on W, as the weight without a window. Outside a window lie singular
+    """(h_T / (h_T + d))^(2 (k + 1)) / (h~_W + d) per element (``h_t``: the diameters h_T of
+    the estimate), d its distance to the window W, k the ``order`` of PEERS_k: the L2(W)
+    norm^2 of a dipole's traction, (eta_T h_T)^2 d^-3, for an element of diameter h_T far
+    from W at k = 0; 1 / h~_W on W, as the weight without a window. Outside a window lie singular
     points of Gamma_C (the punch edges), whose tiny elements the weight
     h~_W / (h~_W + d)^2 counted as if as large as W's edges. At order k the dual weight
     that the element's residual meets is approximated to h_T^(k+1) by PEERS_k, and the
     dual solution, smooth away from W, has (k+1)-th derivatives ~ d^-(k+1): k more powers
     of h_T / d than at k = 0 (docs/theory/estimator.md, "The pressure goal at order k")."""
-    h_t = np.max(np.linalg.norm(corners - np.roll(corners, 1, axis=1), axis=2), axis=1)
     power = 2 * (order + 1)   # at k = 0 the dipole's h_T^2, to the bit
     return h_t**power / ((h_t + distance)**power * (h_near + distance))
 
