@@ -197,7 +197,6 @@ def check_order_against_mesh_size(r: dict) -> None:
         assert kept["sigma"][-1] < kept["sigma"][0] and kept["ndof"][-1] > kept["ndof"][0], k
 
 
-
 def check_goal_and_tolerance(r: dict) -> None:
     """Both goals stop by the tolerance; the pressure goal refines along Gamma_C, reaches a
     smaller true pressure error than uniform refinement with fewer unknowns, and its
@@ -212,6 +211,7 @@ def check_goal_and_tolerance(r: dict) -> None:
     finest = uniform[-1]
     assert pressure["error"][-1] < finest["error"] and pressure["ndof"][-1] < 2 * finest["ndof"]
     assert all(0.25 <= e <= 4 for e in r["effectivity"]), r["effectivity"]
+
 
 CHECKS = {1: check_peers_spaces, 2: check_locking, 3: check_signorini_uzawa,
           4: check_friction, 5: check_friction_inf_sup, 6: check_estimator,
