@@ -16,11 +16,13 @@ units of pressure^2 x length, per fine edge e of Gamma_C (its element T)::
     ``jump``             JUMP_WEIGHT |e| [p_h]^2 / 2             at every interior vertex
                                                                  of a chain, on each of its
                                                                  two edges (order k only)
-    ``far``              eta_{sigma,T}^2 h~_C / (h~_C + dist(T, Gamma_C))^2   every element
+    ``far``              eta_{sigma,T}^2 h~_C / (h~_C + d)^2     every element, d its
+                         x (h_T / (h_T + d))^(2k)                distance to Gamma_C
 
 with E* = 4 mu (lambda + mu) / (lambda + 2 mu) the scene's 2D modulus (E / (1 - nu^2) in
 plane strain), h~_e the h~ edge holding e, h~_C the
-h~ of the nearest fine Gamma_C edge and eta_{sigma,T}^2 the stress terms of (4.15) with
+h~ of the nearest fine Gamma_C edge, h_T the element's diameter, k the order of PEERS_k
+(the last factor is 1 at k = 0) and eta_{sigma,T}^2 the stress terms of (4.15) with
 the strain terms (w_h) scaled by (2 mu)^2 into stress. docs/theory/estimator.md ("A goal:
 the contact pressure") derives each power of h~ and says what is proven and what is
 heuristic. The estimate is ``CALIBRATION`` times the root of the sum.
@@ -71,9 +73,10 @@ STRAIN_TERMS = ("curl", "jump_interior", "jump_dirichlet", "jump_neumann")
 # One constant: 1 / (the geometric mean, 9.7, of the uncalibrated effectivity over six
 # theta = 0.8 steps on hertz-cylinder), rounded to one digit (docs/theory/estimator.md).
 CALIBRATION = 0.1
-# At order k with the facet multipliers, the same: 1 / (the geometric mean, 6.8, over eight
-# theta = 0.8 steps on hertz-cylinder at order 1 from level 1, the vertex jumps included),
-# rounded to 0.15 (4.2 and 0.2 before the jumps).
+# At order k with the facet multipliers, the same: 1 / (the geometric mean, 6.3, over eight
+# theta = 0.8 steps on hertz-cylinder at order 1 from level 1, the vertex jumps and the
+# far field of order k included), rounded to 0.15 (6.8 without that far field; 4.2 and 0.2
+# before the jumps).
 CALIBRATION_ORDER_K = 0.15
 # The weight of the vertex jumps of the order-k pressure against the other terms, measured
 # (docs/theory/estimator.md, "The jumps of the pressure of order k"): at k = 1 the pressure
@@ -202,7 +205,8 @@ def goal_estimate(solution: Solution, estimated: Estimate,
     distance, nearest = cKDTree(gamma_c.midpoints[inside]).query(corners.mean(axis=1))
     h_near = htilde[inside][nearest]
     if window is None:
-        terms["far"] = eta_sigma * h_near / (h_near + distance)**2
+        terms["far"] = (eta_sigma * h_near / (h_near + distance)**2
+                        * _order_decay(estimated.h, distance, spaces.order))
     else:
         terms["far"] = eta_sigma * _dipole_weight(estimated.h, distance, h_near, spaces.order)
     # the facet multipliers of order k have their own constant
@@ -223,6 +227,15 @@ def _dipole_weight(h_t: np.ndarray, distance: np.ndarray, h_near: np.ndarray,
     of h_T / d than at k = 0 (docs/theory/estimator.md, "The pressure goal at order k")."""
     power = 2 * (order + 1)   # at k = 0 the dipole's h_T^2, to the bit
     return h_t**power / ((h_t + distance)**power * (h_near + distance))
+
+
+def _order_decay(h_t: np.ndarray, distance: np.ndarray, order: int) -> np.ndarray:
+    """(h_T / (h_T + d))^(2k) per element (``h_t``: the diameters h_T of the estimate), d
+    its distance to Gamma_C, k the ``order`` of PEERS_k: the k powers of h_T / d by which
+    PEERS_k approximates a dual solution that is smooth at the distance d better than
+    PEERS_0 does, as in :func:`_dipole_weight` (docs/theory/estimator.md, "The pressure goal
+    at order k"); 1 at k = 0, to the bit."""
+    return (h_t / (h_t + distance))**(2 * order)
 
 
 def _in_window(x: np.ndarray, window: tuple[float, float] | None) -> np.ndarray:

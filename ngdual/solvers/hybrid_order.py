@@ -238,9 +238,7 @@ def _edge_coupling(broken_rt: ngs.FESpace, order: int) -> sp.csr_matrix:
     form += facet.TrialFunction() * (broken_rt.TestFunction() * n) * ngs.dx(
         element_boundary=True, intrules={ngs.SEGM: ngs.IntegrationRule(ngs.SEGM, 2 * order)})
     form.Assemble()
-    boundary = np.zeros(facet.ndof, dtype=bool)
-    for el in mesh.Elements(ngs.BND):
-        boundary[[d for d in facet.GetDofNrs(el) if d >= 0]] = True
+    boundary = np.array(facet.GetDofs(mesh.Boundaries(".*")), dtype=bool)
     return to_scipy(form.mat).tocsc()[:, np.flatnonzero(~boundary)].tocsr()
 
 
