@@ -387,3 +387,19 @@ def test_a_solve_record_and_an_adaptive_step_hold_the_estimate_under_the_same_ke
         assert 0 < estimator(record) <= estimator(record, "sum"), record
     assert estimator(solve) == estimator(steps[0]) and "eta" in solve["norms"]
     assert estimator({"status": "ok", "ndof": 3}) is None  # the primal peer has none
+
+
+def _worker_environment() -> dict:
+    return {name: os.environ.get(name) for name in ("MALLOC_TRIM_THRESHOLD_", "OMP_NUM_THREADS")}
+
+
+@pytest.mark.slow
+def test_a_sweep_worker_times_like_a_plain_process():
+    """The workers of a sweep's LocalCluster run with glibc's own memory trimming (dask's
+    nanny would set MALLOC_TRIM_THRESHOLD_=65536, under which the timed solves of a study
+    ran 1.3-1.5 times slower than in a plain process) and one BLAS thread each."""
+    from ngdual.studies.sweep.runner import Runner
+
+    with Runner(workers=1, progress=False) as runner:
+        environments = list(runner.client().run(_worker_environment).values())
+    assert environments == [{"MALLOC_TRIM_THRESHOLD_": None, "OMP_NUM_THREADS": "1"}]
