@@ -214,17 +214,18 @@ def conforming_active_set(problem: DiscreteProblem, settings: ActiveSetSettings,
 
 def checked_solution(problem: DiscreteProblem, x: np.ndarray, law: str, mu_f: float,
                      F: np.ndarray | None, method: str, iterations: dict, history: list,
-                     seconds: dict) -> Solution:
+                     seconds: dict, found: dict | None = None) -> Solution:
     """The solution x of (3.62) with the facet multipliers, once its residuals on
-    ``problem.K`` (:func:`residuals`) are round-off; the friction multiplier nu and the
-    bound reported per fine edge (the h^ edges of ``FacetFrictionForms``).
+    ``problem.K`` (:func:`residuals`; ``found``: those of this x, computed by the caller)
+    are round-off; the friction multiplier nu and the bound reported per fine edge (the h^
+    edges of ``FacetFrictionForms``).
 
     Raises
     ------
     ConvergenceError
         Naming every residual above ``TOLERANCE``.
     """
-    found = residuals(problem, x, law, mu_f, F)
+    found = residuals(problem, x, law, mu_f, F) if found is None else found
     bad = {k: v for k, v in found.items() if not v <= TOLERANCE}
     if bad:
         raise ConvergenceError("the active-set solution does not satisfy (3.62) to round-off: "

@@ -310,8 +310,8 @@ def hybrid_active_set(problem: DiscreteProblem, settings: ActiveSetSettings,
             back = time.perf_counter()
             z = state.lam_n if law == "none" else np.concatenate([state.lam_n, state.lam_t])
             x = hybrid.solve(chol, y, problem.rhs, z)
-            if refinement == CONTACT_REFINEMENTS or max(
-                    residuals(problem, x, law, model.mu_f, F).values()) <= TOLERANCE:
+            found = residuals(problem, x, law, model.mu_f, F)
+            if refinement == CONTACT_REFINEMENTS or max(found.values()) <= TOLERANCE:
                 break
             # the moments on K are exact for these multipliers, those of the Schur
             # complement carry the round-off of the Cholesky factors: b takes the difference
@@ -328,4 +328,4 @@ def hybrid_active_set(problem: DiscreteProblem, settings: ActiveSetSettings,
     seconds["factorize"] = seconds["hybridize"] + seconds["cholesky"]
     return checked_solution(problem, x, law, model.mu_f, F, "active-set-hybrid",
                             {**iterations, "condensed": n_c, "contact_refinements": refinement},
-                            history, seconds)
+                            history, seconds, found)
