@@ -231,10 +231,10 @@ def _dipole_weight(h_t: np.ndarray, distance: np.ndarray, h_near: np.ndarray,
 
 def _order_decay(h_t: np.ndarray, distance: np.ndarray, order: int) -> np.ndarray:
     """(h_T / (h_T + d))^(2k) per element (``h_t``: the diameters h_T of the estimate), d
-    its distance to Gamma_C, k the ``order`` of PEERS_k: the k powers of h_T / d by which
-    PEERS_k approximates a dual solution that is smooth at the distance d better than
-    PEERS_0 does, as in :func:`_dipole_weight` (docs/theory/estimator.md, "The pressure goal
-    at order k"); 1 at k = 0, to the bit."""
+    its distance to Gamma_C, k the ``order`` of PEERS_k: PEERS_k approximates a dual
+    solution that is smooth at the distance d to h_T^(k+1) d^-(k+1), k powers of h_T / d
+    better than PEERS_0, squared in the squared indicator, as in :func:`_dipole_weight`
+    (docs/theory/estimator.md, "The pressure goal at order k"); 1 at k = 0, to the bit."""
     return (h_t / (h_t + distance))**(2 * order)
 
 

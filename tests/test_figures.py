@@ -394,7 +394,7 @@ def _worker_environment() -> dict:
 
 
 @pytest.mark.slow
-def test_a_sweep_worker_times_like_a_plain_process():
+def test_a_sweep_worker_keeps_glibcs_own_memory_trimming_and_one_blas_thread():
     """The workers of a sweep's LocalCluster run with glibc's own memory trimming (dask's
     nanny would set MALLOC_TRIM_THRESHOLD_=65536, under which the timed solves of a study
     ran 1.3-1.5 times slower than in a plain process) and one BLAS thread each."""
