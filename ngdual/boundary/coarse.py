@@ -28,7 +28,7 @@ import ngsolve as ngs
 import numpy as np
 import scipy.sparse as sp
 
-from ..mesh import boundary_segments
+from ..mesh import edge_dofs
 from .chains import Chain, EndRule, boundary_chains, edge_normals, end_rule
 
 
@@ -241,24 +241,12 @@ class CoarseMesh:
 
     def fine_edge_dofs(self, space: ngs.FESpace) -> np.ndarray:
         """(n, 2) dofs of the fine P1 trace ``space`` at the start and the end of every fine
-        edge, in the order of :meth:`fine_edges`.
-
-        Read from the boundary elements of the fine edges by ``ElementId`` (found by their
-        vertices, :func:`ngdual.mesh.boundary_segments`): ``GetDofNrs`` of a compressed
-        space by element object or vertex ``NodeId`` costs ten times as much, seconds on
-        level 8.
-        """
-        ends, number = boundary_segments(space.mesh)
+        edge, in the order of :meth:`fine_edges` (:func:`ngdual.mesh.edge_dofs`)."""
         vertices, _ = self.fine_edges()
-        out = np.empty((len(vertices), 2), dtype=int)
-        for i, (a, b) in enumerate(vertices.tolist()):
-            nr = number[frozenset((a, b))]
-            dofs = space.GetDofNrs(ngs.ElementId(ngs.BND, nr))
-            if len(dofs) != 2 or min(dofs) < 0:
-                raise RuntimeError(f"the fine edge ({a}, {b}) has no two dofs of the trace "
-                                   "space")
-            out[i] = dofs if ends[nr, 0] == a else dofs[::-1]
-        return out
+        dofs = edge_dofs(space, vertices)
+        if any(len(d) != 2 for d in dofs):
+            raise RuntimeError("a fine edge has more than two dofs of the trace space")
+        return np.array(dofs, dtype=int).reshape(-1, 2)
 
     def p1_prolongation(self, edge_dofs: np.ndarray, n_fine: int, ends: bool = False
                         ) -> sp.csr_matrix:

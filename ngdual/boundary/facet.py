@@ -32,6 +32,7 @@ import ngsolve as ngs
 import numpy as np
 import scipy.sparse as sp
 
+from ..mesh import edge_dofs
 from .chains import EndRule, boundary_chains
 from .coarse import CoarseMesh, WithoutP1
 
@@ -109,16 +110,10 @@ class FacetMesh(WithoutP1, CoarseMesh):
 
     def host_dofs(self, space: ngs.FESpace) -> np.ndarray:
         """(n_edges, max(k, 1) + 1) dofs of the host ``space`` on every fine edge, in the order
-        of :meth:`fine_edges`: the start vertex's, the end vertex's, then the bubbles."""
-        dofs_of = {}
-        for el in space.mesh.Elements(ngs.BND):
-            dofs = space.GetDofNrs(ngs.ElementId(ngs.BND, el.nr))
-            if len(dofs) >= 2 and min(dofs) >= 0:
-                a, b = (v.nr for v in el.vertices)
-                dofs_of[(a, b)] = tuple(dofs)
-                dofs_of[(b, a)] = (dofs[1], dofs[0], *dofs[2:])
+        of :meth:`fine_edges`: the start vertex's, the end vertex's, then the bubbles
+        (:func:`ngdual.mesh.edge_dofs`)."""
         vertices, _ = self.fine_edges()
-        return np.array([dofs_of[(int(a), int(b))] for a, b in vertices], dtype=int)
+        return np.array(edge_dofs(space, vertices), dtype=int)
 
     def prolongation(self, space: ngs.FESpace, labels: list[str]) -> sp.csr_matrix:
         """(space.ndof, n_coefficients): Bernstein coefficients -> host coefficients.
