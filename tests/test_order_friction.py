@@ -184,3 +184,20 @@ def test_a_side_in_contact_and_sticking_is_solved_with_vanishing_multipliers():
     state = semismooth_newton(G, b, 2, np.diag(F))
     assert np.max(np.abs(np.concatenate([state.lam_n, state.lam_t]))) < 1e-15
     assert np.allclose(state.nu, b[2:] / F, rtol=1e-12)
+
+
+@pytest.mark.parametrize("order, level", [(1, 2), (2, 3)])
+def test_the_coulomb_law_solved_on_the_fixed_points_sets_is_its_fixed_point(order, level,
+                                                                           monkeypatch):
+    """On the sets of a Tresca solution (conforming.coulomb_on_sets) the Coulomb problem is
+    linear: solved there, the fixed point of Remark 3.45 stops after a few steps (the plain
+    iteration takes 12-16, rate ~0.1) at the solution the plain iteration reaches, and
+    F = mu_f (-t_n) holds on every coefficient."""
+    problem = _problem("thesis-3.46-coulomb", order, level)
+    fast = solve_problem(problem)
+    monkeypatch.setattr(conforming, "coulomb_on_sets", lambda cond, mu_f, state: None)
+    plain = solve_problem(problem)
+    assert fast.iterations["outer"] <= 6 < plain.iterations["outer"]
+    for part in (problem.sigma, problem.lam_n, problem.index("lam_t")):
+        assert _relative(fast.x[part], plain.x[part]) < 1e-10
+    assert fast.history[-1] <= 1e-12 and fast.residuals["friction_bound"] < 1e-12

@@ -56,6 +56,7 @@ round-off, or a :class:`ConvergenceError` names every one that is not.
 
 from __future__ import annotations
 
+import functools
 import time
 from dataclasses import dataclass
 
@@ -253,6 +254,36 @@ def _start_state(first, J: np.ndarray, friction: bool, n_rows: int) -> BoundaryS
                             False, {})
 
 
+def coulomb_on_sets(cond: Condensed, mu_f: float, state: BoundarySolution
+                    ) -> np.ndarray | None:
+    """The normal moments t_n of the Coulomb problem on the sets of the Tresca solution
+    ``state`` (None if that linear system is singular): with t = b - G z and F_i = mu_f
+    (-t_n,i) (:class:`~ngdual.friction.MomentFriction`), the conditions on fixed sets are
+    linear in z alone,
+
+        lambda_n,i = 0 (contact),           t_n,i = 0 (separation),
+        lambda_t,i = 0 (stick),             t_t,i + mu_f s_i t_n,i = 0 (slip with sign s_i,
+                                             t_t,i = 0 where F_i = 0),
+
+    the Newton step of the Coulomb law itself (Hueber, Stadler and Wohlmuth) on the sets the
+    fixed point of Remark 3.45 has found; :func:`ngdual.solvers.active_set.coulomb_fixed_point`
+    checks it as it checks its own steps."""
+    n = cond.n_c
+    G, b = cond.G, cond.b
+    stick = state.stick
+    sign = np.where(stick, 0.0, np.sign(state.nu))
+    rows = np.vstack([-G[:n], -G[n:] - mu_f * sign[:, None] * G[:n]])
+    rhs = np.concatenate([-b[:n], -b[n:] - mu_f * sign * b[:n]])
+    fixed = np.concatenate([state.contact, stick])   # lambda_n = 0, lambda_t = 0 there
+    rows[fixed] = np.eye(2 * n)[fixed]
+    rhs[fixed] = 0.0
+    try:
+        z = sla.solve(rows, rhs, check_finite=False)
+    except (sla.LinAlgError, sla.LinAlgWarning, ValueError):
+        return None
+    return (b - G @ z)[:n] if np.all(np.isfinite(z)) else None
+
+
 def solve_condensed(cond: Condensed, law: str, mu_f: float, bound: np.ndarray | None,
                     friction: MomentFriction, first, max_iter: int, tol: float):
     """The contact (and friction) problem t(z) = b - G z on J by the semismooth Newton
@@ -264,7 +295,8 @@ def solve_condensed(cond: Condensed, law: str, mu_f: float, bound: np.ndarray | 
         noise = floor * mu_f * float(np.max(np.abs(cond.b), initial=0.0))
         state, F, history, iterations = coulomb_fixed_point(
             cond, friction, mu_f, tol, max_iter, None, noise,
-            _start_state(first, cond.J, True, 0))
+            _start_state(first, cond.J, True, 0),
+            functools.partial(coulomb_on_sets, cond, mu_f))
         return state, F, history, iterations
     F = bound[cond.J] if law == "tresca" else None
     Q = friction.q_matrix(F).toarray() if F is not None else None
