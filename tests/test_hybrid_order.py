@@ -16,7 +16,7 @@ from ngdual.mesh import build_mesh
 from ngdual.scene import load_scene
 from ngdual.solvers import solve_scene
 from ngdual.solvers.conforming import TOLERANCE, conforming_active_set
-from ngdual.solvers.hybrid_order import OrderHybridSystem, hybrid_active_set
+from ngdual.solvers.hybrid_order import OrderHybridSystem, _element_schur, hybrid_active_set
 from ngdual.solvers.linear import solve_linear
 from ngdual.solvers.settings import solver_settings
 from ngdual.verification.manufactured import manufactured_case
@@ -117,3 +117,15 @@ def test_the_moments_on_k_correct_the_schur_complement_on_cattaneo_mindlin():
     assert hybrid.iterations["contact_refinements"] >= 1
     assert max(hybrid.residuals.values()) <= TOLERANCE
     assert np.max(np.abs(hybrid.x - conforming.x)) <= 1e-9 * np.max(np.abs(conforming.x))
+
+
+@pytest.mark.parametrize("order", [1, 2])
+def test_the_element_schur_complements_sum_to_the_sparse_product(order):
+    """C^T B^{-1} C from the dense blocks of every triangle (in batches, the last one
+    short) is the product of the sparse matrices, to round-off."""
+    problem, _ = _problem("thesis-3.46-coulomb", order, 2)
+    hybrid = OrderHybridSystem(problem, friction=True)
+    sparse = (hybrid.A_LI.T @ (hybrid.B_inv @ hybrid.A_LI)).toarray()
+    for chunk in (2048, 37):
+        batched = _element_schur(hybrid.B_inv, hybrid.A_LI, chunk).toarray()
+        assert np.max(np.abs(batched - sparse)) <= 1e-14 * np.max(np.abs(sparse))

@@ -83,6 +83,7 @@ from .result import Solution
 from .settings import ActiveSetSettings
 
 CONTACT_REFINEMENTS = 2  # corrections of b by the moments on K (hybrid_active_set)
+SCHUR_CHUNK = 2048  # triangles per batch of _element_schur (PEERS_2: 48 MB of blocks)
 
 
 class OrderHybridSystem:
@@ -153,8 +154,7 @@ class OrderHybridSystem:
                         [None, sp.csr_matrix((2 * n_mu, 2 * n_mu)), None],
                         [coupled[eta].T, None, K[multipliers][:, multipliers]]], format="csr")
         self.B_inv = _block_inverse(Kb[:n_l, :n_l], self.local.shape[1])
-        extension = self.B_inv @ self.A_LI
-        self.H = (self.A_LI.T @ extension - A_II).tocsr()
+        self.H = (_element_schur(self.B_inv, self.A_LI) - A_II).tocsr()
         self.H = 0.5 * (self.H + self.H.T)
         n_i = len(self.interface)
         self.contact_index = np.arange(n_i - len(contact), n_i)
@@ -253,6 +253,53 @@ def _block_inverse(A: sp.csr_matrix, size: int) -> sp.bsr_matrix:
         raise RuntimeError("the element-local unknowns couple across triangles")
     return sp.bsr_matrix((np.linalg.inv(bsr.data), np.arange(n), np.arange(n + 1)),
                          shape=A.shape)
+
+
+def _element_schur(B_inv: sp.bsr_matrix, A_LI: sp.csr_matrix,
+                   chunk: int = SCHUR_CHUNK) -> sp.csr_matrix:
+    """C^T B^{-1} C for the block-diagonal B^{-1} (one block per triangle) and the coupling
+    C = ``A_LI`` of the element-local unknowns (rows, triangle by triangle) to the global
+    ones: the sum over the triangles of C_T^T B_T^{-1} C_T, each C_T the dense block of the
+    few global unknowns its triangle couples to. Computed ``chunk`` triangles at a time by
+    batched dense products (one matrix per triangle), which costs about half the two
+    sparse products B^{-1} C and C^T (B^{-1} C) (PEERS_2, 512 triangles, 25 065 unknowns:
+    0.023 s against 0.045 s); the sum of the element contributions is the same matrix up to
+    round-off."""
+    size = B_inv.blocksize[0]
+    n_tri, n_glob = B_inv.shape[0] // size, A_LI.shape[1]
+    A_LI = A_LI.tocsr()
+    A_LI.sum_duplicates()
+    # the global unknowns of every triangle: the union of its rows' columns, sorted
+    owner = sp.csr_matrix((np.ones(A_LI.shape[0]), (np.arange(A_LI.shape[0]) // size,
+                                                    np.arange(A_LI.shape[0]))),
+                          shape=(n_tri, A_LI.shape[0]))
+    pattern = (owner @ abs(A_LI)).tocsr()
+    pattern.sort_indices()
+    counts = np.diff(pattern.indptr)
+    width = int(counts.max(initial=0))
+    slot = np.arange(pattern.nnz) - np.repeat(pattern.indptr[:-1], counts)
+    columns = np.full((n_tri, width), -1, dtype=np.int64)
+    columns[np.repeat(np.arange(n_tri), counts), slot] = pattern.indices
+    # the slot of every entry of A_LI in its triangle's list (the lists are sorted, and so
+    # are their keys triangle * n_glob + column over all triangles)
+    rows = np.repeat(np.arange(A_LI.shape[0]), np.diff(A_LI.indptr))
+    keys = np.repeat(np.arange(n_tri), counts) * n_glob + pattern.indices
+    where = np.searchsorted(keys, rows // size * n_glob + A_LI.indices)
+    entry_slot = slot[where]
+    inverse = B_inv.data
+    parts = []
+    for first in range(0, n_tri, chunk):
+        last = min(first + chunk, n_tri)
+        lo, hi = A_LI.indptr[first * size], A_LI.indptr[last * size]
+        C = np.zeros((last - first, size, width))
+        C[rows[lo:hi] // size - first, rows[lo:hi] % size, entry_slot[lo:hi]] = A_LI.data[lo:hi]
+        S = np.matmul(C.transpose(0, 2, 1), np.matmul(inverse[first:last], C))
+        cols = columns[first:last]
+        valid = (cols[:, :, None] >= 0) & (cols[:, None, :] >= 0)
+        parts.append((S[valid], np.broadcast_to(cols[:, :, None], S.shape)[valid],
+                      np.broadcast_to(cols[:, None, :], S.shape)[valid]))
+    data, i, j = (np.concatenate(p) for p in zip(*parts))
+    return sp.csr_matrix((data, (i, j)), shape=(n_glob, n_glob))
 
 
 def hybrid_active_set(problem: DiscreteProblem, settings: ActiveSetSettings,
