@@ -60,7 +60,6 @@ import ngsolve as ngs
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
 
 from .. import peers
 from ..forms import DiscreteProblem
@@ -146,14 +145,26 @@ class OrderHybridSystem:
                                (where[r.start:r.stop], np.arange(r.stop - r.start))),
                               shape=(n_l, r.stop - r.start)) @ mu
                 for r in (ranges["r1"], ranges["r2"])]
-        # one permutation of the broken matrix (triangle by triangle, then eta), sliced
-        order = np.concatenate([L, eta])
-        Kb = broken.matrix[order][:, order]
-        self.A_LI = sp.hstack([Kb[:n_l, n_l:], *rows, coupled[L]], format="csr")
-        A_II = sp.bmat([[Kb[n_l:, n_l:], None, coupled[eta]],
+        # the local rows of the broken matrix, triangle by triangle: each row holds its
+        # triangle's local unknowns first (in the order of self.local), then its eta
+        M = broken.matrix if broken.matrix.has_sorted_indices else \
+            broken.matrix.sorted_indices()
+        M_L = M[L]
+        size = self.local.shape[1]
+        lengths = np.diff(M_L.indptr)
+        place = np.arange(M_L.nnz) - np.repeat(M_L.indptr[:-1], lengths)
+        local = place < size
+        if not np.array_equal(M_L.indices[local], np.repeat(self.local, size, axis=0).ravel()):
+            raise RuntimeError("the element-local unknowns couple across triangles")
+        self.B_inv = _block_inverse(M_L.data[local].reshape(-1, size, size))
+        K_LI = sp.csr_matrix((M_L.data[~local], M_L.indices[~local] - n_l,
+                              np.concatenate([[0], np.cumsum(lengths - size)])),
+                             shape=(n_l, len(eta)))
+        K_II = M[n_l:][:, n_l:]
+        self.A_LI = sp.hstack([K_LI, *rows, coupled[L]], format="csr")
+        A_II = sp.bmat([[K_II, None, coupled[eta]],
                         [None, sp.csr_matrix((2 * n_mu, 2 * n_mu)), None],
                         [coupled[eta].T, None, K[multipliers][:, multipliers]]], format="csr")
-        self.B_inv = _block_inverse(Kb[:n_l, :n_l], self.local.shape[1])
         self.H = (_element_schur(self.B_inv, self.A_LI) - A_II).tocsr()
         self.H = 0.5 * (self.H + self.H.T)
         n_i = len(self.interface)
@@ -207,18 +218,21 @@ class OrderHybridSystem:
 
 def _element_dofs(matrix: sp.csr_matrix, n_local: int) -> np.ndarray:
     """(triangles, local unknowns): the element-local unknowns (those numbered below
-    ``n_local``: the broken sigma rows, the bubbles, u) of every triangle.
+    ``n_local``: the broken sigma rows, the bubbles, u) of every triangle, in increasing
+    order, the triangles by their first unknown.
 
     Read from NGSolve's sparsity pattern of the broken PEERS matrix, which holds every pair
     of unknowns of a triangle (explicit zeros included) and couples the local unknowns of
-    different triangles nowhere: the triangles are its connected components.
+    different triangles nowhere: the first column of a local unknown's row is the first
+    unknown of its triangle (:func:`_block_inverse` checks that no entry couples two).
     """
-    pattern = matrix[:n_local, :n_local]
-    n_el, label = connected_components(pattern, directed=False)
-    order = np.argsort(label, kind="stable")
-    if np.any(np.bincount(label) != n_local // n_el) or n_local % n_el:
+    if not matrix.has_sorted_indices:
+        matrix = matrix.sorted_indices()
+    first = matrix.indices[matrix.indptr[:n_local]]
+    triangles, label, counts = np.unique(first, return_inverse=True, return_counts=True)
+    if np.any(counts != counts[0]) or np.any(triangles >= n_local):
         raise RuntimeError("the triangles do not have the same number of local unknowns")
-    return order.reshape(n_el, -1)
+    return np.argsort(label, kind="stable").reshape(len(triangles), -1)
 
 
 def _first_copies(conforming: np.ndarray, n_p: int) -> np.ndarray:
@@ -242,17 +256,12 @@ def _edge_coupling(broken_rt: ngs.FESpace, order: int) -> sp.csr_matrix:
     return to_scipy(form.mat).tocsc()[:, np.flatnonzero(~boundary)].tocsr()
 
 
-def _block_inverse(A: sp.csr_matrix, size: int) -> sp.bsr_matrix:
-    """The inverse of the block-diagonal A (blocks of ``size``, one per triangle), inverted
-    block by block in one batched LAPACK call."""
-    n = A.shape[0] // size
-    bsr = sp.bsr_matrix(A, blocksize=(size, size))
-    bsr.sort_indices()
-    if not (np.array_equal(bsr.indices, np.arange(n))
-            and np.array_equal(bsr.indptr, np.arange(n + 1))):
-        raise RuntimeError("the element-local unknowns couple across triangles")
-    return sp.bsr_matrix((np.linalg.inv(bsr.data), np.arange(n), np.arange(n + 1)),
-                         shape=A.shape)
+def _block_inverse(blocks: np.ndarray) -> sp.bsr_matrix:
+    """The block-diagonal matrix of the inverses of ``blocks`` (triangles, size, size),
+    inverted in one batched LAPACK call."""
+    n, size, _ = blocks.shape
+    return sp.bsr_matrix((np.linalg.inv(blocks), np.arange(n), np.arange(n + 1)),
+                         shape=(n * size, n * size))
 
 
 def _element_schur(B_inv: sp.bsr_matrix, A_LI: sp.csr_matrix,
