@@ -10,6 +10,7 @@ slow: Hertz at k = 2 and level 2 of Example 3.46 with Coulomb friction at k = 2.
 
 import numpy as np
 import pytest
+import scipy.sparse as sp
 
 from ngdual.forms import assemble, broken_peers, conforming_peers
 from ngdual.mesh import build_mesh
@@ -129,3 +130,24 @@ def test_the_element_schur_complements_sum_to_the_sparse_product(order):
     for chunk in (2048, 37):
         batched = _element_schur(hybrid.B_inv, hybrid.A_LI, chunk).toarray()
         assert np.max(np.abs(batched - sparse)) <= 1e-14 * np.max(np.abs(sparse))
+
+
+def test_the_element_schur_complements_keep_explicit_zeros_out_of_the_way():
+    """NGSolve's patterns hold explicit zeros: a column a triangle touches only with zeros
+    (here its last one) must not take another column's place."""
+    rng = np.random.default_rng(0)
+    size, n_tri, n_glob = 3, 4, 7
+    blocks = rng.normal(size=(n_tri, size, size)) + 4 * np.eye(size)
+    B_inv = sp.bsr_matrix((np.linalg.inv(blocks), np.arange(n_tri), np.arange(n_tri + 1)),
+                          shape=(n_tri * size, n_tri * size))
+    dense = np.zeros((n_tri * size, n_glob))
+    for t in range(n_tri):
+        dense[t * size:(t + 1) * size, t:t + 3] = rng.normal(size=(size, 3))
+    A = sp.csr_matrix(dense)
+    rows, cols = [0, 1, 2], [6, 6, 6]  # triangle 0 touches column 6 with zeros only
+    A = sp.csr_matrix((np.concatenate([A.data, np.zeros(3)]),
+                       (np.concatenate([A.tocoo().row, rows]),
+                        np.concatenate([A.tocoo().col, cols]))), shape=A.shape)
+    assert A.nnz == np.count_nonzero(dense) + 3
+    expected = dense.T @ (B_inv @ dense)
+    assert np.allclose(_element_schur(B_inv, A).toarray(), expected, rtol=0, atol=1e-13)

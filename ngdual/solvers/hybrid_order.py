@@ -154,7 +154,8 @@ class OrderHybridSystem:
         lengths = np.diff(M_L.indptr)
         place = np.arange(M_L.nnz) - np.repeat(M_L.indptr[:-1], lengths)
         local = place < size
-        if not np.array_equal(M_L.indices[local], np.repeat(self.local, size, axis=0).ravel()):
+        if not (np.array_equal(M_L.indices[local], np.repeat(self.local, size, axis=0).ravel())
+                and np.all(M_L.indices[~local] >= n_l)):
             raise RuntimeError("the element-local unknowns couple across triangles")
         self.B_inv = _block_inverse(M_L.data[local].reshape(-1, size, size))
         K_LI = sp.csr_matrix((M_L.data[~local], M_L.indices[~local] - n_l,
@@ -224,7 +225,7 @@ def _element_dofs(matrix: sp.csr_matrix, n_local: int) -> np.ndarray:
     Read from NGSolve's sparsity pattern of the broken PEERS matrix, which holds every pair
     of unknowns of a triangle (explicit zeros included) and couples the local unknowns of
     different triangles nowhere: the first column of a local unknown's row is the first
-    unknown of its triangle (:func:`_block_inverse` checks that no entry couples two).
+    unknown of its triangle (:class:`OrderHybridSystem` checks that no entry couples two).
     """
     if not matrix.has_sorted_indices:
         matrix = matrix.sorted_indices()
@@ -282,7 +283,10 @@ def _element_schur(B_inv: sp.bsr_matrix, A_LI: sp.csr_matrix,
     owner = sp.csr_matrix((np.ones(A_LI.shape[0]), (np.arange(A_LI.shape[0]) // size,
                                                     np.arange(A_LI.shape[0]))),
                           shape=(n_tri, A_LI.shape[0]))
-    pattern = (owner @ abs(A_LI)).tocsr()
+    # (ones, not |A_LI|: a product drops the sums that vanish, and NGSolve's pattern holds
+    # explicit zeros)
+    ones = sp.csr_matrix((np.ones(A_LI.nnz), A_LI.indices, A_LI.indptr), shape=A_LI.shape)
+    pattern = (owner @ ones).tocsr()
     pattern.sort_indices()
     counts = np.diff(pattern.indptr)
     width = int(counts.max(initial=0))
