@@ -381,7 +381,7 @@ def coulomb_fixed_point(boundary: BoundaryProblem, forms: FrictionForms, mu_f: f
     solution's, the next Tresca solve reproduces F to round-off and the iteration stops by
     the same criterion, otherwise it goes on from there (:func:`ngdual.solvers.conforming.
     coulomb_on_sets`; the plain iteration takes 12-16 steps on Example 3.46 at order k,
-    this one 3-4).
+    levels 1-4, this one 2-7).
     """
     G, b, n_c = boundary.G, boundary.b, boundary.n_c
     floor = SAFETY * boundary.roundoff  # = kkt_tolerance(G)
@@ -390,7 +390,8 @@ def coulomb_fixed_point(boundary: BoundaryProblem, forms: FrictionForms, mu_f: f
     bound = _coulomb_bound(forms, boundary.normal_stress(state), mu_f, noise)
     history: list[float] = []
     omega, change = 1.0, np.inf
-    tried, jumped = set(), False   # the sets whose Coulomb problem was solved; the last step
+    # the sets whose Coulomb problem was solved, and whether the last step was such a solve
+    tried, jumped = set(), False
     for outer in range(1, max_iter + 1):
         state = semismooth_newton(G, b, n_c, forms.q_matrix(bound).toarray(), start=state,
                                   tol=floor)

@@ -58,6 +58,7 @@ from __future__ import annotations
 
 import functools
 import time
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -278,7 +279,9 @@ def coulomb_on_sets(cond: Condensed, mu_f: float, state: BoundarySolution
     rows[fixed] = np.eye(2 * n)[fixed]
     rhs[fixed] = 0.0
     try:
-        z = sla.solve(rows, rhs, check_finite=False)
+        with warnings.catch_warnings():   # an ill-conditioned system is no step, not noise
+            warnings.simplefilter("error", sla.LinAlgWarning)
+            z = sla.solve(rows, rhs, check_finite=False)
     except (sla.LinAlgError, sla.LinAlgWarning, ValueError):
         return None
     return (b - G @ z)[:n] if np.all(np.isfinite(z)) else None
