@@ -26,6 +26,7 @@ from __future__ import annotations
 import functools
 
 import ngsolve as ngs
+import numpy as np
 from ngsolve.meshes import MakeStructured2DMesh
 
 from .scene import SceneError
@@ -65,10 +66,16 @@ def bubbles(mesh: ngs.Mesh, order: int = 0) -> ngs.FESpace:
     active = ~h1.FreeDofs(coupling=True)
     positions = redundant_bubbles(order)
     if positions:
-        for element in mesh.Elements(ngs.VOL):
-            inner = [d for d in h1.GetDofNrs(element) if active[d]]
-            for position in positions:
-                active[inner[position]] = False
+        # NGSolve numbers the interior dofs triangle by triangle, each triangle's in the
+        # order of its GetDofNrs (checked on the first and the last triangle)
+        inner = np.flatnonzero(np.array(active, dtype=bool)).reshape(mesh.ne, -1)
+        for nr in (0, mesh.ne - 1):
+            own = [d for d in h1.GetDofNrs(ngs.ElementId(ngs.VOL, nr)) if active[d]]
+            if own != inner[nr].tolist():
+                raise RuntimeError("NGSolve's interior H1 dofs are not numbered triangle by "
+                                   "triangle")
+        for dof in inner[:, list(positions)].ravel().tolist():
+            active[dof] = False
     return ngs.Compress(h1, active_dofs=active)
 
 
