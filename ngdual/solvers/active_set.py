@@ -411,12 +411,13 @@ def coulomb_fixed_point(boundary: BoundaryProblem, forms: FrictionForms, mu_f: f
             return state, bound, history, {"outer": outer, "inner": int(inner)}
         if change >= previous and not jumped:
             omega = max(0.5 * omega, RELAXATION_MIN)
-        key = (state.contact.tobytes(), state.stick.tobytes(), np.sign(state.nu).tobytes())
-        jumped = on_sets is not None and key not in tried
-        if jumped:
-            tried.add(key)
-            stress = on_sets(state)
-            jumped = stress is not None
+        jumped = False
+        if on_sets is not None:
+            key = (state.contact.tobytes(), state.stick.tobytes(), np.sign(state.nu).tobytes())
+            if key not in tried:
+                tried.add(key)
+                stress = on_sets(state)
+                jumped = stress is not None
         bound = (_coulomb_bound(forms, stress, mu_f, noise) if jumped
                  else bound + omega * (mapped - bound))
     raise ConvergenceError(f"the Coulomb fixed point (3.123) did not converge in "

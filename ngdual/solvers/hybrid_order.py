@@ -118,7 +118,10 @@ class OrderHybridSystem:
         fes = broken.fes
         ranges = {name: fes.Range(i) for i, name in enumerate(peers.PEERS)}
         n_b, n_p = fes.ndof, len(np.bincount(broken.conforming))
-        self.local = _element_dofs(broken.matrix, ranges["eta"].start)
+        # the broken matrix with sorted rows, which _element_dofs and the element blocks read
+        matrix = broken.matrix if broken.matrix.has_sorted_indices else \
+            broken.matrix.sorted_indices()
+        self.local = _element_dofs(matrix, ranges["eta"].start)
         mu = _edge_coupling(fes.components[peers.PEERS.index("r1")], spaces.order)
         n_mu = mu.shape[1]
         contact = problem.lam_n if not friction else np.concatenate(
@@ -147,9 +150,7 @@ class OrderHybridSystem:
                 for r in (ranges["r1"], ranges["r2"])]
         # the local rows of the broken matrix, triangle by triangle: each row holds its
         # triangle's local unknowns first (in the order of self.local), then its eta
-        M = broken.matrix if broken.matrix.has_sorted_indices else \
-            broken.matrix.sorted_indices()
-        M_L = M[L]
+        M_L = matrix[L]
         size = self.local.shape[1]
         lengths = np.diff(M_L.indptr)
         place = np.arange(M_L.nnz) - np.repeat(M_L.indptr[:-1], lengths)
@@ -161,7 +162,7 @@ class OrderHybridSystem:
         K_LI = sp.csr_matrix((M_L.data[~local], M_L.indices[~local] - n_l,
                               np.concatenate([[0], np.cumsum(lengths - size)])),
                              shape=(n_l, len(eta)))
-        K_II = M[n_l:][:, n_l:]
+        K_II = matrix[n_l:][:, n_l:]
         self.A_LI = sp.hstack([K_LI, *rows, coupled[L]], format="csr")
         A_II = sp.bmat([[K_II, None, coupled[eta]],
                         [None, sp.csr_matrix((2 * n_mu, 2 * n_mu)), None],
