@@ -48,6 +48,10 @@ punch edges) and the relative error of sigma in the compliance norm (int A tau :
 
 Time: uniform and peer -- the wall time of one solve (mesh, assembly, solve; not the
 estimator); adaptive -- cumulative over all SOLVE-ESTIMATE-MARK-REFINE steps to that mesh.
+From the default K on, every time is the median of three runs (an adaptive step's: the
+median of its step's times, summed over the steps), runs beyond the first only while they
+take under 5 s (``ngdual.studies.sweep.work.REPEAT_BELOW_S``): one run's time of a fraction
+of a second varies by about 10 % with the load, enough to decide a verdict.
 The table gives the least time to reach 5 %, 2 % and 1 % per method and measure, the
 verdicts adaptive against uniform (at order 0, and the fastest of each at any order), the
 ratio of the fastest ngdual method to the primal P2

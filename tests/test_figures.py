@@ -403,3 +403,30 @@ def test_a_sweep_worker_keeps_glibcs_own_memory_trimming_and_one_blas_thread():
     with Runner(workers=1, progress=False) as runner:
         environments = list(runner.client().run(_worker_environment).values())
     assert environments == [{"MALLOC_TRIM_THRESHOLD_": None, "OMP_NUM_THREADS": "1"}]
+
+
+def test_a_true_error_task_times_the_median_of_its_runs(monkeypatch):
+    """With ``repeat`` the wall time of a solve, a peer solve and an adaptive run is the
+    median of its runs (an adaptive run's: its steps' median times summed); runs beyond
+    the first only below REPEAT_BELOW_S, and a plan below the default K times once."""
+    from ngdual.studies.sweep import work
+
+    solve, _ = work.solve_task("thesis-3.46-frictionless", 1, repeat=3)
+    assert len(solve["time_runs_s"]) == 3
+    assert solve["time_s"] == pytest.approx(np.median(solve["time_runs_s"]))
+    assert solve["time_runs_s"][0] == solve["timings_s"]["total"]
+    peer, _ = work.peer_task("hertz-cylinder", 1, 1, repeat=2)
+    assert len(peer["time_runs_s"]) == 2 and peer["time_s"] == np.median(peer["time_runs_s"])
+    run, _ = work.adapt_task("thesis-3.46-frictionless", "dorfler", 0.8, 3, 1, repeat=3)
+    cumulative = [r["cumulative_s"] for r in run["history"]]
+    assert len(cumulative) == 3 and np.all(np.diff(cumulative) > 0)
+    for r in run["history"]:   # the same meshes in every run: three times per step
+        assert len(r["cumulative_runs_s"]) == 3, r["cumulative_runs_s"]
+    runs = np.array([r["cumulative_runs_s"] for r in run["history"]]).T
+    steps = np.median(np.diff(runs, axis=1, prepend=0.0), axis=0)
+    assert cumulative == pytest.approx(np.cumsum(steps), rel=1e-12)
+    monkeypatch.setattr(work, "REPEAT_BELOW_S", 0.0)
+    once, _ = work.adapt_task("thesis-3.46-frictionless", "dorfler", 0.8, 2, 1, repeat=3)
+    assert [len(r["cumulative_runs_s"]) for r in once["history"]] == [1, 1]
+    assert len(work.solve_task("thesis-3.46-frictionless", 1, repeat=3)[0]["time_runs_s"]) == 1
+    assert Plan(3).timing_repeats == 1 and Plan(5).timing_repeats == Plan(7).timing_repeats == 3

@@ -16,6 +16,8 @@ import numpy as np
 from ..variants import setting
 
 DEFAULT_MAX_LEVEL = 5
+# the wall time of a true-error task: the median of this many runs (Plan.timing_repeats)
+TIMING_REPEATS = 3
 THESIS_MAX_LEVEL = 8
 SCENES = {"frictionless": "thesis-3.46-frictionless", "coulomb": "thesis-3.46-coulomb"}
 HHAT1 = setting("contact.hhat_factor", 1)
@@ -112,6 +114,13 @@ class Plan:
     def dorfler_refinements(self) -> int:
         return 2 * self.max_level
 
+    @property
+    def timing_repeats(self) -> int:
+        """Timed runs of a true-error task (the median is its wall time,
+        :data:`ngdual.studies.sweep.work.REPEAT_BELOW_S`): :data:`TIMING_REPEATS` from the
+        default K on; a smoke run below it times once."""
+        return TIMING_REPEATS if self.max_level >= DEFAULT_MAX_LEVEL else 1
+
     def truth_levels(self, problem: str) -> list[int]:
         """Uniform levels of the true-error studies (:data:`TRUTH_PROBLEMS`): 1 to K minus the
         problem's ``coarser``, the memory and time budget of uniform refinement."""
@@ -141,7 +150,7 @@ class Plan:
         names = ("max_level", "levels", "field_level", "reference_levels", "rho_level",
                  "rho_grid", "rho1_grid", "rho2_grid", "rho_cross", "gap_level", "uzawa_gap_level",
                  "max_marking_refinements", "max_marking_snapshots", "fraction_refinements",
-                 "fraction_snapshots", "dorfler_refinements")
+                 "fraction_snapshots", "dorfler_refinements", "timing_repeats")
         return {n: getattr(self, n) for n in names}
 
 

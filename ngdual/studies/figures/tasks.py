@@ -98,6 +98,12 @@ def adaptive_task(plan: Plan, problem: str, strategy: str) -> Task:
                 f"{scene} {marking} theta={theta}", 4.0 * refinements)
 
 
+def _repeats(plan: Plan) -> dict:
+    """The timed runs of a true-error task, as its parameter (none when one: the ids of
+    the smoke runs' tasks stay)."""
+    return {"repeat": plan.timing_repeats} if plan.timing_repeats > 1 else {}
+
+
 def truth_solve(plan: Plan, problem: str, level: int, order: int = 0,
                 family: str = "facet") -> Task:
     """A uniform solve of a :data:`TRUTH_PROBLEMS` scene that keeps its sample arrays, by
@@ -105,7 +111,7 @@ def truth_solve(plan: Plan, problem: str, level: int, order: int = 0,
     tp = TRUTH_PROBLEMS[problem]
     return Task("solve", {"scene": tp.scene, "level": level,
                           "overrides": [*tp.overrides, *order_overrides(order, family)],
-                          "fields": False, "samples": True},
+                          "fields": False, "samples": True, **_repeats(plan)},
                 f"{tp.scene} L{level} samples"
                 + (f" k={order}" if order else "") + (" coarse" if family == "coarse" else ""),
                 _cost(level + 1 + order, problem == "coulomb"))
@@ -135,7 +141,8 @@ def truth_adapt(plan: Plan, problem: str, goal: str, order: int = 0) -> Task:
                                      else None),
                           **({"reference_order": REFERENCE_ORDER,
                               "reference_dofs": REFERENCE_ORDER_DOFS}
-                             if goal == "stress" and order < REFERENCE_ORDER else {})},
+                             if goal == "stress" and order < REFERENCE_ORDER else {}),
+                          **_repeats(plan)},
                 f"{tp.scene} {goal} goal samples" + (f" k={order}" if order else ""),
                 2.0 * plan.truth_levels(problem)[-1])
 
@@ -147,7 +154,7 @@ def peer_solve(plan: Plan, problem: str, level: int, order: int) -> Task:
     finest = plan.truth_levels(problem)[-1]
     return Task("peer", {"scene": tp.scene, "level": level, "order": order,
                          "overrides": list(tp.overrides),
-                         "subdivisions": 2 ** max(finest - level, 0)},
+                         "subdivisions": 2 ** max(finest - level, 0), **_repeats(plan)},
                 f"{tp.scene} L{level} peer P{order}", _cost(level, False))
 
 

@@ -137,7 +137,7 @@ def _candidates(ctx: Context, problem: str) -> list[tuple[dict, dict]]:
                 out.append(({"method": method, "order": order, "multipliers": family,
                              "status": "ok",
                              "level_or_step": task.params["level"], "ndof": record["ndof"],
-                             "time_s": record["timings_s"]["total"],
+                             "time_s": record.get("time_s", record["timings_s"]["total"]),
                              "estimator": estimator(record)}, arrays))
     return out
 

@@ -25,6 +25,27 @@ from .fields import field_arrays
 from .records import Task
 
 
+# The true-error tasks time ``repeat`` runs and record the median: a wall time of a fraction
+# of a second varies by about 10 % from run to run with the machine's load, enough to decide
+# which of two methods reaches an accuracy first (the work-precision study's verdicts). The
+# runs after the first are made only while a run takes less than REPEAT_BELOW_S: longer ones
+# vary less and cost more.
+REPEAT_BELOW_S = 5.0
+
+
+def repeated(first: float, again: Callable[[], float], repeat: int) -> list[float]:
+    """``first`` and the wall times of further runs ``again()``, up to ``repeat`` in all,
+    while the last one took less than :data:`REPEAT_BELOW_S`.
+
+    >>> repeated(0.3, lambda: 0.2, 3), repeated(6.0, lambda: 0.2, 3)
+    ([0.3, 0.2, 0.2], [6.0])
+    """
+    times = [float(first)]
+    while len(times) < repeat and times[-1] < REPEAT_BELOW_S:
+        times.append(float(again()))
+    return times
+
+
 def load_scene_with(scene: str, overrides):
     """The shipped scene ``scene`` with ``overrides`` (a sweep parameter: a list)."""
     from ...scene import load_scene
@@ -36,8 +57,17 @@ def _status_of(solution) -> str:
     return "ok" if solution.converged else "not-converged"
 
 
+def _solve_quietly(scene, level: int):
+    from ...solvers import solve_scene
+    from ...solvers.result import PhysicsWarning
+
+    with warnings.catch_warnings():  # recorded under "warnings", not printed by a worker
+        warnings.simplefilter("ignore", PhysicsWarning)
+        return solve_scene(scene, level)
+
+
 def solve_task(scene: str, level: int, overrides: list[str] = (), fields: bool = False,
-               samples: bool = False) -> tuple[dict, dict]:
+               samples: bool = False, repeat: int = 1) -> tuple[dict, dict]:
     """Solve one scene on one level: the result record of ``ngdual solve`` (and field arrays).
 
     The record keeps the failed physics checks under ``warnings``, as ``result.json`` does.
@@ -48,17 +78,19 @@ def solve_task(scene: str, level: int, overrides: list[str] = (), fields: bool =
     of ``timings_s``, which times the solve as in ``result.json``). With ``fields=True`` the
     arrays hold what the figures of Section 3.4 plot (:func:`field_arrays`); with
     ``samples=True`` the solution as the arrays of
-    :func:`ngdual.verification.overkill.solution_samples` (true errors).
+    :func:`ngdual.verification.overkill.solution_samples` (true errors). ``time_s`` is the
+    median of ``timings_s["total"]`` over ``repeat`` solves (:func:`repeated`; the runs in
+    ``time_runs_s``).
     """
     from ...estimator import estimate
     from ...post import result_record
-    from ...solvers import solve_scene
-    from ...solvers.result import PhysicsWarning
 
-    with warnings.catch_warnings():  # recorded under "warnings", not printed by a worker
-        warnings.simplefilter("ignore", PhysicsWarning)
-        solution = solve_scene(load_scene_with(scene, overrides), level)
+    sc = load_scene_with(scene, overrides)
+    solution = _solve_quietly(sc, level)
     record = result_record(solution)
+    runs = repeated(solution.timings["total"],
+                    lambda: _solve_quietly(sc, level).timings["total"], repeat)
+    record.update(time_s=float(np.median(runs)), time_runs_s=runs)
     record["status"] = _status_of(solution)
     record["ndof"] = int(sum(record["dofs"].values()))
     indicators = estimate(solution)
@@ -92,8 +124,8 @@ def adapt_task(scene: str, marking: str, theta: float, steps: int, level: int,
                overrides: list[str] = (), snapshots: list[int] = (), samples: bool = False,
                max_elements: int | None = None, goal: str = "stress",
                tol: float | None = None, window: list[float] | None = None,
-               reference_order: int | None = None, reference_dofs: int = 0
-               ) -> tuple[dict, dict]:
+               reference_order: int | None = None, reference_dofs: int = 0,
+               repeat: int = 1) -> tuple[dict, dict]:
     """An adaptive run (:func:`ngdual.afem.adapt` with its ``goal``, ``tol`` and ``window``):
     its history, with extras for Section 4.2.
 
@@ -111,6 +143,12 @@ def adapt_task(scene: str, marking: str, theta: float, steps: int, level: int,
     by PEERS_k on its mesh (:func:`order_samples`, arrays ``s<k>_order_<name>``; not in
     ``cumulative_s``): references for sigma; the first that fails ends them
     (``reference_order_failed``).
+
+    With ``repeat`` > 1 the loop alone (no samples, no extras) runs up to ``repeat - 1``
+    times more, each to the first step past :data:`REPEAT_BELOW_S` (:func:`_loop_times`);
+    ``cumulative_runs_s`` holds every run's time to the step, and ``cumulative_s`` is the
+    sum of the steps' median times (a step's time is its cumulative time less the step
+    before's), so it grows with the steps as one run's does.
     """
     from ...afem import adapt
     from ...estimator import estimate
@@ -156,17 +194,68 @@ def adapt_task(scene: str, marking: str, theta: float, steps: int, level: int,
         if max_elements is not None and record["elements"] >= max_elements:
             raise _Budget
 
+    loop = {"marking": marking, "theta": theta, "steps": steps, "level": level, "goal": goal,
+            "tol": tol, "window": None if window is None else tuple(window)}
     try:
-        adapt(load_scene_with(scene, overrides), marking, theta, steps, level, on_step=on_step,
-              goal=goal, tol=tol, window=None if window is None else tuple(window))
+        adapt(load_scene_with(scene, overrides), on_step=on_step, **loop)
         status = "ok" if all(r["converged"] for r in history) else "not-converged"
     except ConvergenceError as err:
         run.update(message=str(err))
         status = "failed"
     except _Budget:
         status = "ok" if all(r["converged"] for r in history) else "not-converged"
+    runs = [[r["cumulative_s"] for r in history]]
+    while len(runs) < repeat and history and runs[-1][0] < REPEAT_BELOW_S:
+        runs.append(_loop_times(scene, overrides, loop, [r["dofs"]["total"] for r in history],
+                                max_elements))
+    for r, cumulative in zip(history, median_steps(runs)):
+        r["cumulative_runs_s"] = [t[r["step"]] for t in runs if len(t) > r["step"]]
+        r["cumulative_s"] = cumulative
     run.update(status=status, history=history)
     return run, arrays
+
+
+def median_steps(runs: list[list[float]]) -> list[float]:
+    """The cumulative times of a loop whose steps take the median of their times in
+    ``runs`` (each run's cumulative time per step; a run may stop early): nondecreasing as
+    every run's are.
+
+    >>> median_steps([[1.0, 3.0, 7.0], [2.0, 3.0], [1.0, 4.0]])
+    [1.0, 3.0, 7.0]
+    """
+    steps = [np.diff(t, prepend=0.0) for t in runs]
+    return np.cumsum([np.median([d[j] for d in steps if len(d) > j])
+                      for j in range(len(runs[0]))]).tolist()
+
+
+def _loop_times(scene: str, overrides, loop: dict, unknowns: list[int],
+                max_elements: int | None) -> list[float]:
+    """The wall time from the start to every step's marks of the adaptive run ``loop`` on
+    ``scene`` (the loop alone, timed as :func:`adapt_task` times it), up to the first step
+    past :data:`REPEAT_BELOW_S` or :data:`max_elements` triangles; the steps from the first
+    whose unknowns differ from ``unknowns`` (another mesh: a tie in the marking broken
+    otherwise) are left out."""
+    from ...afem import adapt
+    from ...solvers.result import ConvergenceError
+
+    times = []
+    start = time.perf_counter()
+
+    def on_step(record, solution, indicators, marked):
+        times.append(time.perf_counter() - start)
+        step = record["step"]
+        if step >= len(unknowns) or record["dofs"]["total"] != unknowns[step]:
+            times.pop()
+            raise _Budget
+        if times[-1] >= REPEAT_BELOW_S or (max_elements is not None
+                                           and record["elements"] >= max_elements):
+            raise _Budget
+
+    try:
+        adapt(load_scene_with(scene, overrides), on_step=on_step, **loop)
+    except (ConvergenceError, _Budget):
+        pass
+    return times
 
 
 def order_samples(solution, order: int) -> dict:
@@ -186,12 +275,13 @@ def order_samples(solution, order: int) -> dict:
 
 
 def peer_task(scene: str, level: int, order: int, overrides: list[str] = (),
-              subdivisions: int = 1) -> tuple[dict, dict]:
+              subdivisions: int = 1, repeat: int = 1) -> tuple[dict, dict]:
     """The scene solved by the primal peer (:mod:`ngdual.studies.primal_peer`: P``order``
     displacements, Nitsche contact, semismooth Newton) on the scene's mesh of ``level``:
     DOFs, Newton steps, wall time (meshing included) and the arrays of
     :func:`~ngdual.studies.primal_peer.primal_samples` (pressure samples on Gamma_C edges
-    split into ``subdivisions`` parts)."""
+    split into ``subdivisions`` parts); ``time_s`` the median over ``repeat`` solves
+    (:func:`repeated`, the runs in ``time_runs_s``)."""
     from ..primal_peer import NewtonError, primal_samples, solve_scene_primal
 
     sc = load_scene_with(scene, overrides)
@@ -203,6 +293,8 @@ def peer_task(scene: str, level: int, order: int, overrides: list[str] = (),
               "ndof": int(result.ndof), "newton_iterations": result.newton_iterations,
               "timings_s": {**{k: float(v) for k, v in result.times.items()},
                             "total": seconds}}
+    runs = repeated(seconds, lambda: solve_scene_primal(sc, level, order)[1], repeat)
+    record.update(time_s=float(np.median(runs)), time_runs_s=runs)
     return record, primal_samples(sc, result, subdivisions)
 
 
