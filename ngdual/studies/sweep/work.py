@@ -24,7 +24,6 @@ from ...io import versions
 from .fields import field_arrays
 from .records import Task
 
-
 # The true-error tasks time ``repeat`` runs and record the median: a wall time of a fraction
 # of a second varies by about 10 % from run to run with the machine's load, enough to decide
 # which of two methods reaches an accuracy first (the work-precision study's verdicts). The
