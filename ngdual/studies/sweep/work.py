@@ -231,7 +231,7 @@ def _loop_times(scene: str, overrides, loop: dict, unknowns: list[int],
                 max_elements: int | None) -> list[float]:
     """The wall time from the start to every step's marks of the adaptive run ``loop`` on
     ``scene`` (the loop alone, timed as :func:`adapt_task` times it), up to the first step
-    past :data:`REPEAT_BELOW_S` or :data:`max_elements` triangles; the steps from the first
+    past :data:`REPEAT_BELOW_S` or ``max_elements`` triangles; the steps from the first
     whose unknowns differ from ``unknowns`` (another mesh: a tie in the marking broken
     otherwise) are left out."""
     from ...afem import adapt
