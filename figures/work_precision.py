@@ -51,7 +51,9 @@ estimator); adaptive -- cumulative over all SOLVE-ESTIMATE-MARK-REFINE steps to 
 From the default K on, every time is the median of three runs (an adaptive step's: the
 median of its step's times, summed over the steps), runs beyond the first only while they
 take under 5 s (``ngdual.studies.sweep.work.REPEAT_BELOW_S``): one run's time of a fraction
-of a second varies by about 10 % with the load, enough to decide a verdict.
+of a second varies by about 10 % with the load, enough to decide a verdict. Every task
+runs NGSolve and BLAS on one thread (``ngdual.studies.sweep.work.one_thread``): one task per
+core, the same for every method.
 The table gives the least time to reach 5 %, 2 % and 1 % per method and measure, the
 verdicts adaptive against uniform (at order 0, and the fastest of each at any order), the
 ratio of the fastest ngdual method to the primal P2

@@ -389,6 +389,18 @@ def test_a_solve_record_and_an_adaptive_step_hold_the_estimate_under_the_same_ke
     assert estimator({"status": "ok", "ndof": 3}) is None  # the primal peer has none
 
 
+def test_a_task_runs_on_one_thread_and_leaves_the_threads_as_they_were():
+    """execute() runs NGSolve's task manager (and BLAS) on one thread: one task per core,
+    so that a large mesh's parallel assembly does not take a second core the other
+    methods' timings do not get; the setting is restored afterwards."""
+    from ngdual.studies.sweep import work
+
+    before = work._ngsolve_threads()
+    record, _ = execute(Task("dofs", {"scene": "thesis-3.46-coulomb", "level": 1}))
+    assert record["status"] == "ok" and record["threads"] == 1
+    assert work._ngsolve_threads() == before
+
+
 def _worker_environment() -> dict:
     return {name: os.environ.get(name) for name in ("MALLOC_TRIM_THRESHOLD_", "OMP_NUM_THREADS")}
 

@@ -10,6 +10,7 @@ adaptive run with the extras of Section 4.2), ``peer`` (the primal peer,
 
 from __future__ import annotations
 
+import contextlib
 import os
 import platform
 import socket
@@ -326,19 +327,51 @@ TASKS: dict[str, Callable[..., tuple[dict, dict]]] = {
     "manufactured": manufactured_task}
 
 
-def execute(task: Task) -> tuple[dict, dict]:
-    """Compute ``task`` (no files): its record and arrays, failures included."""
+def _ngsolve_threads() -> int:
+    """The threads of NGSolve's task manager (``ngsolve.GetNumThreads`` counts them only
+    inside one)."""
+    import ngsolve as ngs
+
+    with ngs.TaskManager():
+        return ngs.GetNumThreads()
+
+
+@contextlib.contextmanager
+def one_thread():
+    """NGSolve's task manager and every BLAS on one thread inside (restored on exit).
+
+    One task per core, so that the wall times of the methods compare: with NGSolve's
+    default (every core) the PEERS assembly of a mesh of 8 192 triangles or more
+    (:data:`ngdual.forms.PARALLEL_ELEMENTS`) took the second core of a one-worker study,
+    while the primal peer and the small meshes of an adaptive run assemble on one; BLAS on
+    one thread for the reason of :data:`ngdual.tolerances.BLAS_THREADS`.
+    """
+    import ngsolve as ngs
     from threadpoolctl import threadpool_limits
 
-    from ...solvers.result import ConvergenceError
     from ...tolerances import BLAS_THREADS
+
+    before = _ngsolve_threads()
+    ngs.SetNumThreads(1)
+    try:
+        with threadpool_limits(limits=BLAS_THREADS):
+            yield
+    finally:
+        ngs.SetNumThreads(before)
+
+
+def execute(task: Task) -> tuple[dict, dict]:
+    """Compute ``task`` (no files) on one thread (:func:`one_thread`): its record and
+    arrays, failures included; the record's ``threads`` are NGSolve's during the task."""
+    from ...solvers.result import ConvergenceError
 
     started = time.time()
     start = time.perf_counter()
     arrays: dict = {}
+    threads = None
     try:
-        # one BLAS thread per task, one task per core: fair timings (ngdual.tolerances)
-        with threadpool_limits(limits=BLAS_THREADS):
+        with one_thread():
+            threads = _ngsolve_threads()
             record, arrays = TASKS[task.kind](**task.params)
     except ConvergenceError as err:
         record = {"status": "failed", "message": str(err), "history_length": len(err.history)}
@@ -347,7 +380,7 @@ def execute(task: Task) -> tuple[dict, dict]:
                   "traceback": traceback.format_exc()}
     header = {"id": task.id, "kind": task.kind, "params": task.params, "label": task.label,
               "started": started, "wall_s": time.perf_counter() - start,
-              "host": socket.gethostname(), "pid": os.getpid(),
+              "host": socket.gethostname(), "pid": os.getpid(), "threads": threads,
               "load_average": list(os.getloadavg()),  # at the end: wall times depend on it
               "python": platform.python_version(), "arrays": sorted(arrays),
               "versions": versions()}
