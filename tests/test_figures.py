@@ -437,6 +437,13 @@ def test_a_true_error_task_times_the_median_of_its_runs(monkeypatch):
     runs = np.array([r["cumulative_runs_s"] for r in run["history"]]).T
     steps = np.median(np.diff(runs, axis=1, prepend=0.0), axis=0)
     assert cumulative == pytest.approx(np.cumsum(steps), rel=1e-12)
+    # a rerun that keeps no step (its first mesh differs) leaves the first run's times
+    with monkeypatch.context() as m:
+        m.setattr(work, "_loop_times", lambda *args: [])
+        alone, _ = work.adapt_task("thesis-3.46-frictionless", "dorfler", 0.8, 2, 1, repeat=3)
+    assert alone["status"] == "ok"
+    assert [r["cumulative_s"] for r in alone["history"]] == pytest.approx(
+        [r["cumulative_runs_s"][0] for r in alone["history"]], rel=1e-12)
     monkeypatch.setattr(work, "REPEAT_BELOW_S", 0.0)
     once, _ = work.adapt_task("thesis-3.46-frictionless", "dorfler", 0.8, 2, 1, repeat=3)
     assert [len(r["cumulative_runs_s"]) for r in once["history"]] == [1, 1]

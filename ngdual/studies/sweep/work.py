@@ -205,7 +205,8 @@ def adapt_task(scene: str, marking: str, theta: float, steps: int, level: int,
     except _Budget:
         status = "ok" if all(r["converged"] for r in history) else "not-converged"
     runs = [[r["cumulative_s"] for r in history]]
-    while len(runs) < repeat and history and runs[-1][0] < REPEAT_BELOW_S:
+    # (a rerun may keep no step: one whose first mesh differs, or that fails)
+    while len(runs) < repeat and history and runs[0][0] < REPEAT_BELOW_S:
         runs.append(_loop_times(scene, overrides, loop, [r["dofs"]["total"] for r in history],
                                 max_elements))
     for r, cumulative in zip(history, median_steps(runs)):
@@ -338,7 +339,8 @@ def _ngsolve_threads() -> int:
 
 @contextlib.contextmanager
 def one_thread():
-    """NGSolve's task manager and every BLAS on one thread inside (restored on exit).
+    """NGSolve's task manager and every BLAS on one thread inside (restored on exit); yields
+    the threads NGSolve's task manager then has.
 
     One task per core, so that the wall times of the methods compare: with NGSolve's
     default (every core) the PEERS assembly of a mesh of 8 192 triangles or more
@@ -355,7 +357,7 @@ def one_thread():
     ngs.SetNumThreads(1)
     try:
         with threadpool_limits(limits=BLAS_THREADS):
-            yield
+            yield _ngsolve_threads()
     finally:
         ngs.SetNumThreads(before)
 
@@ -370,8 +372,7 @@ def execute(task: Task) -> tuple[dict, dict]:
     arrays: dict = {}
     threads = None
     try:
-        with one_thread():
-            threads = _ngsolve_threads()
+        with one_thread() as threads:
             record, arrays = TASKS[task.kind](**task.params)
     except ConvergenceError as err:
         record = {"status": "failed", "message": str(err), "history_length": len(err.history)}
