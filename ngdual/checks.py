@@ -141,7 +141,7 @@ def contact_forces(solution: Solution, forms: FrictionForms | None = None) -> Fo
     traction = (forms.T_n @ solution.x)[:, None] * gamma_c.normals \
         + (forms.T_t @ solution.x)[:, None] * gamma_c.tangents
     force = gamma_c.lengths[:, None] * traction  # int_e sigma n ds per fine edge
-    hats = gamma_c.hat_means(pb.spaces.prolongations["lam_n"])
+    hats = forms.midpoint_hats  # the means of the h~ hats of lambda_n on the fine edges
     ends = gamma_c.hat_means(pb.spaces.end_hats["lam_n"])
     moments, end_moments = hats.T @ force, ends.T @ force  # (hats, 2): int sigma n mu_i
     normal = hats.T @ (force * gamma_c.normals).sum(axis=1)

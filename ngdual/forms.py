@@ -511,14 +511,7 @@ def assemble(scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes | None = None
     for form in (d, rhs):
         if form is not None:
             form.Assemble()
-    blocks_p, blocks, offset = [], {}, 0
-    for name in names:
-        p = spaces.prolongations.get(name)
-        p = sp.identity(spaces.components[name].ndof, format="csr") if p is None else p
-        blocks_p.append(p)
-        blocks[name] = slice(offset, offset + p.shape[1])
-        offset += p.shape[1]
-    P = sp.block_diag(blocks_p, format="csr")
+    P, blocks = _prolongation(spaces, names)
     # the PEERS unknowns come first and are not prolonged
     volume = broken.summed(P.shape[1])
     lift = _end_lift(scene, spaces, fes, names)
@@ -533,6 +526,32 @@ def assemble(scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes | None = None
     K.eliminate_zeros()
     return DiscreteProblem(scene, spaces, fes, names, P, K, F, blocks, lift, broken,
                            time.perf_counter() - start)
+
+
+def _prolongation(spaces: Spaces, names: list[str]) -> tuple[sp.csr_matrix, dict[str, slice]]:
+    """P (fine unknowns x coarse unknowns): the identity on a component without a
+    prolongation, ``spaces.prolongations[name]`` on the others, block by block in the order
+    of ``names``; and every component's columns.
+
+    A run of components without a prolongation is one identity block (one sparse matrix
+    instead of one per component: the same P).
+    """
+    parts, blocks, offset, identity = [], {}, 0, 0
+    for name in names:
+        p = spaces.prolongations.get(name)
+        width = spaces.components[name].ndof if p is None else p.shape[1]
+        blocks[name] = slice(offset, offset + width)
+        offset += width
+        if p is None:
+            identity += width
+            continue
+        if identity:
+            parts.append(sp.identity(identity, format="csr"))
+            identity = 0
+        parts.append(p)
+    if identity:
+        parts.append(sp.identity(identity, format="csr"))
+    return sp.block_diag(parts, format="csr"), blocks
 
 
 def _discrete_gap(scene: Scene, spaces: Spaces, fes: ngs.FESpace, names: list[str]
