@@ -84,6 +84,32 @@ def test_the_broken_peers_block_sums_to_the_conforming_one_bit_for_bit(order):
     assert np.max(np.abs(difference.data), initial=0.0) == 0.0
 
 
+def test_the_products_and_blocks_of_an_unformed_k_are_those_of_k(monkeypatch):
+    """problem.apply (E^T K_b E x plus the boundary couplings) and the multiplier blocks of
+    ``problem.block`` (from the boundary part) equal K x and K's blocks once K is formed, and
+    the hybridised solver of order k never sums K's PEERS block (it takes K x from apply)."""
+    from ngdual.forms import BrokenPeers
+
+    problem, settings = _problem("thesis-3.46-coulomb", 1, 1)
+    summed = BrokenPeers.summed
+
+    def refuse(*args):
+        raise AssertionError("the hybridised solver summed K's PEERS block")
+
+    monkeypatch.setattr(BrokenPeers, "summed", refuse)
+    solution = hybrid_active_set(problem, settings)
+    x = solution.x
+    applied = problem.apply(x)
+    blocks = [problem.block(problem.sigma, problem.lam_n),
+              problem.block(problem.index("lam_t"), problem.sigma)]
+    monkeypatch.setattr(BrokenPeers, "summed", summed)
+    K = problem.K
+    assert np.max(np.abs(applied - K @ x)) <= 1e-13 * np.max(np.abs(abs(K) @ np.abs(x)))
+    for block, rows, cols in zip(blocks, (problem.sigma, problem.index("lam_t")),
+                                 (problem.lam_n, problem.sigma)):
+        assert (block != K[rows][:, cols]).nnz == 0
+
+
 def test_the_hybridised_matrix_is_symmetric_positive_definite():
     problem, _ = _problem("thesis-3.46-coulomb", 1, 1)
     H = OrderHybridSystem(problem, friction=True).H.toarray()

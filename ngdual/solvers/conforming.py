@@ -69,7 +69,7 @@ from ..friction import MomentFriction, build_friction_forms, tresca_moments
 from ..tolerances import COULOMB_FIXED_POINT_TOL
 from .active_set import ContactStart, coulomb_fixed_point
 from .linear import Factorization
-from .qp import contact_problem_residuals
+from .qp import product_residuals
 from .result import ConvergenceError, Solution
 from .semismooth import EPS, SAFETY, BoundarySolution, condition_number, semismooth_newton
 from .settings import ActiveSetSettings
@@ -132,7 +132,7 @@ class WholeFactorization:
 
     def columns(self, unknowns: np.ndarray) -> np.ndarray:
         """(K^{-1})_{lambda, p} for the unknowns p (2 N_C x len(unknowns))."""
-        e = np.zeros(self.problem.K.shape[0])
+        e = np.zeros(self.problem.n)
         for p in unknowns:
             if p not in self._columns:
                 e[p] = 1.0
@@ -402,7 +402,7 @@ def _on_every_coefficient(problem: DiscreteProblem, law: str, mu_f: float, bound
 
 def moments(problem: DiscreteProblem, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """t_n, t_t = C^T sigma - r on every coefficient (the lambda rows of K x - rhs)."""
-    residual = problem.K @ x - problem.rhs
+    residual = problem.apply(x) - problem.rhs
     return residual[problem.lam_n], residual[problem.index("lam_t")]
 
 
@@ -420,14 +420,18 @@ def residuals(problem: DiscreteProblem, x: np.ndarray, law: str, mu_f: float,
     """
     i_sigma, i_mult, i_lam = problem.sigma, problem.mult, problem.lam_n
     b = problem.rhs[i_mult].copy()
-    t_n, t_t = moments(problem, x)
+    # K applied to sigma alone and to the rest: (A sigma, B^T sigma, C_n^T sigma) and
+    # (B y + C_n lambda_n, 0, 0), without the blocks of K
+    only_sigma = np.zeros_like(x)
+    only_sigma[i_sigma] = x[i_sigma]
+    of_sigma, of_rest = problem.apply(only_sigma), problem.apply(x - only_sigma)
+    residual = of_sigma + of_rest - problem.rhs
+    t_n, t_t = residual[i_lam], residual[problem.index("lam_t")]
     lam_t_rows = problem.index("lam_t") - len(i_sigma)
     if F is not None:  # the lambda_t rows carry Q_F^T nu = t_t
         b[lam_t_rows] += t_t
-    found = contact_problem_residuals(problem.block(i_sigma, i_sigma),
-                                      problem.block(i_sigma, i_mult),
-                                      problem.block(i_sigma, i_lam), problem.rhs[i_sigma],
-                                      b, x[i_sigma], x[i_mult], x[i_lam])
+    found = product_residuals(of_sigma[i_sigma], of_rest[i_sigma], of_sigma[i_mult],
+                              of_sigma[i_lam], problem.rhs[i_sigma], b, x[i_lam])
     lam_n, lam_t = x[i_lam], x[problem.index("lam_t")]
     displacement = float(np.max(np.abs(x[problem.index("u1", "u2", "lam_n", "lam_t")]),
                                 initial=0.0)) or 1.0

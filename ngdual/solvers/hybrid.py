@@ -368,7 +368,7 @@ class HybridSystem:
                                                      interface[self.interface])
         eta = self._ranges[peers.PEERS.index("eta")]
         values[eta.start:eta.stop] = interface[:self.n_eta]
-        x = np.zeros(pb.K.shape[0])
+        x = np.zeros(pb.n)
         peers_part = pb.broken.to_conforming(values)
         x[:len(peers_part)] = peers_part
         if "phi1" in pb.blocks:

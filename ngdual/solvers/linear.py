@@ -77,7 +77,7 @@ def solve_linear(problem: DiscreteProblem) -> Solution:
     saddle = problem.saddle
     fact = Factorization(problem.block(saddle, saddle))
     start = time.perf_counter()
-    x = np.zeros(problem.K.shape[0])
+    x = np.zeros(problem.n)
     x[saddle] = fact.solve(problem.rhs[saddle])
     solve_s = time.perf_counter() - start
     return Solution(problem, x, True, "linear",

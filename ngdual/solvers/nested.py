@@ -284,7 +284,7 @@ def nested_uzawa(problem: DiscreteProblem, settings: NestedUzawaSettings,
     state, inner, _, inner_ok = loop.run(lam, rho1, eps1, max_iter, tau=friction.load(nu))
     inner_total += inner
     converged = converged and inner_ok
-    x = np.zeros(problem.K.shape[0])
+    x = np.zeros(problem.n)
     x[problem.saddle], x[problem.lam_n] = loop.solution(state), state.lam
     bound = friction.bound
     return Solution(problem, x, converged, f"nested-uzawa-{law}-{s.metric}-{s.loop_order}",

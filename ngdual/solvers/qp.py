@@ -107,7 +107,7 @@ def _solve_qp(problem: DiscreteProblem, modulus: float,
     polish_s = time.perf_counter() - start
     z_v, y_v, lam_v = polished if polished is not None else scaled
 
-    x = np.zeros(problem.K.shape[0])
+    x = np.zeros(problem.n)
     x[i_sigma] = stress * z_v
     x[i_mult] = stress / modulus * y_v
     x[i_lam] = stress / modulus * lam_v
@@ -215,15 +215,20 @@ def _polish(A, B, C_n, g, b, z, y, lam):
 
 
 def contact_problem_residuals(A, B, C_n, g, b, sigma, y, lam) -> dict:
-    """Relative residuals of (3.103): stationarity, equalities, sign conditions, complementarity."""
-    traction = C_n.T @ sigma
-    a_sigma = A @ sigma
+    """Relative residuals of (3.103) for the blocks A, B, C_n of K (:func:`product_residuals`)."""
+    return product_residuals(A @ sigma, B @ y + C_n @ lam, B.T @ sigma, C_n.T @ sigma, g, b, lam)
+
+
+def product_residuals(a_sigma, coupling, b_sigma, traction, g, b, lam) -> dict:
+    """Relative residuals of (3.103): stationarity, equalities, sign conditions, complementarity,
+    from the products of K with the solution: A sigma, B y + C_n lambda_n, B^T sigma and the
+    traction moments C_n^T sigma (taken from K's blocks, or from K x without forming K)."""
     lam_scale = np.max(np.abs(lam), initial=0.0) or 1.0
     tr_scale = np.max(np.abs(traction), initial=0.0) or 1.0
     return {
-        "stationarity": float(np.linalg.norm(a_sigma + B @ y + C_n @ lam - g)
+        "stationarity": float(np.linalg.norm(a_sigma + coupling - g)
                               / ((np.linalg.norm(g) + np.linalg.norm(a_sigma)) or 1.0)),
-        "equality": float(np.linalg.norm(B.T @ sigma - b) / (np.linalg.norm(b) or 1.0)),
+        "equality": float(np.linalg.norm(b_sigma - b) / (np.linalg.norm(b) or 1.0)),
         "lambda_n_negative": float(max(0.0, -lam.min(initial=0.0)) / lam_scale),
         "sigma_n_positive": float(max(0.0, traction.max(initial=0.0)) / tr_scale),
         "complementarity": float(abs(lam @ traction)

@@ -243,7 +243,7 @@ def uzawa(problem: DiscreteProblem, settings: UzawaSettings,
     start = time.perf_counter()
     state, its, history, converged = loop.run(np.zeros(len(problem.lam_n)), s.rho, s.eps,
                                               s.max_iter, progress=progress)
-    x = np.zeros(problem.K.shape[0])
+    x = np.zeros(problem.n)
     x[problem.saddle], x[problem.lam_n] = loop.solution(state), state.lam
     residuals = {"increment": history[-1], **loop.residuals(state)}
     return Solution(problem, x, converged, f"uzawa-{s.metric}",

@@ -28,7 +28,7 @@ def one_level(scene: str, level: int, overrides: list[str]) -> dict:
 
     solution = solve_quietly(load_scene(scene, overrides), level)
     return {"scene": scene, "level": level, "overrides": overrides,
-            "ndof": int(solution.problem.K.shape[0]), "dofs": solution.problem.spaces.dofs(),
+            "ndof": solution.problem.n, "dofs": solution.problem.spaces.dofs(),
             "converged": solution.converged, "iterations": solution.iterations,
             "timings_s": solution.timings, "norms": norms(solution),
             "peak_rss_mb": peak_rss_mb(), "warnings": warning_messages(solution),

@@ -140,7 +140,7 @@ def _measure(case: str, level: int, solver: str) -> dict:
     record = {
         "case": case, "scene": scene.name, "level": level, "solver": solver,
         "method": solution.method if solution else None,
-        "ndof": int(problem.K.shape[0]), "dofs": problem.spaces.dofs(),
+        "ndof": problem.n, "dofs": problem.spaces.dofs(),
         "converged": bool(solution and solution.converged), "error": error,
         "iterations": {k: int(v) for k, v in solution.iterations.items()} if solution else None,
         "seconds_assemble": assemble_s,
