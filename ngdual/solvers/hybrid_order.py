@@ -167,7 +167,8 @@ class OrderHybridSystem:
         self.A_LI = sp.hstack([K_LI, *rows, coupled[L]], format="csr")
         A_II = sp.bmat([[K_II, None, coupled[eta]],
                         [None, sp.csr_matrix((2 * n_mu, 2 * n_mu)), None],
-                        [coupled[eta].T, None, boundary[multipliers][:, multipliers]]], format="csr")
+                        [coupled[eta].T, None, boundary[multipliers][:, multipliers]]],
+                       format="csr")
         self.H = (_element_schur(self.B_inv, self.A_LI) - A_II).tocsr()
         self.H = 0.5 * (self.H + self.H.T)
         n_i = len(self.interface)
