@@ -414,7 +414,7 @@ class DiscreteProblem:
     blocks : dict[str, slice]
         Position of every component in the unknown vector.
     broken : BrokenPeers
-        The PEERS block element by element, from which K's PEERS block was summed (the
+        The PEERS block element by element, from which K's PEERS block is summed (the
         input of the hybridised solvers, :mod:`ngdual.solvers.hybrid` and
         :mod:`ngdual.solvers.hybrid_order`).
     """

@@ -12,11 +12,12 @@ refinement included); ``other`` is what no phase accounts for (meshing, the form
 checks, the spaces of the next mesh).
 
 The unit is one linear solve of the mesh's own system as the active-set solver does it,
-from its formulas: the assembly of (3.62) (which assembles the PEERS block once, for K and
-for the hybridisation, :class:`~ngdual.forms.BrokenPeers`), the factorisation
-(``timings["factorize"]``: the static condensation and the Cholesky factorisation) and one
-forward and one backward substitution (``timings["substitute"]``); ``ratio`` = step total /
-unit is what the adaptive loop pays on a mesh beyond solving it once. ``ratio_factorize``
+from its formulas: the assembly of (3.62) (the PEERS element matrices once, for the
+hybridisation and for K where a solver forms it, :class:`~ngdual.forms.BrokenPeers`), the
+factorisation (``timings["factorize"]``: the static condensation and the Cholesky
+factorisation) and one forward and one backward substitution (``timings["substitute"]``);
+``ratio`` = step total / unit is what the adaptive loop pays on a mesh beyond solving it
+once. ``ratio_factorize``
 counts the assembly as a fixed cost of the step (unit: factorisation and substitution),
 ``ratio_cholesky`` the condensation too (unit: Cholesky factorisation and substitution).
 """
