@@ -178,6 +178,8 @@ class ContactBoundary:
         The vertex functions of the trace space have the mean 1/2 on their edge, its bubbles
         ``bubble_means`` (facet multipliers of order k >= 2)."""
         P = prolongation.tocsr()
+        if P.shape[1] == 0:  # no function (the facet multipliers fix no end)
+            return sp.csr_matrix((len(self.edge_dofs), 0))
         means = 0.5 * (P[self.edge_dofs[:, 0]] + P[self.edge_dofs[:, 1]])
         for j in range(self.bubble_dofs.shape[1]):
             means = means + sp.diags(self.bubble_means[:, j]) @ P[self.bubble_dofs[:, j]]
