@@ -17,9 +17,9 @@ hybridisation and for K where a solver forms it, :class:`~ngdual.forms.BrokenPee
 factorisation (``timings["factorize"]``: the static condensation and the Cholesky
 factorisation) and one forward and one backward substitution (``timings["substitute"]``);
 ``ratio`` = step total / unit is what the adaptive loop pays on a mesh beyond solving it
-once. ``ratio_factorize``
-counts the assembly as a fixed cost of the step (unit: factorisation and substitution),
-``ratio_cholesky`` the condensation too (unit: Cholesky factorisation and substitution).
+once. ``ratio_factorize`` counts the assembly as a fixed cost of the step (unit:
+factorisation and substitution), ``ratio_cholesky`` the condensation too (unit: Cholesky
+factorisation and substitution).
 """
 
 from __future__ import annotations
