@@ -80,6 +80,10 @@ TARGETS = (0.05, 0.02, 0.01)
 MEASURES = {"pressure": "pressure error on $\\Gamma_C$ (rel. $L^2$) [-]",
             "sigma_energy": "error of $\\sigma$ (rel. compliance norm) [-]"}
 UNIFORM, P2 = "uniform", "primal P2"
+# the problems' names in the summary tables (the README's)
+SUMMARY_NAMES = {"frictionless": "3.46, μ_f = 0", "coulomb": "3.46, μ_f = 0.5",
+                 "flat-punch": "punch core", "hertz-cylinder": "Hertz",
+                 "cattaneo-mindlin": "Cattaneo–Mindlin", "wedge": "wedge"}
 # the figure's curves: a colour per order (the peers: grey P1, black P2), a line style and
 # a marker per method
 ORDER_COLOURS = {0: "C0", 1: "C1", 2: "C2"}
@@ -241,6 +245,77 @@ def pivot(table: list[dict], verdict: list[dict]) -> list[dict]:
     return out
 
 
+def seconds_and_unknowns(time_s: float, ndof: int) -> str:
+    """A cell of the summary: the time to two digits (one decimal from 10 s on) and the
+    unknowns in groups of three.
+
+    >>> seconds_and_unknowns(0.0987, 12721), seconds_and_unknowns(24.93, 592390)
+    ('0.099 s (12 721)', '24.9 s (592 390)')
+    """
+    time = f"{time_s:.1f}" if time_s >= 10 else f"{time_s:.2g}"
+    return f"{time} s ({ndof:,})".replace(",", " ")
+
+
+def method_letters(method: str) -> str:
+    """u (uniform), s / p (adaptive, stress / pressure goal), with c for the coarse
+    multipliers of order k.
+
+    >>> method_letters("adaptive, pressure goal, k = 2"), method_letters("uniform, k = 1, coarse")
+    ('p', 'uc')
+    """
+    base = {UNIFORM: "u", "adaptive, stress goal": "s", "adaptive, pressure goal": "p"}
+    order, family = method_order(method)
+    return base[method_base(method)] + ("c" if order and family == "coarse" else "")
+
+
+def summary_rows(table: list[dict], verdict: list[dict], measure: str) -> list[dict]:
+    """The README's time-to-accuracy table of ``measure``: per problem and target the least
+    time (unknowns) of uniform and adaptive refinement at k = 0, of the fastest method of
+    each order k >= 1 and of the primal P2 peer, the ratios to P2, whether the fastest
+    adaptive method of any order comes first and whether the reference resolves the target."""
+    def cell(rows: list[dict], letters: bool = True) -> str | None:
+        hits = [r for r in rows if r["time_s"] is not None]
+        if not hits:
+            return None
+        best = min(hits, key=lambda r: r["time_s"])
+        text = seconds_and_unknowns(best["time_s"], best["ndof"])
+        return f"{text} {method_letters(best['method'])}" if letters else text
+
+    def ratio(value: float | None) -> str | None:
+        return None if value is None else f"{value:.2g}"
+
+    out = []
+    for v in verdict:
+        if v["measure"] != measure:
+            continue
+        mine = [r for r in table if (r["problem"], r["measure"], r["target"])
+                == (v["problem"], measure, v["target"])]
+        ngdual = [r for r in mine if not is_peer(r["method"])]
+        row = {"case": f"{SUMMARY_NAMES[v['problem']]}, {v['target']:.0%}".replace("%", " %"),
+               "uniform": cell([r for r in mine if r["method"] == UNIFORM], letters=False),
+               "adaptive": cell([r for r in ngdual if r["method"].startswith("adaptive")
+                                 and r["order"] == 0]),
+               **{f"k{k}": cell([r for r in ngdual if r["order"] == k]) for k in ORDERS},
+               "p2": cell([r for r in mine if r["method"] == P2], letters=False),
+               "ratio": ratio(v["ratio_ngdual_p2"]), "ratio_order": ratio(v["ratio_order_p2"]),
+               "first": (None if v["adaptive_any_wins"] is None
+                         else "yes" if v["adaptive_any_wins"] else "no"),
+               "resolved": "yes" if v["resolved"] else "no"}
+        out.append(row)
+    return out
+
+
+def summary_markdown(table: list[dict], verdict: list[dict]) -> str:
+    """Both measures' :func:`summary_rows` as the two markdown tables of the README."""
+    what = {"pressure": "problem, pressure", "sigma_energy": "problem, σ"}
+    return "\n\n".join(markdown_table(
+        summary_rows(table, verdict, measure),
+        {"case": header, "uniform": "uniform, k = 0", "adaptive": "adaptive, k = 0",
+         **{f"k{k}": f"k = {k}" for k in ORDERS}, "p2": "primal P2", "ratio": "ngdual / P2",
+         "ratio_order": "k ≥ 1 / P2", "first": "adaptive first", "resolved": "resolved"},
+        missing="–") for measure, header in what.items()) + "\n"
+
+
 def curve_style(method: str) -> dict:
     """The colour of the method's order (:data:`ORDER_COLOURS`; the peers
     :data:`PEER_COLOURS`), the line style and marker of the method (:data:`METHOD_STYLES`);
@@ -353,8 +428,8 @@ def run(ctx):
     # WRITE
     data = ctx.write_csv("work_precision.csv", rows, "true errors (pressure, sigma), wall "
                          "time, DOFs, estimator and goal estimate of every solution")
-    summary = ctx.write_csv("work_precision_table.csv", table,
-                            "least wall time to 5 %, 2 %, 1 % true error per method")
+    least = ctx.write_csv("work_precision_table.csv", table,
+                          "least wall time to 5 %, 2 %, 1 % true error per method")
     verdicts_csv = ctx.write_csv("work_precision_verdict.csv", verdict,
                                  "adaptive against uniform, fastest ngdual against primal P2")
     js = ctx.write_json("work_precision.json",
@@ -364,6 +439,10 @@ def run(ctx):
                         "time to accuracy on true errors, adaptive references with their "
                         "Richardson and quadrature checks, adaptive against uniform, the "
                         "pressure goal's effectivity")
+    summary = ctx.write_markdown("work_precision_summary.md", summary_markdown(table, verdict),
+                                 "least wall time to 5 %, 2 %, 1 % per order, the README's "
+                                 "tables (u = uniform, s / p = adaptive with the stress / "
+                                 "pressure goal, c = the coarse multipliers)")
     # PLOT: one row per problem, pressure and sigma against time and unknowns
     fig = plot.plot_curves(_panels(rows, references),
                            "What accuracy costs: true errors against adaptive references; "
@@ -373,7 +452,7 @@ def run(ctx):
                            figure_legend=True)
     figs = plot.save_figure(fig, ctx.figure_stem("work_precision"))
     ctx.entry(THESIS, "Work-precision: true errors against wall time and unknowns",
-              [*figs, data, summary, verdicts_csv, js],
+              [*figs, data, least, verdicts_csv, js, summary],
               _numbers(verdict, effectivity, budget),
               table=markdown_table(
                   pivot(table, verdict),

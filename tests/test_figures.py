@@ -248,6 +248,15 @@ def test_work_precision_measures_true_errors_against_references_it_checks(coarse
     assert not any(r["failed"] for r in table if ", k = " not in r["method"])
     assert any(r["time_s"] != "" and r["order"] == "2" for r in table)
     assert {v["target"] for v in result["verdicts"]} == {0.05, 0.02, 0.01}
+    # the README's two tables: a row per problem and target, its verdict in "adaptive first"
+    summary = (coarse_run / "data" / "work_precision_summary.md").read_text()
+    rows = [line.split(" | ") for line in summary.splitlines() if line.startswith("| ")
+            and not line.startswith("| problem")]
+    assert len(rows) == len(result["verdicts"])
+    ordered = [v for measure in ("pressure", "sigma_energy") for v in result["verdicts"]
+               if v["measure"] == measure]
+    assert [r[-2] for r in rows] == [{None: "–", True: "yes", False: "no"}[
+        v["adaptive_any_wins"]] for v in ordered]
     for v in result["verdicts"]:
         # the fastest adaptive run of any order is at least as fast as that of order 0
         if v["adaptive_s"] is not None:
@@ -314,6 +323,45 @@ def test_the_thesis_scale_plan_uses_the_thesis_steps():
     with pytest.raises(ValueError, match="max-level"):
         Plan(9)
     assert main(["figures", "--max-level", "1", "--out", "unused"]) == 2
+
+
+def test_the_readme_summary_takes_the_fastest_method_of_each_order():
+    """work_precision's summary tables (the README's): per order the least time of any of
+    its methods with its letters, uniform and P2 without, the verdict's ratios and "adaptive
+    first", a dash where nothing reaches the target; and the script's doctests pass."""
+    import doctest
+
+    from ngdual.studies.figures.run import load_script
+
+    wp = load_script(Path(__file__).parents[1] / "figures" / "work_precision.py")
+    assert doctest.testmod(wp).failed == 0
+
+    def hit(method, order, time_s, ndof, family="facet"):
+        return {"problem": "hertz-cylinder", "measure": "pressure", "target": 0.02,
+                "method": method, "order": order, "multipliers": family, "time_s": time_s,
+                "ndof": ndof}
+    table = [hit("uniform", 0, None, None, "coarse"),
+             hit("adaptive, stress goal", 0, 4.2, 250813, "coarse"),
+             hit("adaptive, pressure goal", 0, 0.89, 30079, "coarse"),
+             hit("uniform, k = 1", 1, 0.59, 87857), hit("adaptive, pressure goal, k = 1", 1,
+                                                         0.71, 15139),
+             hit("uniform, k = 2, coarse", 2, 0.43, 43034, "coarse"),
+             hit("adaptive, stress goal, k = 2", 2, 0.81, 15533),
+             hit("primal P2", 2, 3.6, 58690, "Nitsche")]
+    verdict = [{"problem": "hertz-cylinder", "measure": "pressure", "target": 0.02,
+                "resolved": True, "adaptive_any_wins": False, "ratio_ngdual_p2": 0.43 / 3.6,
+                "ratio_order_p2": 0.43 / 3.6},
+               {"problem": "hertz-cylinder", "measure": "sigma_energy", "target": 0.02,
+                "resolved": False, "adaptive_any_wins": None, "ratio_ngdual_p2": None,
+                "ratio_order_p2": None}]
+    [row] = wp.summary_rows(table, verdict, "pressure")
+    assert row == {"case": "Hertz, 2 %", "uniform": None, "adaptive": "0.89 s (30 079) p",
+                   "k1": "0.59 s (87 857) u", "k2": "0.43 s (43 034) uc",
+                   "p2": "3.6 s (58 690)", "ratio": "0.12", "ratio_order": "0.12",
+                   "first": "no", "resolved": "yes"}
+    markdown = wp.summary_markdown(table, verdict)
+    assert "| Hertz, 2 % | – | 0.89 s (30 079) p |" in markdown
+    assert "| Hertz, 2 % | – | – | – | – | – | – | – | – | no |" in markdown
 
 
 def test_task_ids_are_stable_and_distinguish_parameters():

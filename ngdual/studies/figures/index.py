@@ -105,8 +105,9 @@ def write_gallery(out: str | Path, dest: str | Path, width: int = 900,
     return written
 
 
-def markdown_table(rows: list[dict], columns: dict[str, str]) -> str:
-    """A markdown table of ``rows``; ``columns`` maps keys to headers (missing values: -).
+def markdown_table(rows: list[dict], columns: dict[str, str], missing: str = "-") -> str:
+    """A markdown table of ``rows``; ``columns`` maps keys to headers (a missing value:
+    ``missing``).
 
     >>> print(markdown_table([{"a": 1, "b": 0.5}], {"a": "A", "b": "B"}))
     | A | B |
@@ -115,6 +116,6 @@ def markdown_table(rows: list[dict], columns: dict[str, str]) -> str:
     """
     head = "| " + " | ".join(columns.values()) + " |"
     rule = "|" + "---|" * len(columns)
-    body = ["| " + " | ".join("-" if r.get(k) is None else _format(r[k]) for k in columns) + " |"
-            for r in rows]
+    body = ["| " + " | ".join(missing if r.get(k) is None else _format(r[k]) for k in columns)
+            + " |" for r in rows]
     return "\n".join([head, rule, *body])

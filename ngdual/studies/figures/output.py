@@ -119,6 +119,17 @@ class Context:
         self.written.append(path)
         return path
 
+    def write_markdown(self, name: str, text: str, description: str) -> Path:
+        """Markdown ``text`` after an HTML comment with the description, plan and package
+        versions (a table to paste into a page)."""
+        path = self.data_path(name)
+        header = "\n".join(f"{key}: {json.dumps(value) if not isinstance(value, str) else value}"
+                           for key, value in self.header(description).items())
+        with atomic(path) as fh:
+            fh.write(f"<!--\n{header}\n-->\n\n{text}")
+        self.written.append(path)
+        return path
+
     def entry(self, thesis: str, title: str, files: list, numbers: dict | None = None,
               thesis_says: str = "", notes: str = "", table: str = "") -> Path:
         """Register this script's outputs for the index (``DIR/entries/<script>.json``).
