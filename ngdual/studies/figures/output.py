@@ -99,6 +99,11 @@ class Context:
         return {"description": description, "script": self.script, "plan": self.plan.describe(),
                 "versions": versions()}
 
+    def _header_lines(self, description: str) -> list[str]:
+        """``key: value`` lines of :meth:`header` for a text file (non-strings as JSON)."""
+        return [f"{key}: {json.dumps(value) if not isinstance(value, str) else value}"
+                for key, value in self.header(description).items()]
+
     def write_json(self, name: str, data: dict, description: str) -> Path:
         path = write_json({**self.header(description), **data}, self.data_path(name))
         self.written.append(path)
@@ -109,9 +114,8 @@ class Context:
         path = self.data_path(name)
         columns = list(dict.fromkeys(k for row in rows for k in row))
         with atomic(path, newline="") as fh:
-            for key, value in self.header(description).items():
-                fh.write(f"# {key}: {json.dumps(value) if not isinstance(value, str) else value}"
-                         "\n")
+            for line in self._header_lines(description):
+                fh.write(f"# {line}\n")
             writer = csv.DictWriter(fh, columns)
             writer.writeheader()
             for row in rows:
@@ -123,8 +127,7 @@ class Context:
         """Markdown ``text`` after an HTML comment with the description, plan and package
         versions (a table to paste into a page)."""
         path = self.data_path(name)
-        header = "\n".join(f"{key}: {json.dumps(value) if not isinstance(value, str) else value}"
-                           for key, value in self.header(description).items())
+        header = "\n".join(self._header_lines(description))
         with atomic(path) as fh:
             fh.write(f"<!--\n{header}\n-->\n\n{text}")
         self.written.append(path)
