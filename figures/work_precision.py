@@ -47,7 +47,9 @@ Nitsche pressure; the flat punch: on the core |x| < a/2, its pressure is not in 
 punch edges) and the relative error of sigma in the compliance norm (int A tau : tau)^(1/2).
 
 Time: uniform and peer -- the wall time of one solve (mesh, assembly, solve; not the
-estimator); adaptive -- cumulative over all SOLVE-ESTIMATE-MARK-REFINE steps to that mesh.
+estimator); adaptive -- to that mesh's solution: the SOLVE-ESTIMATE-MARK-REFINE of every
+step before and its SOLVE (the estimate on the mesh, which decides whether to go on, is left
+out as uniform's is; ngdual.studies.sweep.work.adapt_task).
 From the default K on, every time is the median of three runs (an adaptive step's: the
 median of its step's times, summed over the steps), runs beyond the first only while they
 take under 5 s (``ngdual.studies.sweep.work.REPEAT_BELOW_S``): one run's time of a fraction

@@ -171,25 +171,30 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
         ``goal``, ``goal_estimate``, ``relative_estimate`` and ``elapsed_s``, the wall time
         of SOLVE, ESTIMATE, MARK and REFINE from the start of ``adapt`` to the end of the
         step (without the time spent in ``on_step``; before ``on_step`` it holds the time
-        up to MARK). The last record's ``stopped_by`` is ``"tol"``
-        or ``"steps"``.
+        up to MARK), and ``solved_s``, the wall time from the start to the step's solution:
+        the steps before in full and this step's SOLVE (as ``timings["total"]`` of
+        :func:`~ngdual.solvers.solve_scene` times one solve, from the checks of the
+        arguments on, meshing included). The last record's ``stopped_by`` is ``"tol"`` or
+        ``"steps"``.
     """
+    start = time.perf_counter()   # as solve_scene's timings["total"]: checks and mesh too
     scene = with_discretisation(scene, order, multipliers)
     _check_adapt_arguments(scene, marking, theta, steps, level, asymmetry, reference, on_step,
                            allow_large, goal, tol, window)
     marking = MARKING if marking is None else marking
     theta, steps, level = loop_defaults(tol, theta, steps, level)
     budget.check_scene(scene, level, "level", allow_large)
-    start = time.perf_counter()
     mesh = build_mesh(scene.geometry, level)
     coarse = BoundaryMeshes.for_scene(scene, mesh)
     history, warm = [], None
     for step in range(steps):
         # SOLVE
         solution = solve_on_mesh(scene, mesh, coarse, start=warm)
+        solved = time.perf_counter() - start
         # ESTIMATE
         estimated = estimate(solution, asymmetry)
         record = step_record(step, solution, estimated, reference)
+        record["solved_s"] = solved
         indicators = _goal_indicators(record, solution, estimated, goal, window)
         history.append(record)
         converged = tol is not None and record["relative_estimate"] <= tol

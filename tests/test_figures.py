@@ -482,6 +482,8 @@ def test_a_true_error_task_times_the_median_of_its_runs(monkeypatch):
     assert len(cumulative) == 3 and np.all(np.diff(cumulative) > 0)
     for r in run["history"]:   # the same meshes in every run: three times per step
         assert len(r["cumulative_runs_s"]) == 3, r["cumulative_runs_s"]
+        # the time to the step's solution, its estimate and marks not counted
+        assert r["cumulative_runs_s"][0] == r["solved_s"] < r["elapsed_s"]
     runs = np.array([r["cumulative_runs_s"] for r in run["history"]]).T
     steps = np.median(np.diff(runs, axis=1, prepend=0.0), axis=0)
     assert cumulative == pytest.approx(np.cumsum(steps), rel=1e-12)

@@ -91,6 +91,10 @@ def test_a_tolerance_stops_the_loop_by_itself(hertz):
     assert 2 <= len(history) < 8
     elapsed = [r["elapsed_s"] for r in history]
     assert all(b > a > 0 for a, b in zip(elapsed, elapsed[1:]))
+    # a step's solution comes after the whole step before and before its own estimate
+    solved = [r["solved_s"] for r in history]
+    assert 0 < solved[0] < elapsed[0]
+    assert all(e < s < f for e, s, f in zip(elapsed, solved[1:], elapsed[1:]))
 
 
 def test_without_tol_the_loop_runs_its_steps_and_says_so(hertz):

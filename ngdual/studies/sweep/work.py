@@ -131,9 +131,12 @@ def adapt_task(scene: str, marking: str, theta: float, steps: int, level: int,
 
     Every step record of :func:`ngdual.afem.step_record` gets ``eta_as`` (the
     largest eta_{as,T} with as(sigma_h) in L^2 and in H(div), and the share
-    q_as of triangles with eta_{as,T} >= 0.1 max, Table 4.2) and ``cumulative_s``
-    (the wall time from the start to this step's marks, all solves, estimates and
-    refinements before included; not the extra H(div) estimate). The
+    q_as of triangles with eta_{as,T} >= 0.1 max, Table 4.2) and ``cumulative_s``, the
+    wall time to this step's solution (the step's ``solved_s``: every SOLVE, ESTIMATE, MARK
+    and REFINE before it and its SOLVE; not the extras of ``on_step``). A uniform solve's
+    time (:func:`solve_task`) is that of its SOLVE, without the estimate: the estimate and
+    marks on the step's mesh, which only decide whether to go on, are left out here alike
+    (loading the scene from its TOML is left out of both). The
     meshes of the steps in ``snapshots`` are kept as arrays ``points_<k>``,
     ``triangles_<k>`` and ``marked_<k>``. A ConvergenceError keeps the steps done.
     With ``samples=True`` every step's solution is kept as the arrays of
@@ -156,16 +159,12 @@ def adapt_task(scene: str, marking: str, theta: float, steps: int, level: int,
     from ...solvers.result import ConvergenceError
 
     history, arrays = [], {}
-    start, extra = time.perf_counter(), [0.0]
     run = {"scene": scene, "marking": marking, "theta": theta, "steps": steps, "level": level,
            "overrides": list(overrides), "goal": goal, "tol": tol, "window": window,
            "reference_order": reference_order}
 
     def on_step(record, solution, indicators, marked):
-        # wall time up to this solution, its estimate and marks (refine of the step before
-        # included; step_record's "solve" leaves out the Gamma_C condensation)
-        record["cumulative_s"] = time.perf_counter() - start - extra[0]
-        t0 = time.perf_counter()
+        record["cumulative_s"] = record["solved_s"]
         hdiv = estimate(solution, "hdiv")
         record["eta_as"] = {}
         for norm, est in (("l2", indicators), ("hdiv", hdiv)):
@@ -190,7 +189,6 @@ def adapt_task(scene: str, marking: str, theta: float, steps: int, level: int,
                 except ConvergenceError as err:   # no reference from here on; k = 0 stays
                     run["reference_order_failed"] = f"step {k}: {err}"
         history.append(dict(record))
-        extra[0] += time.perf_counter() - t0
         if max_elements is not None and record["elements"] >= max_elements:
             raise _Budget
 
@@ -231,8 +229,8 @@ def median_steps(runs: list[list[float]]) -> list[float]:
 
 def _loop_times(scene: str, overrides, loop: dict, unknowns: list[int],
                 max_elements: int | None) -> list[float]:
-    """The wall time from the start to every step's marks of the adaptive run ``loop`` on
-    ``scene`` (the loop alone, timed as :func:`adapt_task` times it), up to the first step
+    """The wall time from the start to every step's solution of the adaptive run ``loop``
+    on ``scene`` (``solved_s``, as :func:`adapt_task` times it), up to the first step
     past :data:`REPEAT_BELOW_S` or ``max_elements`` triangles; the steps from the first
     whose unknowns differ from ``unknowns`` (another mesh: a tie in the marking broken
     otherwise) are left out."""
@@ -240,10 +238,9 @@ def _loop_times(scene: str, overrides, loop: dict, unknowns: list[int],
     from ...solvers.result import ConvergenceError
 
     times = []
-    start = time.perf_counter()
 
     def on_step(record, solution, indicators, marked):
-        times.append(time.perf_counter() - start)
+        times.append(record["solved_s"])
         step = record["step"]
         if step >= len(unknowns) or record["dofs"]["total"] != unknowns[step]:
             times.pop()
