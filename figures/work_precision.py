@@ -53,7 +53,13 @@ out as uniform's is; ngdual.studies.sweep.work.adapt_task).
 From the default K on, every time is the median of three runs (an adaptive step's: the
 median of its step's times, summed over the steps), runs beyond the first only while they
 take under 5 s (``ngdual.studies.sweep.work.REPEAT_BELOW_S``): one run's time of a fraction
-of a second varies by about 10 % with the load, enough to decide a verdict. Every task
+of a second varies by about 10 % with the load, enough to decide a verdict. A task's runs
+follow each other, so one slow period of the machine (10-25 % on a shared VM, invisible to
+the guest) can fall on all runs of one method: a verdict whose two times lie within
+CLOSE (1.3x) of each other is timed again after the sweep, the uniform solve and the
+adaptive run to its step in turn, seven runs of each after one not counted
+(ngdual.studies.sweep.work.paired_task), and decided by their medians (the table's
+"adaptive first" gives them). Every task
 runs NGSolve and BLAS on one thread (``ngdual.studies.sweep.work.one_thread``): one task per
 core, the same for every method.
 The table gives the least time to reach 5 %, 2 % and 1 % per method and measure, the
@@ -75,6 +81,8 @@ from ngdual.studies.figures.plan import (
     method_order,
     order_method,
 )
+from ngdual.studies.figures.tasks import paired_timing, truth_tasks
+from ngdual.studies.sweep.work import REPEAT_BELOW_S
 
 THESIS = "Work-precision (beyond the thesis)"
 STUDIES = ("truth",)
@@ -82,6 +90,10 @@ TARGETS = (0.05, 0.02, 0.01)
 MEASURES = {"pressure": "pressure error on $\\Gamma_C$ (rel. $L^2$) [-]",
             "sigma_energy": "error of $\\sigma$ (rel. compliance norm) [-]"}
 UNIFORM, P2 = "uniform", "primal P2"
+# A verdict whose adaptive and uniform times lie within this factor of each other (both
+# under REPEAT_BELOW_S) is timed again in pairs, the two methods in turn (paired_timing):
+# one slow period of the machine moves a task's back-to-back repeats by 10-25 %.
+CLOSE = 1.3
 # the problems' names in the summary tables (the README's)
 SUMMARY_NAMES = {"frictionless": "3.46, μ_f = 0", "coulomb": "3.46, μ_f = 0.5",
                  "flat-punch": "punch core", "hertz-cylinder": "Hertz",
@@ -178,9 +190,12 @@ def verdicts(table: list[dict]) -> list[dict]:
                     "adaptive_wins": _wins(adaptive, uniform),
                     "uniform_any_s": uniform_any and uniform_any["time_s"],
                     "uniform_any_method": uniform_any and uniform_any["method"],
+                    "uniform_any_level": uniform_any and uniform_any["level_or_step"],
                     "adaptive_any_s": adaptive_any and adaptive_any["time_s"],
                     "adaptive_any_method": adaptive_any and adaptive_any["method"],
+                    "adaptive_any_step": adaptive_any and adaptive_any["level_or_step"],
                     "adaptive_any_wins": _wins(adaptive_any, uniform_any),
+                    "paired_uniform_s": None, "paired_adaptive_s": None,
                     "fastest_ngdual": ngdual and ngdual["method"],
                     "ngdual_s": ngdual and ngdual["time_s"], "p2_s": p2 and p2["time_s"],
                     "ratio_ngdual_p2": (ngdual["time_s"] / p2["time_s"]
@@ -190,6 +205,44 @@ def verdicts(table: list[dict]) -> list[dict]:
                     "ratio_order_p2": (higher["time_s"] / p2["time_s"]
                                        if higher and p2 else None)})
     return out
+
+
+def is_close(v: dict) -> bool:
+    """Whether the fastest adaptive and uniform times of a verdict lie within
+    :data:`CLOSE` of each other, both under REPEAT_BELOW_S (longer runs vary less)."""
+    a, u = v["adaptive_any_s"], v["uniform_any_s"]
+    return (a is not None and u is not None and max(a / u, u / a) <= CLOSE
+            and max(a, u) < REPEAT_BELOW_S)
+
+
+def paired_tasks(plan, verdict: list[dict], rows: list[dict]) -> dict[int, object]:
+    """The paired timing (:func:`paired_timing`) of every close verdict (:func:`is_close`),
+    by its index: the fastest uniform solve and the fastest adaptive run to its step."""
+    out = {}
+    for i, v in enumerate(verdict):
+        if not is_close(v):
+            continue
+        tasks = truth_tasks(plan, v["problem"])
+        [uniform] = [t for t in tasks[v["uniform_any_method"]]
+                     if t.params["level"] == v["uniform_any_level"]]
+        [adaptive] = tasks[v["adaptive_any_method"]]
+        steps = sorted((r["level_or_step"], r["ndof"]) for r in rows
+                       if (r["problem"], r["method"]) == (v["problem"], v["adaptive_any_method"])
+                       and r["status"] == "ok" and r["level_or_step"] <= v["adaptive_any_step"])
+        out[i] = paired_timing(plan, uniform, adaptive, [n for _, n in steps])
+    return out
+
+
+def apply_paired(verdict: list[dict], paired: dict[int, dict | None]) -> None:
+    """The close verdicts decided by their paired timing (records by verdict index): the
+    medians of the runs in turn (``paired_uniform_s``, ``paired_adaptive_s``) decide
+    ``adaptive_any_wins``; a paired timing that failed leaves the verdict as it was."""
+    for i, record in paired.items():
+        if record is None or record.get("status") != "ok":
+            continue
+        v = verdict[i]
+        v["paired_uniform_s"], v["paired_adaptive_s"] = record["uniform_s"], record["adaptive_s"]
+        v["adaptive_any_wins"] = record["adaptive_s"] < record["uniform_s"]
 
 
 def effectivities(rows: list[dict]) -> list[dict]:
@@ -270,6 +323,22 @@ def method_letters(method: str) -> str:
     return base[method_base(method)] + ("c" if order and family == "coarse" else "")
 
 
+def first_cell(v: dict) -> str | None:
+    """"yes" / "no": the fastest adaptive method of any order comes first; with the medians
+    of a paired timing (adaptive / uniform) where there is one.
+
+    >>> first_cell({"adaptive_any_wins": True, "paired_adaptive_s": 0.378,
+    ...             "paired_uniform_s": 0.4512})
+    'yes (in turn: 0.38 / 0.45 s)'
+    """
+    if v["adaptive_any_wins"] is None:
+        return None
+    verdict = "yes" if v["adaptive_any_wins"] else "no"
+    if v.get("paired_adaptive_s") is None:
+        return verdict
+    return f"{verdict} (in turn: {v['paired_adaptive_s']:.2g} / {v['paired_uniform_s']:.2g} s)"
+
+
 def summary_rows(table: list[dict], verdict: list[dict], measure: str) -> list[dict]:
     """The README's time-to-accuracy table of ``measure``: per problem and target the least
     time (unknowns) of uniform and adaptive refinement at k = 0, of the fastest method of
@@ -300,8 +369,7 @@ def summary_rows(table: list[dict], verdict: list[dict], measure: str) -> list[d
                **{f"k{k}": cell([r for r in ngdual if r["order"] == k]) for k in ORDERS},
                "p2": cell([r for r in mine if r["method"] == P2], letters=False),
                "ratio": ratio(v["ratio_ngdual_p2"]), "ratio_order": ratio(v["ratio_order_p2"]),
-               "first": (None if v["adaptive_any_wins"] is None
-                         else "yes" if v["adaptive_any_wins"] else "no"),
+               "first": first_cell(v),
                "resolved": "yes" if v["resolved"] else "no"}
         out.append(row)
     return out
@@ -383,9 +451,12 @@ def _numbers(verdict: list[dict], effectivity: list[dict], budget: list[dict]) -
         else:
             uniform = ("not reached" if v["uniform_any_s"] is None
                        else f"{v['uniform_any_s']:.2f} s {v['uniform_any_method']}")
+            paired = ("" if v["paired_adaptive_s"] is None else
+                      f"; timed in turn {v['paired_adaptive_s']:.3f} s vs "
+                      f"{v['paired_uniform_s']:.3f} s")
             numbers[f"{what}, adaptive beats uniform, any order"] = (
                 f"{v['adaptive_any_wins']} ({v['adaptive_any_s']:.2f} s "
-                f"{v['adaptive_any_method']} vs {uniform})"
+                f"{v['adaptive_any_method']} vs {uniform}{paired})"
                 f"{'' if v['resolved'] else ', not resolved'}")
         if v["measure"] == "pressure":
             numbers[f"{what}, fastest ngdual / primal P2"] = (
@@ -424,6 +495,9 @@ def run(ctx):
         rows += [{"problem": problem, **r} for r in study["rows"]]
     table = accuracy_table(rows, references)
     verdict = verdicts(table)
+    # COMPUTE: the close verdicts timed again, uniform and adaptive in turn
+    paired = paired_tasks(ctx.plan, verdict, rows)
+    apply_paired(verdict, dict(zip(paired, ctx.compute(list(paired.values()), "paired"))))
     effectivity = effectivities(rows)
     budget = budgets(rows, references)
     machine = {"cpus": os.cpu_count(), "load_average": os.getloadavg(), "versions": versions()}

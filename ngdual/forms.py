@@ -282,6 +282,14 @@ class BrokenPeers:
         ``size``), without forming K: the same products up to the order of the sums."""
         return np.bincount(self.conforming, self.matrix @ x[self.conforming], minlength=size)
 
+    def apply_magnitudes(self, magnitudes: np.ndarray, size: int) -> np.ndarray:
+        """E^T |K_b| E m for m = ``magnitudes`` >= 0 (a vector of length ``size``): every
+        element entry's magnitude times m. With m = |x| this is, row by row, the size of the
+        terms whose sum is (K x)_i, and at least (|K| |x|)_i (an entry of K is the sum of at
+        most two element entries)."""
+        return np.bincount(self.conforming, abs(self.matrix) @ magnitudes[self.conforming],
+                           minlength=size)
+
     def to_conforming(self, values: np.ndarray) -> np.ndarray:
         """The conforming PEERS coefficients of broken ones whose normal fluxes agree across
         every edge (up to rounding): the mean of the two triangles' values."""
@@ -400,9 +408,9 @@ class DiscreteProblem:
     K : scipy.sparse.csr_matrix
         Symmetric matrix of all unknowns (sigma, u, eta, phi, lambda_t, lambda_n): its PEERS
         block summed from ``broken`` plus ``boundary``, formed on first use. The hybridised
-        solver of order k never forms it: it reads the multipliers' rows from ``boundary``
-        and K x from :meth:`apply` (Example 3.46 with PEERS_1, 50 017 unknowns: a solve
-        10 % faster than with K and its blocks formed).
+        solvers never form it: they read the multipliers' rows from ``boundary``, K x from
+        :meth:`apply` and the size of its terms from :meth:`terms` (Example 3.46 with
+        PEERS_1, 50 017 unknowns: a solve 10 % faster than with K and its blocks formed).
     boundary : scipy.sparse.csr_matrix
         P^T D P: the couplings d_N, d_C of the boundary multipliers with sigma (K less its
         PEERS block; zero without Gamma_N and Gamma_C).
@@ -458,6 +466,14 @@ class DiscreteProblem:
         if self._K is not None:
             return self._K @ x
         return self.broken.apply(x, self.n) + self.boundary @ x
+
+    def terms(self, x: np.ndarray) -> np.ndarray:
+        """The size of the terms of K x row by row, from the element matrices and the
+        boundary couplings (:meth:`BrokenPeers.apply_magnitudes`, |boundary| |x|), without
+        forming K: at least |K| |x| entry by entry, equal where no two element entries of
+        K cancel."""
+        magnitudes = np.abs(x)
+        return self.broken.apply_magnitudes(magnitudes, self.n) + abs(self.boundary) @ magnitudes
 
     def index(self, *names: str) -> np.ndarray:
         """Indices of the listed components in the unknown vector."""

@@ -255,8 +255,17 @@ def test_work_precision_measures_true_errors_against_references_it_checks(coarse
     assert len(rows) == len(result["verdicts"])
     ordered = [v for measure in ("pressure", "sigma_energy") for v in result["verdicts"]
                if v["measure"] == measure]
-    assert [r[-2] for r in rows] == [{None: "–", True: "yes", False: "no"}[
-        v["adaptive_any_wins"]] for v in ordered]
+    assert [r[-2].split(" (in turn")[0] for r in rows] == [
+        {None: "–", True: "yes", False: "no"}[v["adaptive_any_wins"]] for v in ordered]
+    for v in result["verdicts"]:
+        # a close verdict is the paired timing's (when it ran), any other the table's
+        if v["paired_adaptive_s"] is not None:
+            a, u = v["adaptive_any_s"], v["uniform_any_s"]
+            assert max(a / u, u / a) <= 1.3, v
+            assert v["adaptive_any_wins"] == (v["paired_adaptive_s"] < v["paired_uniform_s"])
+        elif v["adaptive_any_wins"] is not None:
+            assert v["adaptive_any_wins"] == (v["uniform_any_s"] is None
+                                              or v["adaptive_any_s"] < v["uniform_any_s"])
     for v in result["verdicts"]:
         # the fastest adaptive run of any order is at least as fast as that of order 0
         if v["adaptive_s"] is not None:
@@ -499,3 +508,67 @@ def test_a_true_error_task_times_the_median_of_its_runs(monkeypatch):
     assert [len(r["cumulative_runs_s"]) for r in once["history"]] == [1, 1]
     assert len(work.solve_task("thesis-3.46-frictionless", 1, repeat=3)[0]["time_runs_s"]) == 1
     assert Plan(3).timing_repeats == 1 and Plan(5).timing_repeats == Plan(7).timing_repeats == 3
+
+
+def test_a_paired_timing_runs_uniform_and_adaptive_in_turn(monkeypatch):
+    """paired_task times the uniform solve and the adaptive run to its step alternately
+    (uniform first in the odd rounds, adaptive first in the even ones), the adaptive run
+    only to the step asked for, and its medians are those of its runs; a run on other
+    meshes is not counted, and none counted is a failed record."""
+    from ngdual.studies.sweep import work
+
+    uniform = {"scene": "thesis-3.46-frictionless", "level": 1, "overrides": []}
+    adaptive = {"scene": "thesis-3.46-frictionless", "overrides": [], "marking": "dorfler",
+                "theta": 0.8, "steps": 5, "level": 1, "goal": "stress", "tol": None,
+                "window": None}
+    run, _ = work.adapt_task("thesis-3.46-frictionless", "dorfler", 0.8, 5, 1)
+    unknowns = [r["dofs"]["total"] for r in run["history"]][:2]
+    record, arrays = work.paired_task(uniform, adaptive, unknowns, rounds=3)
+    assert record["status"] == "ok" and arrays == {}
+    assert len(record["uniform_runs_s"]) == len(record["adaptive_runs_s"]) == 3
+    assert record["uniform_s"] == np.median(record["uniform_runs_s"])
+    assert record["adaptive_s"] == np.median(record["adaptive_runs_s"])
+    calls = []
+    monkeypatch.setattr(work, "_solve_quietly", lambda sc, level: calls.append("u") or type(
+        "S", (), {"timings": {"total": 1.0}})())
+
+    def loop_times(scene, overrides, loop, steps, max_elements):
+        calls.append("a")
+        assert loop["steps"] == 5 and steps == unknowns and max_elements is None
+        return [0.1, 0.2]
+    monkeypatch.setattr(work, "_loop_times", loop_times)
+    record, _ = work.paired_task(uniform, adaptive, unknowns, rounds=4)
+    assert "".join(calls) == "ua" + "uaauuaau"
+    assert record["adaptive_runs_s"] == [0.2] * 4 and record["uniform_s"] == 1.0
+    monkeypatch.setattr(work, "_loop_times", lambda *args: [0.1])   # the meshes differ
+    record, _ = work.paired_task(uniform, adaptive, unknowns, rounds=2)
+    assert record["status"] == "failed" and "step's mesh" in record["message"]
+
+
+@pytest.mark.slow
+def test_close_verdicts_are_decided_by_their_paired_timing():
+    """work_precision times a verdict again in pairs only when its adaptive and uniform
+    times lie within CLOSE of each other, both under REPEAT_BELOW_S; the paired medians then
+    decide "adaptive first" (a failed pairing leaves the table's verdict), and the README's
+    cell gives them."""
+    from ngdual.studies.figures.run import load_script
+    from ngdual.studies.sweep.work import REPEAT_BELOW_S
+
+    wp = load_script(Path(__file__).parents[1] / "figures" / "work_precision.py")
+
+    def verdict(adaptive_s, uniform_s):
+        return {"adaptive_any_s": adaptive_s, "uniform_any_s": uniform_s,
+                "adaptive_any_wins": wp._wins(adaptive_s and {"time_s": adaptive_s},
+                                              uniform_s and {"time_s": uniform_s}),
+                "paired_adaptive_s": None, "paired_uniform_s": None}
+    assert wp.is_close(verdict(0.52, 0.42)) and wp.is_close(verdict(0.42, 0.52))
+    assert not wp.is_close(verdict(0.56, 0.42)) and not wp.is_close(verdict(0.3, 0.42))
+    assert not wp.is_close(verdict(REPEAT_BELOW_S, 0.9 * REPEAT_BELOW_S))
+    assert not wp.is_close(verdict(0.5, None)) and not wp.is_close(verdict(None, 0.5))
+    cells = [verdict(0.52, 0.42), verdict(0.44, 0.42), verdict(0.40, 0.42)]
+    wp.apply_paired(cells, {0: {"status": "ok", "adaptive_s": 0.38, "uniform_s": 0.45},
+                            1: {"status": "failed"}, 2: None})
+    assert [c["adaptive_any_wins"] for c in cells] == [True, False, True]
+    assert wp.first_cell(cells[0]) == "yes (in turn: 0.38 / 0.45 s)"
+    assert [wp.first_cell(c) for c in cells[1:]] == ["no", "yes"]
+    assert wp.first_cell(verdict(None, 0.4)) is None

@@ -13,8 +13,9 @@
 4. One back substitution gives the remaining unknowns, the element-local solves sigma and u.
 
 The result is the discrete solution of (3.62) itself (not an approximation of it): the
-residuals of every row of the assembled system and of the contact and friction conditions
-are computed on ``problem.K`` and reported; if they are not at round-off level a
+residuals of every row of the assembled system (K x from its element matrices,
+:meth:`~ngdual.forms.DiscreteProblem.apply`) and of the contact and friction conditions
+are computed and reported; if they are not at round-off level a
 :class:`ConvergenceError` is raised, naming each failing criterion with its value and
 tolerance.
 
@@ -89,17 +90,20 @@ def _linear_residual(problem: DiscreteProblem, x: np.ndarray,
     """Largest blockwise relative residual of the rows sigma, u, eta, phi of K x = rhs.
 
     Each block (their units differ) is measured against the size of its own terms,
-    ||K_b x - rhs_b|| / max(|| |K_b| |x| ||, ||rhs_b||) in the max norm. With ``dx``: the
-    residual K_b dx that a change dx of the solution x causes, on the same scale.
+    ||(K x - rhs)_b|| / max(||t_b||, ||rhs_b||) in the max norm, t the terms of K x
+    (:meth:`~ngdual.forms.DiscreteProblem.terms`, at least |K| |x|). With ``dx``: the
+    residual K dx that a change dx of the solution x causes, on the same scale. K x and t
+    come from the element matrices (:meth:`~ngdual.forms.DiscreteProblem.apply`): K itself
+    is not formed.
     """
+    terms = problem.terms(x)
+    defect = problem.apply(x) - problem.rhs if dx is None else problem.apply(dx)
     worst = 0.0
     for names in _linear_blocks(problem):
-        K_b = problem.K[names]
-        terms = abs(K_b) @ np.abs(x)
-        scale = max(np.max(terms, initial=0.0), np.max(np.abs(problem.rhs[names]), initial=0.0))
-        defect = K_b @ x - problem.rhs[names] if dx is None else K_b @ dx
+        scale = max(np.max(terms[names], initial=0.0),
+                    np.max(np.abs(problem.rhs[names]), initial=0.0))
         if scale > 0:
-            worst = max(worst, float(np.max(np.abs(defect)) / scale))
+            worst = max(worst, float(np.max(np.abs(defect[names])) / scale))
     return worst
 
 

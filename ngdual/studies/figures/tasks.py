@@ -9,6 +9,7 @@ for, so the tables and the figures share it.
 from __future__ import annotations
 
 from ..sweep import Task
+from ..sweep.work import PAIRED_ROUNDS
 from ..variants import UZAWA, setting
 from .plan import (
     ADAPT_STEPS,
@@ -156,6 +157,25 @@ def peer_solve(plan: Plan, problem: str, level: int, order: int) -> Task:
                          "overrides": list(tp.overrides),
                          "subdivisions": 2 ** max(finest - level, 0), **_repeats(plan)},
                 f"{tp.scene} L{level} peer P{order}", _cost(level, False))
+
+
+# the arguments of ngdual.afem.adapt in an adaptive task's parameters
+LOOP_KEYS = ("marking", "theta", "steps", "level", "goal", "tol", "window")
+
+
+def paired_timing(plan: Plan, uniform: Task, adaptive: Task, unknowns: list[int]) -> Task:
+    """The uniform solve ``uniform`` and the adaptive run ``adaptive`` to the solution of
+    its step of ``unknowns[-1]`` unknowns (``unknowns``: its steps' up to that one), timed
+    in turn (:func:`ngdual.studies.sweep.work.paired_task`): PAIRED_ROUNDS runs of each
+    where the plan times its tasks more than once, else one."""
+    u, a = uniform.params, adaptive.params
+    return Task("paired", {"uniform": {k: u[k] for k in ("scene", "level", "overrides")},
+                           "adaptive": {"scene": a["scene"], "overrides": a["overrides"],
+                                        **{k: a[k] for k in LOOP_KEYS}},
+                           "unknowns": [int(n) for n in unknowns],
+                           "rounds": PAIRED_ROUNDS if plan.timing_repeats > 1 else 1},
+                f"{u['scene']} paired: {uniform.label} / {adaptive.label} to {unknowns[-1]}",
+                10.0)
 
 
 def truth_tasks(plan: Plan, problem: str) -> dict[str, list[Task]]:

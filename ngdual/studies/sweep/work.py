@@ -3,7 +3,8 @@
 ``solve`` (one scene on one level, with the estimator and optionally the field arrays or
 the solution samples of the true-error studies), ``dofs`` (Table 3.1), ``adapt`` (an
 adaptive run with the extras of Section 4.2), ``peer`` (the primal peer,
-:mod:`ngdual.studies.primal_peer`) and ``manufactured`` (exact errors and the estimator).
+:mod:`ngdual.studies.primal_peer`), ``manufactured`` (exact errors and the estimator) and
+``paired`` (a uniform solve and an adaptive run timed in turn).
 :func:`execute` runs one task and adds the header every record carries; writing it is
 :mod:`~ngdual.studies.sweep.records`' business, scheduling :mod:`~ngdual.studies.sweep.runner`'s.
 """
@@ -31,6 +32,9 @@ from .records import Task
 # runs after the first are made only while a run takes less than REPEAT_BELOW_S: longer ones
 # vary less and cost more.
 REPEAT_BELOW_S = 5.0
+# The work-precision study times its close verdicts again, uniform and adaptive in turn
+# (:func:`paired_task`): this many runs of each.
+PAIRED_ROUNDS = 7
 
 
 def repeated(first: float, again: Callable[[], float], repeat: int) -> list[float]:
@@ -230,10 +234,10 @@ def median_steps(runs: list[list[float]]) -> list[float]:
 def _loop_times(scene: str, overrides, loop: dict, unknowns: list[int],
                 max_elements: int | None) -> list[float]:
     """The wall time from the start to every step's solution of the adaptive run ``loop``
-    on ``scene`` (``solved_s``, as :func:`adapt_task` times it), up to the first step
-    past :data:`REPEAT_BELOW_S` or ``max_elements`` triangles; the steps from the first
-    whose unknowns differ from ``unknowns`` (another mesh: a tie in the marking broken
-    otherwise) are left out."""
+    on ``scene`` (``solved_s``, as :func:`adapt_task` times it), up to the step of the
+    last of ``unknowns``, the first step past :data:`REPEAT_BELOW_S` or the first of
+    ``max_elements`` triangles; the steps from the first whose unknowns differ from
+    ``unknowns`` (another mesh: a tie in the marking broken otherwise) are left out."""
     from ...afem import adapt
     from ...solvers.result import ConvergenceError
 
@@ -245,8 +249,8 @@ def _loop_times(scene: str, overrides, loop: dict, unknowns: list[int],
         if step >= len(unknowns) or record["dofs"]["total"] != unknowns[step]:
             times.pop()
             raise _Budget
-        if times[-1] >= REPEAT_BELOW_S or (max_elements is not None
-                                           and record["elements"] >= max_elements):
+        if (step == len(unknowns) - 1 or times[-1] >= REPEAT_BELOW_S
+                or (max_elements is not None and record["elements"] >= max_elements)):
             raise _Budget
 
     try:
@@ -254,6 +258,49 @@ def _loop_times(scene: str, overrides, loop: dict, unknowns: list[int],
     except (ConvergenceError, _Budget):
         pass
     return times
+
+
+def paired_task(uniform: dict, adaptive: dict, unknowns: list[int],
+                rounds: int = PAIRED_ROUNDS) -> tuple[dict, dict]:
+    """A uniform solve and an adaptive run to the solution of one of its steps, timed in
+    turn: after one run of each (not counted), ``rounds`` rounds of one run each, uniform
+    first in the odd rounds and adaptive first in the even ones, so that a slow period of
+    the machine falls on both alike (the repeats of a true-error task, back to back, fall
+    on one method).
+
+    ``uniform``: the solve's ``scene``, ``level`` and ``overrides`` (timed as
+    :func:`solve_task` times it); ``adaptive``: the run's ``scene``, ``overrides`` and the
+    keyword arguments of :func:`ngdual.afem.adapt` (timed as :func:`adapt_task` times it,
+    to the solution of the step of the last of ``unknowns``, its steps' unknowns: a run
+    whose meshes differ, or that takes :data:`REPEAT_BELOW_S` or longer, is not counted).
+    The record holds every run (``uniform_runs_s``, ``adaptive_runs_s``) and the medians
+    ``uniform_s`` and ``adaptive_s``.
+    """
+    sc = load_scene_with(uniform["scene"], uniform["overrides"])
+    loop = {k: v for k, v in adaptive.items() if k not in ("scene", "overrides")}
+    if loop.get("window") is not None:
+        loop["window"] = tuple(loop["window"])
+
+    def time_adaptive() -> float | None:
+        times = _loop_times(adaptive["scene"], adaptive["overrides"], loop, unknowns, None)
+        return times[-1] if len(times) == len(unknowns) else None
+
+    # one run of each first, not counted: the first solve of a process pays its one-time
+    # costs (imports, NGSolve's first assembly: 1.5 s against 0.9 s on hertz-cylinder)
+    _solve_quietly(sc, uniform["level"])
+    time_adaptive()
+    runs: dict[str, list] = {"uniform": [], "adaptive": []}
+    for r in range(rounds):
+        for which in ("uniform", "adaptive") if r % 2 == 0 else ("adaptive", "uniform"):
+            runs[which].append(_solve_quietly(sc, uniform["level"]).timings["total"]
+                               if which == "uniform" else time_adaptive())
+    counted = [t for t in runs["adaptive"] if t is not None]
+    if not counted:
+        return {"status": "failed", "message": "no adaptive run reached the step's mesh "
+                "below the repeat limit"}, {}
+    return {"status": "ok", "uniform_runs_s": runs["uniform"], "adaptive_runs_s": runs["adaptive"],
+            "uniform_s": float(np.median(runs["uniform"])),
+            "adaptive_s": float(np.median(counted))}, {}
 
 
 def order_samples(solution, order: int) -> dict:
@@ -322,7 +369,7 @@ def manufactured_task(case: str, level: int, marking: str | None = None, theta: 
 
 TASKS: dict[str, Callable[..., tuple[dict, dict]]] = {
     "solve": solve_task, "dofs": dofs_task, "adapt": adapt_task, "peer": peer_task,
-    "manufactured": manufactured_task}
+    "manufactured": manufactured_task, "paired": paired_task}
 
 
 def _ngsolve_threads() -> int:
