@@ -77,6 +77,28 @@ def test_the_coulomb_solution_on_example_3_46_passes_every_physics_check(order):
     assert solution.residuals["coulomb_bound"] < 1e-10
 
 
+def test_the_coulomb_check_at_order_k_takes_the_bound_as_the_solver_defines_it():
+    """The check F_i = mu_f max(-t_n,i, 0) on K counts F_i = 0 where that bound vanishes
+    (at most 1e-6 of its largest value, tolerances.friction_vanishes), as the fixed point
+    sets it: a moment of -1e-7 of the largest where the body separates is no violation
+    (a tolerance run of Example 3.46, mu_f = 0.5, k = 1, failed at its 15th solve on
+    2.5e-7 of such a moment), one of -1e-5 is."""
+    problem = _problem("thesis-3.46-coulomb", 1, 1)
+    solution = solve_problem(problem)
+    t_n = (problem.apply(solution.x) - problem.rhs)[problem.lam_n]
+    F = 0.5 * np.maximum(-t_n, 0.0)
+    assert conforming.residuals(problem, solution.x, "coulomb", 0.5, F)["coulomb_bound"] < 1e-9
+    separated = np.flatnonzero(np.abs(t_n) < 1e-12 * np.max(np.abs(t_n)))
+    assert len(separated)
+    F[separated] = 0.0
+    for share, fails in ((1e-7, False), (1e-5, True)):
+        rhs = problem.rhs.copy()
+        problem.rhs[problem.lam_n[separated[0]]] += share * np.max(np.abs(t_n))
+        found = conforming.residuals(problem, solution.x, "coulomb", 0.5, F)
+        problem.rhs[:] = rhs
+        assert (found["coulomb_bound"] > 1e-9) == fails, (share, found["coulomb_bound"])
+
+
 @pytest.mark.parametrize("name", ["thesis-3.46-frictionless", "thesis-3.46-coulomb"])
 def test_condensing_onto_every_coefficient_gives_the_solution_of_the_candidates(name,
                                                                                monkeypatch):

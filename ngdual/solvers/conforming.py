@@ -67,7 +67,7 @@ import scipy.linalg as sla
 from ..forms import DiscreteProblem
 from ..friction import MomentFriction, build_friction_forms, tresca_moments
 from ..tolerances import COULOMB_FIXED_POINT_TOL
-from .active_set import ContactStart, coulomb_fixed_point
+from .active_set import ContactStart, _coulomb_bound, coulomb_fixed_point
 from .linear import Factorization
 from .qp import product_residuals
 from .result import ConvergenceError, Solution
@@ -411,7 +411,9 @@ def residuals(problem: DiscreteProblem, x: np.ndarray, law: str, mu_f: float,
     """Relative residuals of (3.103) on ``problem.K`` and, with the bound F on the
     coefficients, of the friction law: |t_t,i| <= F_i (``friction_bound``),
     F_i |lambda_t,i| = lambda_t,i t_t,i (``slip``: stick where |t_t,i| < F_i, slip along
-    t_t,i) and, for Coulomb, F_i = mu_f (-t_n,i) (``coulomb_bound``).
+    t_t,i) and, for Coulomb, F_i = mu_f (-t_n,i), zero where that vanishes
+    (``coulomb_bound``; a moment at 1e-7 of the largest at the end of the contact zone
+    has F_i = 0, as the fixed point sets it).
 
     The sign conditions and the complementarity of lambda_n are measured against the
     displacement scale, the largest of lambda_n, lambda_t and u: with g = 0 a whole side
@@ -446,7 +448,9 @@ def residuals(problem: DiscreteProblem, x: np.ndarray, law: str, mu_f: float,
         found["slip"] = float(np.max(np.abs(F * np.abs(lam_t) - lam_t * t_t),
                                      initial=0.0)) / work
     if law == "coulomb":
-        mapped = MomentFriction().coulomb_bound_of(t_n, mu_f)
+        # F of the moments on K as the solver defines it: zero where it vanishes (at most
+        # 1e-6 of its largest value, tolerances.friction_vanishes), as the F it returns
+        mapped = _coulomb_bound(MomentFriction(), t_n, mu_f, 0.0)
         found["coulomb_bound"] = float(np.max(np.abs(mapped - F), initial=0.0) / (
             mu_f * np.max(np.abs(t_n), initial=0.0) or 1.0))
     return found
