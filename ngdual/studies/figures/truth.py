@@ -67,6 +67,12 @@ RESOLVES = 1 / 3
 # estimate is held by a few triangles it cannot improve, and its steps are no sequence to
 # extrapolate from
 STALLED = 1.3
+# the P2 nodes of the four red children of the reference triangle, in barycentric
+# coordinates of the parent (vertices 0, 1, 2; midpoints m01, m12, m20)
+_V = np.eye(3)
+_M = {(0, 1): (_V[0] + _V[1]) / 2, (1, 2): (_V[1] + _V[2]) / 2, (2, 0): (_V[2] + _V[0]) / 2}
+CHILDREN = ((_V[0], _M[(0, 1)], _M[(2, 0)]), (_M[(0, 1)], _V[1], _M[(1, 2)]),
+            (_M[(2, 0)], _M[(1, 2)], _V[2]), (_M[(1, 2)], _M[(2, 0)], _M[(0, 1)]))
 
 
 def fastest_reduction(growth: float, order: int) -> float:
@@ -81,12 +87,6 @@ def fastest_reduction(growth: float, order: int) -> float:
     (0.5, 0.296)
     """
     return growth ** -(order + 1)
-# the P2 nodes of the four red children of the reference triangle, in barycentric
-# coordinates of the parent (vertices 0, 1, 2; midpoints m01, m12, m20)
-_V = np.eye(3)
-_M = {(0, 1): (_V[0] + _V[1]) / 2, (1, 2): (_V[1] + _V[2]) / 2, (2, 0): (_V[2] + _V[0]) / 2}
-CHILDREN = ((_V[0], _M[(0, 1)], _M[(2, 0)]), (_M[(0, 1)], _V[1], _M[(1, 2)]),
-            (_M[(2, 0)], _M[(1, 2)], _V[2]), (_M[(1, 2)], _M[(2, 0)], _M[(0, 1)]))
 
 
 def _measures(errors: dict) -> dict:
