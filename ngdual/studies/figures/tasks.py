@@ -9,7 +9,7 @@ for, so the tables and the figures share it.
 from __future__ import annotations
 
 from ..sweep import Task
-from ..sweep.work import PAIRED_ROUNDS
+from ..sweep.work import LOOP_KEYS, PAIRED_ROUNDS
 from ..variants import UZAWA, setting
 from .plan import (
     ADAPT_STEPS,
@@ -157,10 +157,6 @@ def peer_solve(plan: Plan, problem: str, level: int, order: int) -> Task:
                          "overrides": list(tp.overrides),
                          "subdivisions": 2 ** max(finest - level, 0), **_repeats(plan)},
                 f"{tp.scene} L{level} peer P{order}", _cost(level, False))
-
-
-# the arguments of ngdual.afem.adapt in an adaptive task's parameters
-LOOP_KEYS = ("marking", "theta", "steps", "level", "goal", "tol", "window")
 
 
 def paired_timing(plan: Plan, uniform: Task, adaptive: Task, unknowns: list[int]) -> Task:

@@ -89,6 +89,15 @@ def fastest_reduction(growth: float, order: int) -> float:
     return growth ** -(order + 1)
 
 
+def _within_rates(check: dict, unknowns: list[int], order: int) -> dict:
+    """A Richardson ``check`` without its own error where its ratio is faster than any rate
+    of the method over the last step of ``unknowns`` (:func:`fastest_reduction`)."""
+    if check["r"] is not None and check["r"] < fastest_reduction(unknowns[-1] / unknowns[-2],
+                                                                 order):
+        return {**check, "overkill_error": None}
+    return check
+
+
 def _measures(errors: dict) -> dict:
     """The relative errors plotted (:data:`TRUE_MEASURES`) and the absolute total error
     e = (||sigma - sigma_ref||^2 + ||u - u_ref||^2 + ||eta - eta_ref||^2)^(1/2) (L2; div sigma
@@ -175,9 +184,7 @@ def _run_check(run: list[tuple[dict, dict]], lam: float, mu: float, window) -> d
     for measure in TRUE_MEASURES:
         check = ({"r": None, "rate": None, "overkill_error": None} if stalled
                  else EXTRAPOLATION[measure](*(e[measure] for e in d)))
-        if check["r"] is not None and check["r"] < fastest_reduction(
-                steps[-1] / steps[-2], last_row["order"]):
-            check = {**check, "overkill_error": None}
+        check = _within_rates(check, steps, last_row["order"])
         out[measure] = {"d_last-2": d[0][measure] if len(d) == 2 else None,
                         "d_last-1": d[-1][measure] if d else None, **check,
                         "estimate": None if check["overkill_error"] is None else "Richardson"}
@@ -326,10 +333,8 @@ def order_reference(run: list[tuple[dict, dict]], lam: float, mu: float
         return None
     (row, last, ndof), before = steps[-1], steps[-3:-1]
     d = [_measures(distance(arrays, last, lam, mu))["sigma_energy"] for _, arrays, _ in before]
-    check = EXTRAPOLATION["sigma_energy"](*d)
-    if check["r"] is not None and check["r"] < fastest_reduction(ndof / before[-1][2],
-                                                                 REFERENCE_ORDER):
-        check = {**check, "overkill_error": None}
+    check = _within_rates(EXTRAPOLATION["sigma_energy"](*d), [before[-1][2], ndof],
+                          REFERENCE_ORDER)
     return ({"method": f"{row['method']}, PEERS_{REFERENCE_ORDER}", "step": row["level_or_step"],
              "ndof": ndof, "elements": row["elements"], "d_last-2": d[0], "d_last-1": d[1],
              **check, "estimate": None if check["overkill_error"] is None

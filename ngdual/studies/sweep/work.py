@@ -120,6 +120,19 @@ def dofs_task(scene: str, level: int, overrides: list[str] = ()) -> tuple[dict, 
             "ndof": int(sum(dofs.values())), "h": mesh_size(mesh), "elements": mesh.ne}, {}
 
 
+# the keyword arguments of ngdual.afem.adapt that an adaptive task carries
+LOOP_KEYS = ("marking", "theta", "steps", "level", "goal", "tol", "window")
+
+
+def loop_arguments(params: dict) -> dict:
+    """The keyword arguments of :func:`ngdual.afem.adapt` in an adaptive task's
+    parameters (:data:`LOOP_KEYS`; the window, a list in JSON, as a tuple)."""
+    loop = {k: params[k] for k in LOOP_KEYS}
+    if loop["window"] is not None:
+        loop["window"] = tuple(loop["window"])
+    return loop
+
+
 class _Budget(Exception):
     """An adaptive run reached its element budget."""
 
@@ -196,8 +209,8 @@ def adapt_task(scene: str, marking: str, theta: float, steps: int, level: int,
         if max_elements is not None and record["elements"] >= max_elements:
             raise _Budget
 
-    loop = {"marking": marking, "theta": theta, "steps": steps, "level": level, "goal": goal,
-            "tol": tol, "window": None if window is None else tuple(window)}
+    loop = loop_arguments({"marking": marking, "theta": theta, "steps": steps, "level": level,
+                           "goal": goal, "tol": tol, "window": window})
     try:
         adapt(load_scene_with(scene, overrides), on_step=on_step, **loop)
         status = "ok" if all(r["converged"] for r in history) else "not-converged"
@@ -277,9 +290,7 @@ def paired_task(uniform: dict, adaptive: dict, unknowns: list[int],
     ``uniform_s`` and ``adaptive_s``.
     """
     sc = load_scene_with(uniform["scene"], uniform["overrides"])
-    loop = {k: v for k, v in adaptive.items() if k not in ("scene", "overrides")}
-    if loop.get("window") is not None:
-        loop["window"] = tuple(loop["window"])
+    loop = loop_arguments(adaptive)
 
     def time_adaptive() -> float | None:
         times = _loop_times(adaptive["scene"], adaptive["overrides"], loop, unknowns, None)
