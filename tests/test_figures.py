@@ -466,11 +466,15 @@ def _worker_environment() -> dict:
 def test_a_sweep_worker_keeps_glibcs_own_memory_trimming_and_one_blas_thread():
     """The workers of a sweep's LocalCluster run with glibc's own memory trimming (dask's
     nanny would set MALLOC_TRIM_THRESHOLD_=65536, under which the timed solves of a study
-    ran 1.3-1.5 times slower than in a plain process) and one BLAS thread each."""
+    ran 1.3-1.5 times slower than in a plain process) and one BLAS thread each; this
+    process's environment is left as it was (the nanny writes its pre-spawn variables into
+    it, and then OPENBLAS_NUM_THREADS here no longer said what BLAS runs on)."""
     from ngdual.studies.sweep.runner import Runner
 
+    before = dict(os.environ)
     with Runner(workers=1, progress=False) as runner:
         environments = list(runner.client().run(_worker_environment).values())
+        assert dict(os.environ) == before
     assert environments == [{"MALLOC_TRIM_THRESHOLD_": None, "OMP_NUM_THREADS": "1"}]
 
 

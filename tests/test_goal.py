@@ -269,16 +269,15 @@ def test_the_punch_core_estimate_is_within_a_factor_3_of_the_overkill_error():
 
 @pytest.mark.slow
 @pytest.mark.parametrize("order", [1, 2])
-def test_the_punch_core_estimate_of_order_k_is_within_a_factor_3_from_the_third_solve(order):
+def test_the_punch_core_estimate_of_order_k_is_within_a_factor_3_on_every_solve(order):
     """The punch core's goal at order k with the facet multipliers against the same loop run
-    on to tol = 3e-4: the dipole weight of a distant element falls like (h_T / d)^(2 (k + 1))
-    (PEERS_k approximates the smooth dual solution to h_T^(k + 1)). Measured, k = 1: 2.50,
-    3.18, 1.82, 1.58; k = 2: 2.52, 2.10, 1.10 (the far field at CALIBRATION, 0.1; at the edge
-    terms' 0.15 3.69, 2.85, 2.40, 1.89, 2.18 and 3.88, 3.09, 1.73; without the vertex jumps
-    of p_h 4.85, 3.70, 2.53, 2.03, 2.15 and 4.75, 2.82, 1.37; with the dipole weight of
-    k = 0 12.1-4.8 and 28.0-16.9, docs/theory/estimator.md). The first two solves, on the
-    initial mesh and one step on, overestimate most (the punch edges' singular triangles
-    carry most of the far field): their tolerance runs stop late, never early."""
+    on to tol = 1e-4: the dipole weight of a distant element falls like (h_T / d)^(2 (k + 1))
+    (PEERS_k approximates the smooth dual solution to h_T^(k + 1)), and the far field has
+    its own constant at order k (CALIBRATION_WINDOW_ORDER_K). Measured, k = 1: 1.10, 1.23, 0.99,
+    0.87; k = 2: 1.39, 1.04, 0.79 (with the far field at 0.1, against a run to 3e-4: 2.50,
+    3.18, 1.82, 1.58 and 2.52, 2.10, 1.10; at the edge terms' 0.15 3.69-1.89 and
+    3.88-1.73; without the vertex jumps of p_h 4.85-2.03 and 4.75-1.37; with the dipole
+    weight of k = 0 12.1-4.8 and 28.0-16.9, docs/theory/estimator.md)."""
     scene = load_scene("flat-punch", [f"discretisation.order={order}",
                                       "discretisation.multipliers=facet"])
     steps = []
@@ -286,14 +285,13 @@ def test_the_punch_core_estimate_of_order_k_is_within_a_factor_3_from_the_third_
     def keep(record, solution, estimated, marked):
         steps.append((record["goal_estimate"], solution_samples(solution)))
 
-    adapt(scene, goal="pressure", tol=3e-4, window=(-0.125, 0.125), on_step=keep)
+    adapt(scene, goal="pressure", tol=1e-4, window=(-0.125, 0.125), on_step=keep)
     reference = steps[-1][1]
     effectivity = [estimate / sample_pressure_errors(samples, reference, 0.125)["pressure_l2"]
                    for estimate, samples in steps[:-2]]
     print(f"flat-punch core, k = {order}: effectivity {np.round(effectivity, 2).tolist()}")
     assert len(effectivity) >= 3
-    assert 0.3 <= min(effectivity[2:]) and max(effectivity[2:]) <= 3
-    assert max(effectivity) <= 4
+    assert 0.3 <= min(effectivity) and max(effectivity) <= 3
 
 
 @pytest.mark.slow
@@ -352,20 +350,25 @@ def test_the_pressure_goal_has_no_jump_term_at_order_0_and_one_at_order_1(hertz)
             assert summed["jump"] == 0.0
 
 
-def test_the_far_field_keeps_the_order_0_constant_at_every_order(hertz):
+def test_the_far_field_and_the_edge_terms_have_their_own_constants_at_order_k(hertz):
     """goal.calibration: at k = 0 one constant for every term; at k = 1, 2 the edge terms
-    take CALIBRATION_ORDER_K[k] and the far field CALIBRATION (its weight carries the
-    order). The estimate is the root of sum_k C_k^2 terms[k] and its indicators drive the
-    marking: their squares sum to the squares of the summed terms."""
-    from ngdual.goal import CALIBRATION, CALIBRATION_ORDER_K, TERMS
+    take CALIBRATION_ORDER_K[k], the far field on all of Gamma_C CALIBRATION and a window's
+    far field CALIBRATION_WINDOW_ORDER_K. The estimate is the root of sum_k C_k^2 terms[k]
+    and its indicators drive the marking: their squares sum to the squares of the summed
+    terms."""
+    from ngdual.goal import CALIBRATION, CALIBRATION_ORDER_K, CALIBRATION_WINDOW_ORDER_K, TERMS
 
     mesh = build_mesh(hertz.geometry, 2)
     for order in (0, 1, 2):
         scene = load_scene("hertz-cylinder", [f"discretisation.order={order}"])
         solution = solve_on_mesh(scene, mesh)
-        pressure = goal_estimate(solution, estimate(solution))
+        estimated = estimate(solution)
         edge = CALIBRATION if order == 0 else CALIBRATION_ORDER_K[order]
-        assert pressure.calibration == {**dict.fromkeys(TERMS, edge), "far": CALIBRATION}
-        summed = pressure.summed()
-        assert summed["far"] == pytest.approx(CALIBRATION * np.sqrt(pressure.terms["far"].sum()))
-        assert pressure.total == pytest.approx(np.sqrt(sum(v**2 for v in summed.values())))
+        for window, far in ((None, CALIBRATION),
+                            ((-0.1, 0.1), CALIBRATION if order == 0
+                             else CALIBRATION_WINDOW_ORDER_K)):
+            pressure = goal_estimate(solution, estimated, window)
+            assert pressure.calibration == {**dict.fromkeys(TERMS, edge), "far": far}
+            summed = pressure.summed()
+            assert summed["far"] == pytest.approx(far * np.sqrt(pressure.terms["far"].sum()))
+            assert pressure.total == pytest.approx(np.sqrt(sum(v**2 for v in summed.values())))

@@ -9,6 +9,7 @@ sweep skips every finished task. A worker runs :func:`run_task`: it computes the
 
 from __future__ import annotations
 
+import contextlib
 import os
 import warnings
 from collections.abc import Iterable
@@ -36,6 +37,21 @@ UNSET_IN_WORKERS = ("MALLOC_TRIM_THRESHOLD_",)
 # (0.39-0.46 s) either way: the profiler biased the study's wall times against the
 # adaptive loop. Its samples are not used here.
 WORKER_CONFIG = {"distributed.worker.profile.enabled": False}
+
+
+@contextlib.contextmanager
+def _environment_kept():
+    """This process's environment as it was on entry, on exit. dask's nanny writes its
+    pre-spawn environment (OMP_NUM_THREADS=1, OPENBLAS_NUM_THREADS=1, MKL_NUM_THREADS=1,
+    PYTHONHASHSEED) into the parent's os.environ before it spawns a worker: afterwards the
+    parent's variables no longer said how many threads its own BLAS runs on (a test that
+    compares the two failed after a sweep had started a cluster in the same process)."""
+    saved = dict(os.environ)
+    try:
+        yield
+    finally:
+        os.environ.clear()
+        os.environ.update(saved)
 
 
 def run_task(task: Task, folder: str) -> tuple[dict, dict]:
@@ -93,7 +109,7 @@ class Runner:
                 dask = require("dask", "studies")
                 unset = {f"distributed.nanny.pre-spawn-environ.{name}": None
                          for name in UNSET_IN_WORKERS}
-                with dask.config.set({**unset, **WORKER_CONFIG}):
+                with dask.config.set({**unset, **WORKER_CONFIG}), _environment_kept():
                     self._cluster = distributed.LocalCluster(
                         n_workers=self.workers if self.processes else 1, threads_per_worker=1,
                         processes=self.processes, dashboard_address=None, memory_limit=0,
