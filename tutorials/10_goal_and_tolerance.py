@@ -201,7 +201,7 @@ print("effectivity of the pressure goal per step:", np.round(effectivity, 2).tol
 
 # %% [markdown]
 # On the full settings (`TOL` = 1 %) the pressure goal stops after seven solves at a true
-# error of 0.78 % with 130 000 unknowns in 2.8 s; the finest uniform level, 110 000
+# error of 0.77 % with 130 000 unknowns in 2.5 s; the finest uniform level, 110 000
 # unknowns, is at 6.8 %, and the stress goal stops at 1.8 % with 205 000 unknowns in
 # 3.4 s. To a rough
 # accuracy (10 % and more) uniform refinement is as fast: every adaptive step is paid for,
