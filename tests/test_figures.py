@@ -434,6 +434,49 @@ def test_the_three_cornered_hat_recovers_three_orthogonal_errors_and_refuses_oth
     assert three_cornered_hat(1.0, 1.0, 2.0) is None
 
 
+def test_a_hat_that_a_corners_richardson_estimate_refutes_is_no_own_error(monkeypatch):
+    """Errors that are not orthogonal: a's and b's aligned (2 v and 1.5 v), c's (w)
+    orthogonal to both. The hat puts a at 1, half its true error 2; c's own (Richardson)
+    error 1 and the distance sqrt(5) bound a's from below by sqrt(5) - 1 (triangle
+    inequality), which refutes the hat: a keeps no own error, and is no reference. With
+    orthogonal errors (a's 0.5 w') the same corners give the hat, exact, as its error."""
+    from ngdual.studies.figures import truth
+    from ngdual.verification import overkill
+
+    v, w, w2 = np.eye(3)
+    solutions = {"a": 2 * v, "b": 1.5 * v, "c": w, "a2": 0.5 * w2, "uniform": 3 * w}
+
+    def dist(x, y):
+        return float(np.linalg.norm(x["e"] - y["e"]))
+
+    monkeypatch.setattr(truth, "pressure_distance", lambda x, y, window=None: dist(x, y))
+    monkeypatch.setattr(overkill, "true_errors", lambda x, y, lam, mu, window=None: {
+        "sigma_energy": dist(x, y), "sigma_energy_norm": 1.0})
+
+    def check(name, own):
+        entry = {"overkill_error": own, "estimate": own and "Richardson"}
+        return {"method": name, "pressure": dict(entry), "sigma_energy": dict(entry)}
+
+    for name, truth_a in (("a", 2.0), ("a2", 0.5)):
+        names = [name, "b", "c"]
+        runs = {m: [({"ndof": 10 - k}, {"e": solutions[m], "triangles": [0]})]
+                for k, m in enumerate(names)}
+        checks = [check(name, None), check("b", None), check("c", 1.0)]
+        truth._hat_checks(checks, runs, ({}, {"e": solutions["uniform"], "triangles": [0]}),
+                          1.0, 1.0, None)
+        entry = checks[0]["pressure"]
+        assert sorted(entry["corners"]) == ["b", "c"]
+        if name == "a":
+            assert entry["hat"] == pytest.approx(1.0)
+            assert entry["hat_bound"] == pytest.approx(5 ** 0.5 - 1)
+            assert entry["hat_bound"] <= truth_a
+            assert entry["hat_refuted"] and entry["overkill_error"] is None
+        else:
+            assert not entry["hat_refuted"] and entry["hat_bound"] <= truth_a
+            assert entry["overkill_error"] == pytest.approx(truth_a)
+            assert entry["estimate"] == "three-cornered hat"
+
+
 def test_a_solve_record_and_an_adaptive_step_hold_the_estimate_under_the_same_keys():
     """``estimator`` is (sum_T eta_T^2)^(1/2) and ``estimator_sum`` sum_T eta_T in every
     record; ``eta`` is the rotation's norm."""
