@@ -334,6 +334,25 @@ def test_the_thesis_scale_plan_uses_the_thesis_steps():
     assert main(["figures", "--max-level", "1", "--out", "unused"]) == 2
 
 
+def test_the_flat_punchs_reference_runs_go_further_than_the_others():
+    """The true-error studies' adaptive runs stop at their problem's tolerance: the flat
+    punch's at a third of the others' (its sigma references converge slowest), with twice
+    the budget at order k >= 1; the others at REFERENCE_TOL with the budget / 4^k."""
+    from ngdual.studies.figures.plan import REFERENCE_TOL, TRUTH_PROBLEMS
+    from ngdual.studies.figures.tasks import truth_adapt
+
+    plan = Plan(7)
+    for problem, tp in TRUTH_PROBLEMS.items():
+        punch = problem == "flat-punch"
+        for order in (0, 1, 2):
+            params = truth_adapt(plan, problem, "stress", order).params
+            assert params["tol"] == tp.reference_tol
+            assert (params["tol"] <= REFERENCE_TOL / 3) if punch else (
+                params["tol"] == REFERENCE_TOL)
+            budget = plan.reference_elements(problem) // 4 ** order * (2 if punch and order else 1)
+            assert params["max_elements"] == budget, (problem, order)
+
+
 def test_the_readme_summary_takes_the_fastest_method_of_each_order():
     """work_precision's summary tables (the README's): per order the least time of any of
     its methods with its letters, uniform and P2 without, the verdict's ratios and "adaptive

@@ -22,7 +22,6 @@ from .plan import (
     PEER_ORDERS,
     REFERENCE_ORDER,
     REFERENCE_ORDER_DOFS,
-    REFERENCE_TOL,
     SCENES,
     TRUTH_GOALS,
     TRUTH_PROBLEMS,
@@ -122,7 +121,7 @@ def truth_adapt(plan: Plan, problem: str, goal: str, order: int = 0) -> Task:
     """The adaptive run of a :data:`TRUTH_PROBLEMS` scene aiming at ``goal``
     (:data:`TRUTH_GOALS`; the pressure goal on the problem's ``pressure_window``), keeping
     every step's samples: a tolerance run of :func:`ngdual.afem.adapt` (its theta and
-    initial level) of PEERS_``order`` to :data:`REFERENCE_TOL` or the budget
+    initial level) of PEERS_``order`` to the problem's ``reference_tol`` or the budget
     :meth:`Plan.reference_elements` (:meth:`Plan.order_elements` at order k), at most
     :data:`ADAPT_STEPS` solves; below order :data:`REFERENCE_ORDER` the stress goal's steps
     of at most :data:`REFERENCE_ORDER_DOFS` unknowns also by PEERS_k, k =
@@ -137,7 +136,7 @@ def truth_adapt(plan: Plan, problem: str, goal: str, order: int = 0) -> Task:
                           "snapshots": [], "samples": True,
                           "max_elements": (plan.order_elements(problem, order) if order
                                            else plan.reference_elements(problem)),
-                          "goal": goal, "tol": REFERENCE_TOL,
+                          "goal": goal, "tol": tp.reference_tol,
                           "window": ([-window, window] if window and goal == "pressure"
                                      else None),
                           **({"reference_order": REFERENCE_ORDER,
