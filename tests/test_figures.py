@@ -455,10 +455,12 @@ def test_the_three_cornered_hat_recovers_three_orthogonal_errors_and_refuses_oth
 
 def test_a_hat_that_a_corners_richardson_estimate_refutes_is_no_own_error(monkeypatch):
     """Errors that are not orthogonal: a's and b's aligned (2 v and 1.5 v), c's (w)
-    orthogonal to both. The hat puts a at 1, half its true error 2; c's own (Richardson)
-    error 1 and the distance sqrt(5) bound a's from below by sqrt(5) - 1 (triangle
-    inequality), which refutes the hat: a keeps no own error, and is no reference. With
-    orthogonal errors (a's 0.5 w') the same corners give the hat, exact, as its error."""
+    orthogonal to both. The hat puts a at 1, half its true error 2; c's Richardson
+    estimate 0.5 (counted twice: 1, its true error) and the distance sqrt(5) bound a's
+    from below by sqrt(5) - 1 (triangle inequality), which refutes the hat: a keeps no own
+    error, and is no reference. With orthogonal errors (a's 0.5 w') the same corners give
+    the hat, exact, as its error. The pressure's hat is bounded by every run with a
+    Richardson estimate, corner or not."""
     from ngdual.studies.figures import truth
     from ngdual.verification import overkill
 
@@ -480,7 +482,7 @@ def test_a_hat_that_a_corners_richardson_estimate_refutes_is_no_own_error(monkey
         names = [name, "b", "c"]
         runs = {m: [({"ndof": 10 - k}, {"e": solutions[m], "triangles": [0]})]
                 for k, m in enumerate(names)}
-        checks = [check(name, None), check("b", None), check("c", 1.0)]
+        checks = [check(name, None), check("b", None), check("c", 0.5)]
         truth._hat_checks(checks, runs, ({}, {"e": solutions["uniform"], "triangles": [0]}),
                           1.0, 1.0, None)
         entry = checks[0]["pressure"]
@@ -494,6 +496,24 @@ def test_a_hat_that_a_corners_richardson_estimate_refutes_is_no_own_error(monkey
             assert not entry["hat_refuted"] and entry["hat_bound"] <= truth_a
             assert entry["overkill_error"] == pytest.approx(truth_a)
             assert entry["estimate"] == "three-cornered hat"
+
+    # a run that is no corner bounds the pressure's hat too (its distance costs little):
+    # d = 5 v lies 3 from a, farther than a's corners b (0.5) and c (sqrt 5); the hat of
+    # a, b, c puts a at 1 (true 2). d's Richardson estimate 5 gives no bound, 1.25 the
+    # bound 3 - 2 x 1.25 = 0.5 (the hat stands), 0.75 the bound 1.5, which refutes it
+    solutions.update(d=5 * v)
+    names = ["a", "b", "c", "d"]
+    runs = {m: [({"ndof": 10 - k}, {"e": solutions[m], "triangles": [0]})]
+            for k, m in enumerate(names)}
+    uniform = ({}, {"e": solutions["uniform"], "triangles": [0]})
+    for own_d, bound in ((5.0, 0.0), (1.25, 0.5), (0.75, 1.5)):
+        checks = [check("a", None), check("b", None), check("c", None), check("d", own_d)]
+        truth._hat_checks(checks, runs, uniform, 1.0, 1.0, None)
+        entry = checks[0]["pressure"]
+        assert sorted(entry["corners"]) == ["b", "c"] and entry["hat"] == pytest.approx(1.0)
+        assert entry["hat_bound"] == pytest.approx(bound) and entry["hat_bound"] <= 2.0
+        assert entry["hat_refuted"] == (bound > 1.0)
+        assert entry["overkill_error"] == (None if bound > 1.0 else pytest.approx(1.0))
 
 
 def test_a_solve_record_and_an_adaptive_step_hold_the_estimate_under_the_same_keys():
