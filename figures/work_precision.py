@@ -36,10 +36,11 @@ taken as orthogonal (the JSON's ``estimate`` says which) -- for sigma the run's 
 the last step of a run of the other goal (of the same order, else of order 0) and the
 finest uniform level; for the pressure the run's last step and the two solutions nearest
 to it among the other runs' last steps and the finest uniform level (corners far from the
-truth would make the hat a difference of large squares). A hat below the error that a
-corner's own Richardson estimate and the triangle inequality force (e_a >= d_ab - e_b, the
-JSON's ``hat_bound``) is refuted and gives no own error (``hat_refuted``): the corners'
-errors are then not orthogonal (runs of one goal refine alike). The runs of order 1 and 2 are
+truth would make the hat a difference of large squares). A hat below the error that
+another run's own Richardson estimate and the triangle inequality force (e_a >= d_ab -
+2 e_b, the estimate counted twice; for sigma the corners', for the pressure every run's;
+the JSON's ``hat_bound``) is refuted and gives no own error (``hat_refuted``): the
+corners' errors are then not orthogonal (runs of one goal refine alike). The runs of order 1 and 2 are
 candidates too: their pressure and sigma converge faster than those of order 0. A target
 is resolved when that error is at most a third of it (the JSON's ``resolves``).
 Candidates whose meshes are not nested in the reference's (uniform, the peers, the other
