@@ -14,12 +14,13 @@ estimate). Where a run gives no such estimate, two independent solutions stand i
 three errors are orthogonal: for sigma the last step of its :func:`partner` and the finest
 uniform level, on meshes of other families; for the pressure the two solutions nearest to
 it (:func:`nearest_corners`) among the other runs' last steps and the finest uniform
-level. The stress goal's steps up to a size are solved again by
-PEERS_2 on their meshes (:func:`order_reference`): their last one is the sigma reference
-where its own error, Richardson from the two before it, is smaller. The reference of a
-measure is the step with the smallest own error, and it resolves the targets at least
-1 / :data:`RESOLVES` times its error. The steps of a run
-are nested meshes (bisection), so their distances to its last step are exact integrals;
+level. A hat that another run's Richardson estimate contradicts by the triangle
+inequality is no own error (:func:`hat_bound`). The stress goal's steps up to a size are
+solved again by PEERS_2 on their meshes (:func:`order_reference`): their last one is the
+sigma reference where its own error, Richardson from the two before it, is smaller. The
+reference of a measure is the step with the smallest own error, and it resolves the
+targets at least 1 / :data:`RESOLVES` times its error. The steps of a run are nested
+meshes (bisection), so their distances to its last step are exact integrals;
 every other candidate's mesh crosses the reference's triangles, and the quadrature error
 this costs (:mod:`ngdual.verification.overkill`) is measured by integrating the sigma
 error again on the reference's triangles split in four (:func:`split_samples`). The
@@ -71,9 +72,8 @@ STALLED = 1.3
 # times its value: it assumes the asymptotic ratio, and where a run has both, it lies up
 # to 13 % below its hat (the stress goal of order 1: the punch's 0.019 % against 0.022 %,
 # Hertz's 1.39 % against 1.53 %) or far above it (the study at 0839a8a); a hat is refuted
-# only by a contradiction larger than such an error. Bounds
-# from remote runs (the Hertz stress goal's 1.39 %, 1.8 % from the pressure goal of order
-# 1 with its hat 0.082 %) are then no refutation
+# only by a contradiction larger than such an error, not by a remote run's (the Hertz
+# stress goal's 1.39 %, 1.8 % from the pressure goal of order 1, whose hat is 0.082 %)
 RICHARDSON_SAFETY = 2.0
 # the P2 nodes of the four red children of the reference triangle, in barycentric
 # coordinates of the parent (vertices 0, 1, 2; midpoints m01, m12, m20)
