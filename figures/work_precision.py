@@ -40,8 +40,9 @@ truth would make the hat a difference of large squares). A hat below the error t
 another run's own Richardson estimate and the triangle inequality force (e_a >= d_ab -
 2 e_b, the estimate counted twice; for sigma the corners', for the pressure every run's;
 the JSON's ``hat_bound``) is refuted and gives no own error (``hat_refuted``): the
-corners' errors are then not orthogonal (runs of one goal refine alike). The runs of order 1 and 2 are
-candidates too: their pressure and sigma converge faster than those of order 0. A target
+corners' errors are then not orthogonal (runs of one goal refine alike). The runs of order
+1 and 2 are candidates too: their pressure and sigma converge faster than those of order 0.
+A target
 is resolved when that error is at most a third of it (the JSON's ``resolves``).
 Candidates whose meshes are not nested in the reference's (uniform, the peers, the other
 runs' steps) carry a quadrature error; it is measured by integrating again on the
