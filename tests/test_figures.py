@@ -486,13 +486,16 @@ def test_a_hat_that_a_corners_richardson_estimate_refutes_is_no_own_error(monkey
         entry = {"overkill_error": own, "estimate": own and "Richardson"}
         return {"method": name, "pressure": dict(entry), "sigma_energy": dict(entry)}
 
+    def samples(name):   # a one-triangle solution whose error is solutions[name]
+        return {"e": solutions[name], "triangles": [0]}
+
+    def runs_of(names):  # one step each, the first name's the largest
+        return {m: [({"ndof": 10 - k}, samples(m))] for k, m in enumerate(names)}
+
+    uniform = ({}, samples("uniform"))
     for name, truth_a in (("a", 2.0), ("a2", 0.5)):
-        names = [name, "b", "c"]
-        runs = {m: [({"ndof": 10 - k}, {"e": solutions[m], "triangles": [0]})]
-                for k, m in enumerate(names)}
         checks = [check(name, None), check("b", None), check("c", 0.5)]
-        truth._hat_checks(checks, runs, ({}, {"e": solutions["uniform"], "triangles": [0]}),
-                          1.0, 1.0, None)
+        truth._hat_checks(checks, runs_of([name, "b", "c"]), uniform, 1.0, 1.0, None)
         entry = checks[0]["pressure"]
         assert sorted(entry["corners"]) == ["b", "c"]
         if name == "a":
@@ -510,13 +513,9 @@ def test_a_hat_that_a_corners_richardson_estimate_refutes_is_no_own_error(monkey
     # a, b, c puts a at 1 (true 2). d's Richardson estimate 5 gives no bound, 1.25 the
     # bound 3 - 2 x 1.25 = 0.5 (the hat stands), 0.75 the bound 1.5, which refutes it
     solutions.update(d=5 * v)
-    names = ["a", "b", "c", "d"]
-    runs = {m: [({"ndof": 10 - k}, {"e": solutions[m], "triangles": [0]})]
-            for k, m in enumerate(names)}
-    uniform = ({}, {"e": solutions["uniform"], "triangles": [0]})
     for own_d, bound in ((5.0, 0.0), (1.25, 0.5), (0.75, 1.5)):
         checks = [check("a", None), check("b", None), check("c", None), check("d", own_d)]
-        truth._hat_checks(checks, runs, uniform, 1.0, 1.0, None)
+        truth._hat_checks(checks, runs_of(["a", "b", "c", "d"]), uniform, 1.0, 1.0, None)
         entry = checks[0]["pressure"]
         assert sorted(entry["corners"]) == ["b", "c"] and entry["hat"] == pytest.approx(1.0)
         assert entry["hat_bound"] == pytest.approx(bound) and entry["hat_bound"] <= 2.0
