@@ -66,7 +66,10 @@ the guest) can fall on all runs of one method: a verdict whose two times lie wit
 CLOSE (1.3x) of each other is timed again after the sweep, the uniform solve and the
 adaptive run to its step in turn, seven runs of each after one not counted
 (ngdual.studies.sweep.work.paired_task), and decided by their medians (the table's
-"adaptive first" gives them). Every task
+"adaptive first" gives them). A verdict whose fastest adaptive run reaches the target with
+its first solve, the very solve of the fastest uniform level (same order, multipliers and
+unknowns), is a tie by construction: "tie: the same solve", no win, not timed again
+(same_solve). Every task
 runs NGSolve and BLAS on one thread (``ngdual.studies.sweep.work.one_thread``): one task per
 core, the same for every method.
 The table gives the least time to reach 5 %, 2 % and 1 % per method and measure, the
@@ -156,11 +159,29 @@ def _fastest(table: list[dict], problem: str, measure: str, target: float, which
     return min(rows, key=lambda r: r["time_s"], default=None)
 
 
+def same_solve(adaptive: dict | None, uniform: dict | None) -> bool:
+    """Whether ``adaptive`` reaches its target with its first solve and that solve is
+    ``uniform``'s: step 0 with the same order, multipliers and unknowns (an adaptive run
+    starts on a uniform level of the same scene). The two times then measure one
+    computation: a tie by construction, which no timing decides (the punch core's pressure,
+    where PEERS_1 on the initial mesh is at 0.92 %).
+
+    >>> first = {"level_or_step": 0, "order": 1, "multipliers": "facet", "ndof": 5205}
+    >>> same_solve(first, {**first, "level_or_step": 1}), same_solve(first, {**first, "ndof": 9})
+    (True, False)
+    """
+    return (adaptive is not None and uniform is not None and adaptive["level_or_step"] == 0
+            and all(adaptive[k] == uniform[k] for k in ("order", "multipliers", "ndof")))
+
+
 def _wins(adaptive: dict | None, uniform: dict | None) -> bool | None:
     """Whether ``adaptive`` reaches the target before ``uniform`` (or uniform does not within
-    its budget); None where adaptive does not reach it."""
-    return None if adaptive is None else (uniform is None
-                                          or adaptive["time_s"] < uniform["time_s"])
+    its budget); None where adaptive does not reach it, False where it is the same solve
+    (:func:`same_solve`: not less time)."""
+    if adaptive is None:
+        return None
+    return uniform is None or (not same_solve(adaptive, uniform)
+                               and adaptive["time_s"] < uniform["time_s"])
 
 
 def verdicts(table: list[dict]) -> list[dict]:
@@ -195,6 +216,7 @@ def verdicts(table: list[dict]) -> list[dict]:
                     "adaptive_ndof": adaptive and adaptive["ndof"],
                     "adaptive_method": adaptive and adaptive["method"],
                     "adaptive_wins": _wins(adaptive, uniform),
+                    "adaptive_same_solve": same_solve(adaptive, uniform),
                     "uniform_any_s": uniform_any and uniform_any["time_s"],
                     "uniform_any_method": uniform_any and uniform_any["method"],
                     "uniform_any_level": uniform_any and uniform_any["level_or_step"],
@@ -202,6 +224,7 @@ def verdicts(table: list[dict]) -> list[dict]:
                     "adaptive_any_method": adaptive_any and adaptive_any["method"],
                     "adaptive_any_step": adaptive_any and adaptive_any["level_or_step"],
                     "adaptive_any_wins": _wins(adaptive_any, uniform_any),
+                    "adaptive_any_same_solve": same_solve(adaptive_any, uniform_any),
                     "paired_uniform_s": None, "paired_adaptive_s": None,
                     "fastest_ngdual": ngdual and ngdual["method"],
                     "ngdual_s": ngdual and ngdual["time_s"], "p2_s": p2 and p2["time_s"],
@@ -216,10 +239,11 @@ def verdicts(table: list[dict]) -> list[dict]:
 
 def is_close(v: dict) -> bool:
     """Whether the fastest adaptive and uniform times of a verdict lie within
-    :data:`CLOSE` of each other, both under REPEAT_BELOW_S (longer runs vary less)."""
+    :data:`CLOSE` of each other, both under REPEAT_BELOW_S (longer runs vary less), and
+    are two computations (not :func:`same_solve`)."""
     a, u = v["adaptive_any_s"], v["uniform_any_s"]
     return (a is not None and u is not None and max(a / u, u / a) <= CLOSE
-            and max(a, u) < REPEAT_BELOW_S)
+            and max(a, u) < REPEAT_BELOW_S and not v.get("adaptive_any_same_solve"))
 
 
 def paired_tasks(plan, verdict: list[dict], rows: list[dict]) -> dict[int, object]:
@@ -332,7 +356,8 @@ def method_letters(method: str) -> str:
 
 def first_cell(v: dict) -> str | None:
     """"yes" / "no": the fastest adaptive method of any order comes first; with the medians
-    of a paired timing (adaptive / uniform) where there is one.
+    of a paired timing (adaptive / uniform) where there is one; "tie: the same solve" where
+    the two are one computation (:func:`same_solve`).
 
     >>> first_cell({"adaptive_any_wins": True, "paired_adaptive_s": 0.378,
     ...             "paired_uniform_s": 0.4512})
@@ -340,6 +365,8 @@ def first_cell(v: dict) -> str | None:
     """
     if v["adaptive_any_wins"] is None:
         return None
+    if v.get("adaptive_any_same_solve"):
+        return "tie: the same solve"
     verdict = "yes" if v["adaptive_any_wins"] else "no"
     if v.get("paired_adaptive_s") is None:
         return verdict
@@ -449,8 +476,9 @@ def _numbers(verdict: list[dict], effectivity: list[dict], budget: list[dict]) -
         else:
             uniform = ("not reached" if v["uniform_s"] is None
                        else f"{v['uniform_s']:.2f} s")
+            tie = "tie, the same solve: " if v["adaptive_same_solve"] else ""
             numbers[f"{what}, adaptive beats uniform"] = (
-                f"{v['adaptive_wins']} ({v['adaptive_s']:.2f} s {v['adaptive_method']} vs "
+                f"{tie}{v['adaptive_wins']} ({v['adaptive_s']:.2f} s {v['adaptive_method']} vs "
                 f"uniform {uniform}){'' if v['resolved'] else ', not resolved'}")
         if v["adaptive_any_wins"] is None:
             numbers[f"{what}, adaptive beats uniform, any order"] = \
@@ -461,8 +489,9 @@ def _numbers(verdict: list[dict], effectivity: list[dict], budget: list[dict]) -
             paired = ("" if v["paired_adaptive_s"] is None else
                       f"; timed in turn {v['paired_adaptive_s']:.3f} s vs "
                       f"{v['paired_uniform_s']:.3f} s")
+            tie = "tie, the same solve: " if v["adaptive_any_same_solve"] else ""
             numbers[f"{what}, adaptive beats uniform, any order"] = (
-                f"{v['adaptive_any_wins']} ({v['adaptive_any_s']:.2f} s "
+                f"{tie}{v['adaptive_any_wins']} ({v['adaptive_any_s']:.2f} s "
                 f"{v['adaptive_any_method']} vs {uniform}{paired})"
                 f"{'' if v['resolved'] else ', not resolved'}")
         if v["measure"] == "pressure":

@@ -264,10 +264,14 @@ def test_work_precision_measures_true_errors_against_references_it_checks(coarse
     ordered = [v for measure in ("pressure", "sigma_energy") for v in result["verdicts"]
                if v["measure"] == measure]
     assert [r[-2].split(" (in turn")[0] for r in rows] == [
-        {None: "–", True: "yes", False: "no"}[v["adaptive_any_wins"]] for v in ordered]
+        "tie: the same solve" if v["adaptive_any_same_solve"]
+        else {None: "–", True: "yes", False: "no"}[v["adaptive_any_wins"]] for v in ordered]
     for v in result["verdicts"]:
-        # a close verdict is the paired timing's (when it ran), any other the table's
-        if v["paired_adaptive_s"] is not None:
+        # a close verdict is the paired timing's (when it ran), a tie no win and not timed
+        # again, any other the table's
+        if v["adaptive_any_same_solve"]:
+            assert v["adaptive_any_wins"] is False and v["paired_adaptive_s"] is None
+        elif v["paired_adaptive_s"] is not None:
             a, u = v["adaptive_any_s"], v["uniform_any_s"]
             assert max(a / u, u / a) <= 1.3, v
             assert v["adaptive_any_wins"] == (v["paired_adaptive_s"] < v["paired_uniform_s"])
@@ -649,10 +653,13 @@ def test_close_verdicts_are_decided_by_their_paired_timing():
 
     wp = load_script(Path(__file__).parents[1] / "figures" / "work_precision.py")
 
+    def row(time_s, ndof):   # a row of the table: a level or step of 100 or 400 unknowns
+        return time_s and {"time_s": time_s, "level_or_step": 2, "order": 0,
+                           "multipliers": "coarse", "ndof": ndof}
+
     def verdict(adaptive_s, uniform_s):
         return {"adaptive_any_s": adaptive_s, "uniform_any_s": uniform_s,
-                "adaptive_any_wins": wp._wins(adaptive_s and {"time_s": adaptive_s},
-                                              uniform_s and {"time_s": uniform_s}),
+                "adaptive_any_wins": wp._wins(row(adaptive_s, 100), row(uniform_s, 400)),
                 "paired_adaptive_s": None, "paired_uniform_s": None}
     assert wp.is_close(verdict(0.52, 0.42)) and wp.is_close(verdict(0.42, 0.52))
     assert not wp.is_close(verdict(0.56, 0.42)) and not wp.is_close(verdict(0.3, 0.42))
@@ -665,3 +672,15 @@ def test_close_verdicts_are_decided_by_their_paired_timing():
     assert wp.first_cell(cells[0]) == "yes (in turn: 0.38 / 0.45 s)"
     assert [wp.first_cell(c) for c in cells[1:]] == ["no", "yes"]
     assert wp.first_cell(verdict(None, 0.4)) is None
+    # the adaptive run's first solve is the uniform solve: a tie whatever the two times say
+    first = {"level_or_step": 0, "order": 1, "multipliers": "facet", "ndof": 5205}
+    for adaptive_s, uniform_s in ((0.0766, 0.0768), (0.0768, 0.0766)):
+        adaptive, uniform = {**first, "time_s": adaptive_s}, {**first, "time_s": uniform_s}
+        tie = {**verdict(adaptive_s, uniform_s), "adaptive_any_wins": wp._wins(adaptive, uniform),
+               "adaptive_any_same_solve": wp.same_solve(adaptive, uniform)}
+        assert tie["adaptive_any_wins"] is False and not wp.is_close(tie)
+        assert wp.first_cell(tie) == "tie: the same solve"
+    # the same unknowns on a later step, or another order, are two computations
+    later = {**first, "level_or_step": 1, "time_s": 0.0766}
+    assert wp._wins(later, {**first, "time_s": 0.0768}) is True
+    assert not wp.same_solve({**first, "order": 2}, first)
