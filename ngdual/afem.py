@@ -17,12 +17,15 @@ The loop aims at a goal (:data:`GOALS`): ``"stress"``, the thesis' (4.50), or
 of the scene's ``[discretisation]``: the indicators are those of (4.50) at order k, and the
 pressure goal's p_h is the trace of sigma_h with the facet multipliers. Given a tolerance
 ``tol`` it stops as soon as the goal's relative estimate (:func:`relative_estimate`) is
-below it, ``steps`` being then only a bound.
+below it, ``steps`` being then only a bound; a run whose estimate stalls
+(:data:`STALL_STEPS`) or whose marking reaches the smallest triangle it refines
+(:data:`RESOLUTION`) stops there and says so (``stopped_by``, :class:`ToleranceWarning`).
 """
 
 from __future__ import annotations
 
 import time
+import warnings
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import asdict
@@ -33,9 +36,10 @@ import numpy as np
 from . import budget
 from .boundary import BoundaryMeshes
 from .estimator import ASYMMETRY_NORMS, Estimate, estimate
+from .geometry import length_scale
 from .goal import GOALS, goal_estimate
 from .marking import STRATEGIES, mark
-from .mesh import build_mesh
+from .mesh import build_mesh, mesh_arrays
 from .quantities import norms
 from .rates import extrapolated_norms, total_error
 from .scene import Scene, SceneError, SceneTypeError, check_level, ensure_valid
@@ -63,6 +67,20 @@ STEPS, STEPS_TOL = 5, 30
 # elsewhere and grow the unknowns by 1.01-1.2x (hertz-cylinder --goal pressure --tol 0.01:
 # 4.6 s from level 1, 12.5 s from level 2, 11.7 s from its level 3; docs/theory/estimator.md).
 LEVEL_TOL = 1
+# A tolerance run stops as stalled when its goal's relative estimate has not fallen below
+# its best for this many steps: the estimate is then held by triangles that refining does
+# not improve (the work-precision study's runs never went more than two steps without a
+# new best; the wedge's pressure goal at order 1 and 2 reaches 7.8e-4 and 6.5e-4 with
+# Gamma_C edges of 2e-6 at the apex, and then rises while only the apex is refined:
+# docs/theory/estimator.md, "A goal and a tolerance").
+STALL_STEPS = 3
+# The smallest triangle the loop refines, as a share of the scene's length scale L
+# (:func:`ngdual.geometry.length_scale`): a thousand times the geometry's round-off
+# (:data:`ngdual.geometry.ROUND_OFF`, below which two vertices are one point and Gamma_C
+# falls apart into other chains), and far below what the studies' solutions need (their
+# finest triangles: 1.2e-6 L, at the flat punch's edges). A marking that reaches below it
+# stops the loop.
+RESOLUTION = 1e-7
 
 
 def loop_defaults(tol: float | None, theta: float | None, steps: int | None,
@@ -177,8 +195,16 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
         up to MARK), and ``solved_s``, the wall time from the start to the step's solution:
         the steps before in full and this step's SOLVE (as ``timings["total"]`` of
         :func:`~ngdual.solvers.solve_scene` times one solve, from the checks of the
-        arguments on, meshing included). The last record's ``stopped_by`` is ``"tol"`` or
-        ``"steps"``.
+        arguments on, meshing included). The last record's ``stopped_by`` is ``"tol"``,
+        ``"steps"``, ``"stall"`` (with ``tol``: the relative estimate has not fallen below
+        its best for :data:`STALL_STEPS` steps) or ``"resolution"`` (the marking reached a
+        triangle smaller than :data:`RESOLUTION` times the scene's length scale), the last
+        two with a ``stop_message``.
+
+    Warns
+    -----
+    ToleranceWarning
+        With ``tol``, when the run stops without reaching it.
     """
     start = time.perf_counter()   # as solve_scene's timings["total"]: checks and mesh too
     scene = with_discretisation(scene, order, multipliers)
@@ -200,17 +226,30 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
         record["solved_s"] = solved
         indicators = _goal_indicators(record, solution, estimated, goal, window)
         history.append(record)
-        converged = tol is not None and record["relative_estimate"] <= tol
-        last = converged or step == steps - 1
+        stop = "tol" if tol is not None and record["relative_estimate"] <= tol else (
+            _stalled(history, tol))
         # MARK
         marked = None
-        if not last:
+        if stop is None and step < steps - 1:
             with _timed(record, "mark"):
                 marked = mark(indicators, theta, marking)
-            record["marked"] = int(marked.sum())
+            stop = _unresolved(scene, solution, estimated, marked)
+            if stop is None:
+                record["marked"] = int(marked.sum())
+            else:
+                marked = None
         record["elapsed_s"] = time.perf_counter() - start
+        last = marked is None
         if last:
-            record["stopped_by"] = "tol" if converged else "steps"
+            stop = stop or {"stopped_by": "steps"}
+            if isinstance(stop, str):
+                stop = {"stopped_by": stop}
+            record.update(stop)
+            if tol is not None and stop["stopped_by"] != "tol":
+                warnings.warn(f"adapt: the goal's relative estimate "
+                              f"{record['relative_estimate']:.3g} is above tol = {tol:g}: "
+                              + stop.get("stop_message", f"the {steps} steps are spent"),
+                              ToleranceWarning, stacklevel=2)
         if on_step is not None:
             called = time.perf_counter()
             on_step(record, solution, estimated, marked)
@@ -224,6 +263,45 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
             warm = _warm_start(solution)
         record["elapsed_s"] = time.perf_counter() - start
     return history
+
+
+class ToleranceWarning(UserWarning):
+    """An adaptive run given a ``tol`` stopped without reaching it (its last record's
+    ``stopped_by`` is ``"steps"``, ``"stall"`` or ``"resolution"``)."""
+
+
+def _stalled(history: list[dict], tol: float | None) -> dict | None:
+    """The stop of a tolerance run whose relative estimate has not fallen below its best
+    for :data:`STALL_STEPS` steps (None while it falls, and without ``tol``)."""
+    if tol is None or len(history) <= STALL_STEPS:
+        return None
+    estimates = [r["relative_estimate"] for r in history]
+    best = int(np.argmin(estimates[:-STALL_STEPS]))
+    if min(estimates[-STALL_STEPS:]) < estimates[best]:
+        return None
+    since = ", ".join(f"{e:.3g}" for e in estimates[-STALL_STEPS:])
+    return {"stopped_by": "stall",
+            "stop_message": f"the estimate has not fallen below its best, "
+                            f"{estimates[best]:.3g} at step {best}, for {STALL_STEPS} "
+                            f"steps ({since}): refining the marked triangles does not reduce "
+                            f"it"}
+
+
+def _unresolved(scene: Scene, solution: Solution, estimated: Estimate,
+                marked: np.ndarray) -> dict | None:
+    """The stop of a loop whose marking reaches a triangle of diameter below
+    :data:`RESOLUTION` times the scene's length scale (None otherwise)."""
+    floor = RESOLUTION * length_scale(scene.geometry.curves())
+    small = marked & (estimated.h < floor)
+    if not small.any():
+        return None
+    points, triangles = mesh_arrays(solution.problem.fes.mesh)
+    where = points[triangles[np.flatnonzero(small)[0]]].mean(axis=0)
+    return {"stopped_by": "resolution",
+            "stop_message": f"the marking reaches triangles of diameter "
+                            f"{estimated.h[small].min():.2g} near ({where[0]:.4g}, "
+                            f"{where[1]:.4g}), below the smallest the loop refines, "
+                            f"{floor:.2g} ({RESOLUTION:g} of the scene's length scale)"}
 
 
 def _warm_start(solution: Solution) -> ContactStart | None:

@@ -1,12 +1,23 @@
 """The adaptive loop's goal (stress or contact pressure) and its stopping tolerance."""
 
 import json
+import warnings
 
 import ngsolve as ngs
 import numpy as np
 import pytest
 
-from ngdual.afem import LEVEL_TOL, STEPS_TOL, THETA_TOL, adapt, loop_defaults, refine_towards
+from ngdual import afem
+from ngdual.afem import (
+    LEVEL_TOL,
+    STALL_STEPS,
+    STEPS_TOL,
+    THETA_TOL,
+    ToleranceWarning,
+    adapt,
+    loop_defaults,
+    refine_towards,
+)
 from ngdual.cli import main
 from ngdual.estimator import estimate
 from ngdual.goal import goal_estimate
@@ -132,6 +143,59 @@ def test_ngdual_adapt_with_goal_and_tol_records_them_and_stops(tmp_path, capsys)
     assert (run["goal"], run["tol"], run["theta"]) == ("pressure", 0.045, THETA_TOL)
     assert run["history"][-1]["stopped_by"] == "tol"
     assert "(stopped by tol)" in capsys.readouterr().out
+
+
+def test_a_tolerance_run_whose_estimate_stops_falling_stops_as_stalled():
+    """A new best within STALL_STEPS steps keeps the run going; STALL_STEPS steps without
+    one stop it, naming the best; a run without tol never stalls."""
+    def history(*estimates):
+        return [{"relative_estimate": e} for e in estimates]
+
+    assert STALL_STEPS == 3
+    assert afem._stalled(history(0.1, 0.05, 0.06, 0.07, 0.049), 0.01) is None
+    assert afem._stalled(history(0.1, 0.05, 0.06), 0.01) is None
+    stop = afem._stalled(history(0.1, 0.05, 0.06, 0.07, 0.05), 0.01)
+    assert stop["stopped_by"] == "stall" and "0.05 at step 1" in stop["stop_message"]
+    assert afem._stalled(history(0.1, 0.05, 0.06, 0.07, 0.05), None) is None
+
+
+def test_a_marking_below_the_resolution_stops_the_loop_and_warns_of_the_tol(hertz, monkeypatch):
+    """A marked triangle smaller than RESOLUTION x the length scale (here raised so that
+    hertz-cylinder's first marks reach it) stops the loop before it refines, saying where;
+    a run with a tol it did not reach warns (ToleranceWarning), one without does not."""
+    monkeypatch.setattr(afem, "RESOLUTION", 0.02)   # 0.16 of the 8-wide block
+    with pytest.warns(ToleranceWarning, match="above tol = 1e-06: the marking reaches"):
+        history = adapt(hertz, goal="pressure", tol=1e-6, steps=6)
+    last = history[-1]
+    assert last["stopped_by"] == "resolution" and last["marked"] == 0   # nothing refined
+    assert "below the smallest the loop refines, 0.16" in last["stop_message"]
+    assert all("stopped_by" not in r for r in history[:-1])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ToleranceWarning)
+        assert adapt(hertz, goal="pressure", steps=6)[-1]["stopped_by"] == "resolution"
+
+
+def test_ngdual_adapt_that_misses_its_tol_says_why_with_exit_status_1(tmp_path, capsys,
+                                                                       monkeypatch):
+    monkeypatch.setattr(afem, "RESOLUTION", 0.02)
+    assert main(["adapt", "hertz-cylinder", "--goal", "pressure", "--tol", "1e-6",
+                 "--out", str(tmp_path)]) == 1
+    out, err = capsys.readouterr()
+    assert "(stopped by resolution)" in out and "below the smallest the loop refines" in out
+    assert "not converged: --tol 1e-06 not reached" in err and "ToleranceWarning" not in err
+    run = json.loads((tmp_path / "history.json").read_text())
+    assert run["history"][-1]["stopped_by"] == "resolution"
+
+
+@pytest.mark.slow
+def test_the_wedge_apex_stops_a_tight_tolerance_run_instead_of_breaking_it():
+    """The pressure goal of order 1 on the wedge refines its apex down to Gamma_C edges of
+    1e-9, where the geometry's round-off split Gamma_C into more chains (a ValueError
+    before the loop stopped): it now stops when its marking reaches RESOLUTION, or stalls."""
+    with pytest.warns(ToleranceWarning):
+        history = adapt(load_scene("wedge"), goal="pressure", tol=3e-4, order=1)
+    assert history[-1]["stopped_by"] in ("resolution", "stall")
+    assert min(r["relative_estimate"] for r in history) < 1e-3
 
 
 @pytest.mark.parametrize("flag, value", [("--tol", "0"), ("--tol", "inf"), ("--theta", "2")])

@@ -117,7 +117,9 @@ def parser() -> argparse.ArgumentParser:
     ad.add_argument("--tol", type=float, default=None,
                     help="stop at the first step whose goal estimate relative to the "
                          "solution's size (||sigma_h|| in H(div), ||p_h|| on Gamma_C) is at "
-                         "most TOL")
+                         "most TOL; a run that stops short of it (by --steps, a stalled "
+                         "estimate or the smallest triangle the loop refines) exits with "
+                         "status 1")
     ad.add_argument("--window", type=float, nargs=2, default=None, metavar=("LO", "HI"),
                     help="with --goal pressure: the error of the pressure on the part of "
                          "Gamma_C with LO <= x <= HI only (default: all of Gamma_C), e.g. "

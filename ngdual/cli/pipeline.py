@@ -113,9 +113,14 @@ def cmd_adapt(args) -> int:
     (.vol, and .png with the marked triangles shaded), with --vtk a VTK file per step.
     The failed physics checks of every step are printed below its line and kept in its
     record; with --strict the run stops at the first step that has one, writing nothing
-    for that step (history.json then holds the steps before it, if any)."""
+    for that step (history.json then holds the steps before it, if any). A --tol that the
+    run does not reach (it stops by its steps, stalls or reaches the smallest triangle it
+    refines) is exit status 1, with the reason."""
+    from ..afem import ToleranceWarning
+
     with warnings.catch_warnings():  # the reference solves' checks are not the run's
         warnings.simplefilter("ignore", PhysicsWarning)
+        warnings.simplefilter("ignore", ToleranceWarning)   # said below, with exit status 1
         return _adapt(args)
 
 
@@ -192,6 +197,8 @@ def _adapt(args) -> int:
         run["history"].append(record)
         write_json(run, out / "history.json")
         print(line)
+        if "stop_message" in record:
+            print(f"    {record['stop_message']}")
         if record["warnings"]:
             print(warning_lines(record["warnings"], "    "))
 
@@ -207,4 +214,10 @@ def _adapt(args) -> int:
     write_json(run, out / "history.json")
     print(f"wrote {out / 'history.json'} and {len(run['history'])} meshes (.vol, .png"
           + (", solution_stepNN.vtu)" if args.vtk else ")"))
+    last = run["history"][-1]
+    if args.tol is not None and last["stopped_by"] != "tol":
+        print(f"ngdual: not converged: --tol {args.tol:g} not reached, the goal's relative "
+              f"estimate is {last['relative_estimate']:.3g} (stopped by "
+              f"{last['stopped_by']})", file=sys.stderr)
+        return EXIT_NOT_CONVERGED
     return 0 if all(r["converged"] for r in run["history"]) else EXIT_NOT_CONVERGED

@@ -212,7 +212,8 @@ def adapt_task(scene: str, marking: str, theta: float, steps: int, level: int,
     loop = loop_arguments({"marking": marking, "theta": theta, "steps": steps, "level": level,
                            "goal": goal, "tol": tol, "window": window})
     try:
-        adapt(load_scene_with(scene, overrides), on_step=on_step, **loop)
+        with _tolerance_kept_quiet():
+            adapt(load_scene_with(scene, overrides), on_step=on_step, **loop)
         status = "ok" if all(r["converged"] for r in history) else "not-converged"
     except ConvergenceError as err:
         run.update(message=str(err))
@@ -267,10 +268,22 @@ def _loop_times(scene: str, overrides, loop: dict, unknowns: list[int],
             raise _Budget
 
     try:
-        adapt(load_scene_with(scene, overrides), on_step=on_step, **loop)
+        with _tolerance_kept_quiet():
+            adapt(load_scene_with(scene, overrides), on_step=on_step, **loop)
     except (ConvergenceError, _Budget):
         pass
     return times
+
+
+@contextlib.contextmanager
+def _tolerance_kept_quiet():
+    """A run that stops short of its tol says so in its last record (``stopped_by``); a
+    worker does not print it as well (:class:`ngdual.afem.ToleranceWarning`)."""
+    from ...afem import ToleranceWarning
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ToleranceWarning)
+        yield
 
 
 def paired_task(uniform: dict, adaptive: dict, unknowns: list[int],
