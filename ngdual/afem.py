@@ -226,8 +226,9 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
         record["solved_s"] = solved
         indicators = _goal_indicators(record, solution, estimated, goal, window)
         history.append(record)
-        stop = "tol" if tol is not None and record["relative_estimate"] <= tol else (
-            _stalled(history, tol))
+        # a dict with the record's stopped_by (and stop_message) once the loop ends
+        stop = ({"stopped_by": "tol"} if tol is not None and record["relative_estimate"] <= tol
+                else _stalled(history, tol))
         # MARK
         marked = None
         if stop is None and step < steps - 1:
@@ -242,8 +243,6 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
         last = marked is None
         if last:
             stop = stop or {"stopped_by": "steps"}
-            if isinstance(stop, str):
-                stop = {"stopped_by": stop}
             record.update(stop)
             if tol is not None and stop["stopped_by"] != "tol":
                 warnings.warn(f"adapt: the goal's relative estimate "
