@@ -34,7 +34,7 @@ import ngsolve as ngs
 import numpy as np
 
 from . import budget
-from .boundary import BoundaryMeshes
+from .boundary import BoundaryMeshes, nearest_vertex
 from .estimator import ASYMMETRY_NORMS, Estimate, estimate
 from .geometry import length_scale
 from .goal import GOALS, goal_estimate
@@ -76,10 +76,9 @@ LEVEL_TOL = 1
 STALL_STEPS = 3
 # The smallest triangle the loop refines, as a share of the scene's length scale L
 # (:func:`ngdual.geometry.length_scale`): a thousand times the geometry's round-off
-# (:data:`ngdual.geometry.ROUND_OFF`, below which two vertices are one point and Gamma_C
-# falls apart into other chains), and far below what the studies' solutions need (their
-# finest triangles: 1.2e-6 L, at the flat punch's edges). A marking that reaches below it
-# stops the loop.
+# (:data:`ngdual.geometry.ROUND_OFF`, below which two positions are one point), and far
+# below what the studies' solutions need (their finest triangles: 1.2e-6 L, at the flat
+# punch's edges). A marking that reaches below it stops the loop.
 RESOLUTION = 1e-7
 
 
@@ -121,13 +120,24 @@ def refine_with_boundary(scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes,
 
 def refine_towards(scene: Scene, mesh: ngs.Mesh, point, times: int
                    ) -> tuple[ngs.Mesh, BoundaryMeshes]:
-    """``times`` refinements of the triangles touching the vertex ``point``, with the coarse
-    boundary meshes following: a mesh graded towards ``point`` (h ratio about 2^times)."""
+    """``times`` refinements of the triangles touching the vertex nearest to ``point``, with
+    the coarse boundary meshes following: a mesh graded towards ``point`` (h ratio about
+    2^times). A grading that would refine a triangle smaller than :data:`RESOLUTION` times
+    the scene's length scale is refused (ValueError), as the adaptive loop stops there."""
     coarse = BoundaryMeshes.for_scene(scene, mesh)
-    point = np.asarray(point, dtype=float)
-    for _ in range(times):
-        touching = np.array([any(np.allclose(mesh[v].point, point) for v in el.vertices)
-                             for el in mesh.Elements()])
+    floor = RESOLUTION * length_scale(scene.geometry.curves())
+    for done in range(times):
+        # the nearest vertex, not every vertex within a fixed distance of point: the graded
+        # mesh's vertices come closer to it than any fixed distance
+        points, triangles = mesh_arrays(mesh)
+        touching = (triangles == nearest_vertex(dict(enumerate(points)), point)).any(axis=1)
+        corners = points[triangles[touching]]
+        h = np.linalg.norm(corners - np.roll(corners, 1, axis=1), axis=2).max()
+        if h < floor:
+            raise ValueError(f"times: refinement {done + 1} of {times} would refine triangles "
+                             f"of diameter {h:.2g} at {tuple(point)}, below the smallest "
+                             f"ngdual refines, {floor:.2g} ({RESOLUTION:g} of the scene's "
+                             f"length scale)")
         mesh, coarse = refine_with_boundary(scene, mesh, coarse, touching)
     return mesh, coarse
 

@@ -2,10 +2,14 @@
 
 import ngsolve as ngs
 import numpy as np
+import pytest
 
-from ngdual.boundary import CoarseMesh, boundary_chains
+from ngdual.afem import refine_towards, refine_with_boundary
+from ngdual.boundary import BoundaryMeshes, CoarseMesh, boundary_chains, end_rule
 from ngdual.forms import _trace_space
-from ngdual.mesh import polygon_mesh, thesis_mesh
+from ngdual.geometry import round_off
+from ngdual.mesh import build_mesh, mesh_arrays, polygon_mesh, thesis_mesh
+from ngdual.scene import load_scene
 
 
 def test_contact_chain_is_ordered_along_the_boundary():
@@ -66,3 +70,31 @@ def test_closed_boundary_has_no_end_constraints():
     (chain,) = coarse.chains
     assert chain.closed
     assert coarse.n_p1_dofs == coarse.n_edges
+
+
+def test_a_kink_breaks_gamma_c_once_however_close_the_graded_mesh_comes_to_it():
+    """The wedge refined 29 times at its apex: vertices 4.6e-10 from the kink, within the
+    geometry's round-off (8e-10) of it. Gamma_C still breaks at the apex vertex alone, into
+    the two flanks, and the coarse meshes follow the refinement."""
+    scene = load_scene("wedge")
+    mesh = build_mesh(scene.geometry, 1)
+    coarse = BoundaryMeshes.for_scene(scene, mesh)
+    tolerance = round_off(scene.geometry.curves())
+    for _ in range(29):
+        points, triangles = mesh_arrays(mesh)
+        apex = int(np.argmin(np.linalg.norm(points, axis=1)))
+        mesh, coarse = refine_with_boundary(scene, mesh, coarse, (triangles == apex).any(axis=1))
+    points = mesh_arrays(mesh)[0]
+    assert np.sum(np.linalg.norm(points, axis=1) <= tolerance) > 1
+    rule = end_rule(scene, mesh, "contact")
+    assert rule.breaks == {apex}
+    chains = boundary_chains(mesh, scene.labels("contact"), rule.breaks)
+    assert len(chains) == len(coarse.contact.chains) == 2
+    assert all(np.all(ch.points[1:-1, 0] < 0) or np.all(ch.points[1:-1, 0] > 0)
+               for ch in chains)
+
+
+def test_grading_below_the_resolution_is_refused_with_the_field_named():
+    scene = load_scene("wedge")
+    with pytest.raises(ValueError, match=r"^times: refinement 20 of 30 .* below the smallest"):
+        refine_towards(scene, build_mesh(scene.geometry, 1), (0.0, 0.0), 30)

@@ -145,6 +145,21 @@ class EndRule:
                      for ch in chains)
 
 
+def nearest_vertex(vertices: dict, point, tolerance: float = np.inf) -> int | None:
+    """The number of the vertex of ``vertices`` (number -> position) nearest to ``point``,
+    None when none lies within ``tolerance`` of it.
+
+    >>> nearest_vertex({3: np.array([0.0, 0.0]), 7: np.array([1e-12, 0.0])}, (1e-12, 0.0))
+    7
+    """
+    if not vertices:
+        return None
+    numbers = list(vertices)
+    distances = np.linalg.norm(np.array([vertices[nr] for nr in numbers]) - point, axis=1)
+    best = int(np.argmin(distances))
+    return numbers[best] if distances[best] <= tolerance else None
+
+
 def end_rule(scene, mesh: ngs.Mesh, role: str) -> EndRule:
     """The :class:`EndRule` of Gamma_C (``role = "contact"``) or Gamma_N (``"neumann"``).
 
@@ -163,8 +178,10 @@ def end_rule(scene, mesh: ngs.Mesh, role: str) -> EndRule:
         # only the vertices of Gamma_C can be kinks (a full vertex scan costs seconds at L8)
         candidates = {v.nr: np.array(mesh[v].point) for el in mesh.Elements(ngs.BND)
                       if el.mat in labels for v in el.vertices} if kinks else {}
-        breaks = frozenset(nr for nr, xy in candidates.items()
-                           if any(np.linalg.norm(xy - k) <= tolerance for k in kinks))
+        # one vertex per kink, the nearest: a mesh graded to edges below the round-off near
+        # a kink has several vertices within it, and each would cut Gamma_C into another chain
+        breaks = frozenset(nr for nr in (nearest_vertex(candidates, k, tolerance)
+                                         for k in kinks) if nr is not None)
         return EndRule(breaks, tuple(kinks) + (tuple(touching) if consistent else ()),
                        tolerance)
     return EndRule(frozenset(), tuple(touching) if consistent else (), tolerance)
