@@ -42,7 +42,7 @@ from .marking import STRATEGIES, mark
 from .mesh import build_mesh, mesh_arrays
 from .quantities import norms
 from .rates import extrapolated_norms, total_error
-from .scene import Scene, SceneError, SceneTypeError, check_level, ensure_valid
+from .scene import Scene, SceneError, SceneTypeError, check_level, contact_junctions, ensure_valid
 from .solvers import solve_on_mesh, solve_scene
 from .solvers.active_set import ContactStart
 from .solvers.dispatch import with_discretisation
@@ -209,12 +209,14 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
         ``"steps"``, ``"stall"`` (with ``tol``: the relative estimate has not fallen below
         its best for :data:`STALL_STEPS` steps) or ``"resolution"`` (the marking reached a
         triangle smaller than :data:`RESOLUTION` times the scene's length scale), the last
-        two with a ``stop_message``.
+        two with a ``stop_message``; so is ``"tol"`` where the goal's estimate is known to be
+        too small (the pressure goal at a kink of Gamma_C, :func:`_reached`).
 
     Warns
     -----
     ToleranceWarning
-        With ``tol``, when the run stops without reaching it.
+        With ``tol``, when the run stops without reaching it, or reaches it with an estimate
+        known to be too small.
     """
     start = time.perf_counter()   # as solve_scene's timings["total"]: checks and mesh too
     scene = with_discretisation(scene, order, multipliers)
@@ -237,8 +239,8 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
         indicators = _goal_indicators(record, solution, estimated, goal, window)
         history.append(record)
         # a dict with the record's stopped_by (and stop_message) once the loop ends
-        stop = ({"stopped_by": "tol"} if tol is not None and record["relative_estimate"] <= tol
-                else _stalled(history, tol))
+        stop = (_reached(scene, goal, window) if tol is not None
+                and record["relative_estimate"] <= tol else _stalled(history, tol))
         # MARK
         marked = None
         if stop is None and step < steps - 1:
@@ -259,6 +261,10 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
                               f"{record['relative_estimate']:.3g} is above tol = {tol:g}: "
                               + stop.get("stop_message", f"the {steps} steps are spent"),
                               ToleranceWarning, stacklevel=2)
+            elif tol is not None and "stop_message" in stop:
+                warnings.warn(f"adapt: the goal's relative estimate "
+                              f"{record['relative_estimate']:.3g} is below tol = {tol:g}, "
+                              f"but {stop['stop_message']}", ToleranceWarning, stacklevel=2)
         if on_step is not None:
             called = time.perf_counter()
             on_step(record, solution, estimated, marked)
@@ -276,7 +282,32 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
 
 class ToleranceWarning(UserWarning):
     """An adaptive run given a ``tol`` stopped without reaching it (its last record's
-    ``stopped_by`` is ``"steps"``, ``"stall"`` or ``"resolution"``)."""
+    ``stopped_by`` is ``"steps"``, ``"stall"`` or ``"resolution"``), or reached it with an
+    estimate known to be too small there (``"tol"`` with a ``stop_message``:
+    :func:`_reached`)."""
+
+
+# The pressure goal's effectivity on the wedge, whose pressure is log-singular at the kink of
+# Gamma_C: its estimate / the true error over the work-precision study's steps at orders 0-2
+# (README; docs/theory/estimator.md, "A kink of Gamma_C").
+KINK_EFFECTIVITY = (0.11, 0.65)
+
+
+def _reached(scene: Scene, goal: str, window: tuple[float, float] | None) -> dict:
+    """The stop of a run whose relative estimate is at most its ``tol``; with the pressure
+    goal on a Gamma_C (or a ``window`` of it) that has a kink, where the estimate is too
+    small by a constant (:data:`KINK_EFFECTIVITY`), with a ``stop_message`` that says so."""
+    kinks = [point for point, kind, _ in contact_junctions(scene) if kind == "kink"
+             and (window is None or window[0] <= point[0] <= window[1])]
+    if goal != "pressure" or not kinks:
+        return {"stopped_by": "tol"}
+    where = ", ".join(f"({x:.4g}, {y:.4g})" for x, y in kinks)
+    low, high = KINK_EFFECTIVITY
+    return {"stopped_by": "tol",
+            "stop_message": f"Gamma_C has a kink at {where}, where the pressure goal's "
+                            f"estimate is too small by a constant ({low:g}-{high:g} of the "
+                            f"true error on the wedge; docs/theory/estimator.md, 'A kink of "
+                            f"Gamma_C'): the pressure error may be several times tol"}
 
 
 def _stalled(history: list[dict], tol: float | None) -> dict | None:

@@ -187,11 +187,36 @@ def test_ngdual_adapt_that_misses_its_tol_says_why_with_exit_status_1(tmp_path, 
     assert run["history"][-1]["stopped_by"] == "resolution"
 
 
+def test_a_pressure_tolerance_reached_at_a_kink_of_gamma_c_warns_that_it_is_no_bound():
+    """On the wedge the pressure goal's estimate is 0.11-0.65 of the true error (its apex, a
+    kink of Gamma_C): a run that reaches its tol there says so, in its last record and as a
+    ToleranceWarning; the stress goal, and a window away from the kink, do not."""
+    wedge = load_scene("wedge")
+    with pytest.warns(ToleranceWarning, match=r"below tol = 0.3, but Gamma_C has a kink at "
+                                              r"\(0, 0\)"):
+        history = adapt(wedge, goal="pressure", tol=0.3)
+    assert history[-1]["stopped_by"] == "tol"
+    assert "the pressure error may be several times tol" in history[-1]["stop_message"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ToleranceWarning)
+        quiet = [adapt(wedge, goal="stress", tol=0.5),
+                 adapt(wedge, goal="pressure", tol=0.5, window=(0.05, 0.5))]
+    assert all(h[-1]["stopped_by"] == "tol" and "stop_message" not in h[-1] for h in quiet)
+
+
+def test_ngdual_adapt_prints_the_kink_caution_with_exit_status_0(tmp_path, capsys):
+    assert main(["adapt", "wedge", "--goal", "pressure", "--tol", "0.3",
+                 "--out", str(tmp_path)]) == 0
+    out, err = capsys.readouterr()
+    assert "(stopped by tol)" in out and "Gamma_C has a kink at (0, 0)" in out
+    assert "ToleranceWarning" not in err
+
+
 @pytest.mark.slow
 def test_the_wedge_apex_stops_a_tight_tolerance_run_instead_of_breaking_it():
-    """The pressure goal of order 1 on the wedge refines its apex down to Gamma_C edges of
-    1e-9, where the geometry's round-off split Gamma_C into more chains (a ValueError
-    before the loop stopped): it now stops when its marking reaches RESOLUTION, or stalls."""
+    """The pressure goal of order 1 on the wedge falls to a relative estimate of 7.8e-4 and
+    then marks the apex alone while its estimate rises, towards Gamma_C edges at the
+    geometry's round-off: it stops when its marking reaches RESOLUTION, or stalls."""
     with pytest.warns(ToleranceWarning):
         history = adapt(load_scene("wedge"), goal="pressure", tol=3e-4, order=1)
     assert history[-1]["stopped_by"] in ("resolution", "stall")

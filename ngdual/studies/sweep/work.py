@@ -277,8 +277,9 @@ def _loop_times(scene: str, overrides, loop: dict, unknowns: list[int],
 
 @contextlib.contextmanager
 def _tolerance_kept_quiet():
-    """A run that stops short of its tol says so in its last record (``stopped_by``); a
-    worker does not print it as well (:class:`ngdual.afem.ToleranceWarning`)."""
+    """A run that stops short of its tol, or reaches it with an estimate known to be too
+    small, says so in its last record (``stopped_by``, ``stop_message``); a worker does not
+    print it as well (:class:`ngdual.afem.ToleranceWarning`)."""
     from ...afem import ToleranceWarning
 
     with warnings.catch_warnings():
