@@ -115,7 +115,9 @@ def cmd_adapt(args) -> int:
     record; with --strict the run stops at the first step that has one, writing nothing
     for that step (history.json then holds the steps before it, if any). A --tol that the
     run does not reach (it stops by its steps, stalls or reaches the smallest triangle it
-    refines) is exit status 1, with the reason."""
+    refines) is exit status 1, with the reason; one reached where the goal's estimate is
+    known to be too small (the pressure goal at a kink of Gamma_C) is 0, with that caution
+    below the last step."""
     from ..afem import ToleranceWarning
 
     with warnings.catch_warnings():  # the reference solves' checks are not the run's
