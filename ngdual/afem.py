@@ -39,7 +39,7 @@ from .estimator import ASYMMETRY_NORMS, Estimate, estimate
 from .geometry import length_scale
 from .goal import GOALS, goal_estimate
 from .marking import STRATEGIES, mark
-from .mesh import build_mesh, mesh_arrays
+from .mesh import build_mesh, element_diameters, mesh_arrays
 from .quantities import norms
 from .rates import extrapolated_norms, total_error
 from .scene import Scene, SceneError, SceneTypeError, check_level, contact_junctions, ensure_valid
@@ -125,21 +125,28 @@ def refine_towards(scene: Scene, mesh: ngs.Mesh, point, times: int
     2^times). A grading that would refine a triangle smaller than :data:`RESOLUTION` times
     the scene's length scale is refused (ValueError), as the adaptive loop stops there."""
     coarse = BoundaryMeshes.for_scene(scene, mesh)
-    floor = RESOLUTION * length_scale(scene.geometry.curves())
     for done in range(times):
         # the nearest vertex, not every vertex within a fixed distance of point: the graded
         # mesh's vertices come closer to it than any fixed distance
         points, triangles = mesh_arrays(mesh)
         touching = (triangles == nearest_vertex(dict(enumerate(points)), point)).any(axis=1)
-        corners = points[triangles[touching]]
-        h = np.linalg.norm(corners - np.roll(corners, 1, axis=1), axis=2).max()
-        if h < floor:
+        small = _below_resolution(scene, element_diameters(mesh), touching)
+        if small:
             raise ValueError(f"times: refinement {done + 1} of {times} would refine triangles "
-                             f"of diameter {h:.2g} at {tuple(point)}, below the smallest "
-                             f"ngdual refines, {floor:.2g} ({RESOLUTION:g} of the scene's "
-                             f"length scale)")
+                             f"at {tuple(point)} {small}")
         mesh, coarse = refine_with_boundary(scene, mesh, coarse, touching)
     return mesh, coarse
+
+
+def _below_resolution(scene: Scene, h: np.ndarray, marked: np.ndarray) -> str | None:
+    """"of diameter ..., below the smallest the loop refines, ..." when a ``marked`` triangle's
+    diameter ``h`` is below :data:`RESOLUTION` times the scene's length scale (else None)."""
+    floor = RESOLUTION * length_scale(scene.geometry.curves())
+    small = marked & (h < floor)
+    if not small.any():
+        return None
+    return (f"of diameter {h[small].min():.2g}, below the smallest the loop refines, "
+            f"{floor:.2g} ({RESOLUTION:g} of the scene's length scale)")
 
 
 def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
@@ -331,17 +338,15 @@ def _unresolved(scene: Scene, solution: Solution, estimated: Estimate,
                 marked: np.ndarray) -> dict | None:
     """The stop of a loop whose marking reaches a triangle of diameter below
     :data:`RESOLUTION` times the scene's length scale (None otherwise)."""
-    floor = RESOLUTION * length_scale(scene.geometry.curves())
-    small = marked & (estimated.h < floor)
-    if not small.any():
+    small = _below_resolution(scene, estimated.h, marked)
+    if small is None:
         return None
     points, triangles = mesh_arrays(solution.problem.fes.mesh)
-    where = points[triangles[np.flatnonzero(small)[0]]].mean(axis=0)
+    smallest = np.flatnonzero(marked)[np.argmin(estimated.h[marked])]
+    where = points[triangles[smallest]].mean(axis=0)
     return {"stopped_by": "resolution",
-            "stop_message": f"the marking reaches triangles of diameter "
-                            f"{estimated.h[small].min():.2g} near ({where[0]:.4g}, "
-                            f"{where[1]:.4g}), below the smallest the loop refines, "
-                            f"{floor:.2g} ({RESOLUTION:g} of the scene's length scale)"}
+            "stop_message": f"the marking reaches triangles near ({where[0]:.4g}, "
+                            f"{where[1]:.4g}) {small}"}
 
 
 def _warm_start(solution: Solution) -> ContactStart | None:

@@ -122,7 +122,7 @@ def cmd_adapt(args) -> int:
 
     with warnings.catch_warnings():  # the reference solves' checks are not the run's
         warnings.simplefilter("ignore", PhysicsWarning)
-        warnings.simplefilter("ignore", ToleranceWarning)   # said below, with exit status 1
+        warnings.simplefilter("ignore", ToleranceWarning)   # said below (stop_message)
         return _adapt(args)
 
 
