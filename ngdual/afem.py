@@ -326,6 +326,14 @@ def _stalled(history: list[dict], tol: float | None) -> dict | None:
     best = int(np.argmin(estimates[:-STALL_STEPS]))
     if min(estimates[-STALL_STEPS:]) < estimates[best]:
         return None
+    if estimates[best] == float("inf"):   # the goal's size is 0 on every mesh so far
+        pressure = history[-1].get("goal") == "pressure"
+        size, why = (("||p_h||", "no contact where the goal measures the pressure; a window "
+                                 "inside the contact zone can be measured") if pressure
+                     else ("||sigma_h||", "no load"))
+        return {"stopped_by": "stall",
+                "stop_message": f"{size} is 0 at every step, so the estimate relative to it "
+                                f"is undefined and no tol can be reached ({why})"}
     since = ", ".join(f"{e:.3g}" for e in estimates[-STALL_STEPS:])
     return {"stopped_by": "stall",
             "stop_message": f"the estimate has not fallen below its best, "
@@ -364,9 +372,14 @@ def relative_estimate(record: dict) -> float:
     (``norms["sigma_X"]``), the leading part of the total error (3.124) that (4.50) bounds.
     ``"pressure"``: the estimate of ||p - p_h||_{L2(Gamma_C)} over ||p_h||_{L2(Gamma_C)}
     (:func:`ngdual.goal.goal_estimate`).
+    A zero size gives infinity (no tol is reached: :func:`_stalled` says why), unless the
+    estimate is zero too (a solution that is zero everywhere the goal measures, and
+    estimated to be exact there).
     """
-    size = record["goal_size"]
-    return record["goal_estimate"] / size if size > 0 else float("inf")
+    size, total = record["goal_size"], record["goal_estimate"]
+    if size > 0:
+        return total / size
+    return 0.0 if total == 0 else float("inf")
 
 
 def _goal_indicators(record: dict, solution: Solution, estimated: Estimate,

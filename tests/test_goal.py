@@ -159,6 +159,26 @@ def test_a_tolerance_run_whose_estimate_stops_falling_stops_as_stalled():
     assert afem._stalled(history(0.1, 0.05, 0.06, 0.07, 0.05), None) is None
 
 
+def test_a_tolerance_run_with_nothing_to_measure_says_so():
+    """A goal whose size is 0 (no contact pressure in the window) has no relative estimate:
+    inf, and the stall names the cause instead of a best of inf; a zero estimate of a zero
+    solution is 0 (reached)."""
+    def record(estimate, size, goal="pressure"):
+        return {"goal": goal, "goal_estimate": estimate, "goal_size": size}
+
+    assert afem.relative_estimate(record(75.2, 0.0)) == float("inf")
+    assert afem.relative_estimate(record(0.0, 0.0)) == 0.0
+    assert afem.relative_estimate(record(1.0, 4.0)) == 0.25
+    history = [{**record(e, 0.0), "relative_estimate": float("inf")} for e in (75, 60, 26, 12)]
+    stop = afem._stalled(history, 0.05)
+    assert stop["stopped_by"] == "stall"
+    assert stop["stop_message"].startswith("||p_h|| is 0 at every step")
+    assert "no contact where the goal measures the pressure" in stop["stop_message"]
+    assert "inf" not in stop["stop_message"]
+    stress = [{**r, "goal": "stress"} for r in history]
+    assert afem._stalled(stress, 0.05)["stop_message"].startswith("||sigma_h|| is 0")
+
+
 def test_a_marking_below_the_resolution_stops_the_loop_and_warns_of_the_tol(hertz, monkeypatch):
     """A marked triangle smaller than RESOLUTION x the length scale (here raised so that
     hertz-cylinder's first marks reach it) stops the loop before it refines, saying where;
