@@ -37,7 +37,7 @@ from . import budget
 from .boundary import BoundaryMeshes, nearest_vertex
 from .estimator import ASYMMETRY_NORMS, Estimate, estimate
 from .geometry import length_scale
-from .goal import GOALS, goal_estimate
+from .goal import GOALS, goal_estimate, singular_free_ends
 from .marking import STRATEGIES, mark
 from .mesh import build_mesh, element_diameters, mesh_arrays
 from .quantities import norms
@@ -248,6 +248,9 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
         # a dict with the record's stopped_by (and stop_message) once the loop ends
         stop = (_reached(scene, goal, window) if tol is not None
                 and record["relative_estimate"] <= tol else _stalled(history, tol))
+        if stop is not None and stop["stopped_by"] == "stall" and goal == "pressure":
+            ends = singular_free_ends(solution, window)
+            stop = _stalled(history, tol, _not_in_l2(ends)) if len(ends) else stop
         # MARK
         marked = None
         if stop is None and step < steps - 1:
@@ -317,9 +320,11 @@ def _reached(scene: Scene, goal: str, window: tuple[float, float] | None) -> dic
                             f"Gamma_C'): the pressure error may be several times tol"}
 
 
-def _stalled(history: list[dict], tol: float | None) -> dict | None:
+def _stalled(history: list[dict], tol: float | None,
+             reason: str = "refining the marked triangles does not reduce it") -> dict | None:
     """The stop of a tolerance run whose relative estimate has not fallen below its best
-    for :data:`STALL_STEPS` steps (None while it falls, and without ``tol``)."""
+    for :data:`STALL_STEPS` steps (None while it falls, and without ``tol``), with the
+    ``reason`` its message gives."""
     if tol is None or len(history) <= STALL_STEPS:
         return None
     estimates = [r["relative_estimate"] for r in history]
@@ -338,8 +343,17 @@ def _stalled(history: list[dict], tol: float | None) -> dict | None:
     return {"stopped_by": "stall",
             "stop_message": f"the estimate has not fallen below its best, "
                             f"{estimates[best]:.3g} at step {best}, for {STALL_STEPS} "
-                            f"steps ({since}): refining the marked triangles does not reduce "
-                            f"it"}
+                            f"steps ({since}): {reason}"}
+
+
+def _not_in_l2(ends: np.ndarray) -> str:
+    """Why the pressure goal stalls where p is not in L2 at ``ends`` of Gamma_C
+    (:func:`ngdual.goal.singular_free_ends`)."""
+    where = ", ".join(f"({x:.4g}, {y:.4g})" for x, y in ends)
+    return (f"the contact zone reaches Gamma_C's end at {where}, where a free side begins, "
+            f"and the pressure is singular there (like d^(-1/2) at a flat punch's edge, d the "
+            f"distance to the end), not in L2: it has no L2 error to reach, a window away "
+            f"from the end has one (window=(lo, hi), ngdual adapt --window)")
 
 
 def _unresolved(scene: Scene, solution: Solution, estimated: Estimate,

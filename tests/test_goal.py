@@ -20,10 +20,10 @@ from ngdual.afem import (
 )
 from ngdual.cli import main
 from ngdual.estimator import estimate
-from ngdual.goal import goal_estimate
+from ngdual.goal import goal_estimate, singular_free_ends
 from ngdual.mesh import build_mesh
 from ngdual.scene import SceneError, SceneTypeError, load_scene
-from ngdual.solvers import solve_on_mesh
+from ngdual.solvers import solve_on_mesh, solve_scene
 from ngdual.verification.benchmark import center_coordinate, exact_solution
 from ngdual.verification.overkill import nodes_to_samples, pressure_error, solution_samples
 from ngdual.verification.overkill import pressure_errors as sample_pressure_errors
@@ -177,6 +177,39 @@ def test_a_tolerance_run_with_nothing_to_measure_says_so():
     assert "inf" not in stop["stop_message"]
     stress = [{**r, "goal": "stress"} for r in history]
     assert afem._stalled(stress, 0.05)["stop_message"].startswith("||sigma_h|| is 0")
+
+
+def test_the_pressure_is_not_in_l2_where_contact_reaches_a_straight_free_end():
+    """The flat punch's edges (Gamma_C runs straight on into the free bottom, contact to the
+    end: p ~ d^(-1/2)) are found, at order 0 and 1; not inside its core's window, not where
+    the contact zone ends inside Gamma_C (Hertz), not at a block's 90-degree corners on the
+    plane, which the contact reaches but where the pressure is bounded."""
+    for order in ("0", "1"):
+        punch = solve_scene(load_scene("flat-punch", [f"discretisation.order={order}"]), 1)
+        assert np.allclose(sorted(singular_free_ends(punch)[:, 0]), [-0.25, 0.25])
+        assert not len(singular_free_ends(punch, (-0.125, 0.125)))
+        assert np.allclose(singular_free_ends(punch, (0.0, 1.0)), [[0.25, 0.0]])
+    assert not len(singular_free_ends(solve_scene(load_scene("hertz-cylinder"), 1)))
+    block = load_scene("flat-punch", ['boundary.contact=["free_left","punch","free_right"]',
+                                      'boundary.neumann=["left","right"]'])
+    solution = solve_scene(block, 1)
+    assert np.all(solution.part("lam_n") <= 1e-12)   # in contact to both corners
+    assert not len(singular_free_ends(solution))
+
+
+def test_a_pressure_tolerance_on_a_pressure_not_in_l2_stalls_and_says_why():
+    """The flat punch's pressure goal on all of Gamma_C cannot fall (0.090-0.097 over four
+    solves): the stall names the punch edges and the window; the core's window reaches tol."""
+    punch = load_scene("flat-punch")
+    with pytest.warns(ToleranceWarning, match=r"reaches Gamma_C's end at \(-0.25, 0\), "
+                                              r"\(0.25, 0\).* not in L2"):
+        history = adapt(punch, goal="pressure", tol=0.02)
+    assert history[-1]["stopped_by"] == "stall"
+    assert "window" in history[-1]["stop_message"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ToleranceWarning)
+        core = adapt(punch, goal="pressure", tol=0.02, window=(-0.125, 0.125))
+    assert core[-1]["stopped_by"] == "tol"
 
 
 def test_a_marking_below_the_resolution_stops_the_loop_and_warns_of_the_tol(hertz, monkeypatch):
