@@ -217,7 +217,9 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
         its best for :data:`STALL_STEPS` steps) or ``"resolution"`` (the marking reached a
         triangle smaller than :data:`RESOLUTION` times the scene's length scale), the last
         two with a ``stop_message``; so is ``"tol"`` where the goal's estimate is known to be
-        too small (the pressure goal at a kink of Gamma_C, :func:`_reached`).
+        too small (the pressure goal at a kink of Gamma_C, :func:`_reached`), and
+        ``"steps"`` where it measures no finite error (the pressure goal where p is not in
+        L2, :func:`ngdual.goal.singular_free_ends`).
 
     Warns
     -----
@@ -265,6 +267,9 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
         last = marked is None
         if last:
             stop = stop or {"stopped_by": "steps"}
+            if goal == "pressure" and stop["stopped_by"] == "steps":
+                ends = singular_free_ends(solution, window)
+                stop = {**stop, "stop_message": _not_in_l2(ends)} if len(ends) else stop
             record.update(stop)
             if tol is not None and stop["stopped_by"] != "tol":
                 warnings.warn(f"adapt: the goal's relative estimate "
@@ -352,8 +357,9 @@ def _not_in_l2(ends: np.ndarray) -> str:
     where = ", ".join(f"({x:.4g}, {y:.4g})" for x, y in ends)
     return (f"the contact zone reaches Gamma_C's end at {where}, where a free side begins, "
             f"and the pressure is singular there (like d^(-1/2) at a flat punch's edge, d the "
-            f"distance to the end), not in L2: it has no L2 error to reach, a window away "
-            f"from the end has one (window=(lo, hi), ngdual adapt --window)")
+            f"distance to the end), not in L2: its L2 error on Gamma_C is infinite and the "
+            f"goal's estimate measures none; a window away from the end has a finite one "
+            f"(window=(lo, hi), ngdual adapt --window)")
 
 
 def _unresolved(scene: Scene, solution: Solution, estimated: Estimate,
