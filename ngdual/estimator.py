@@ -55,7 +55,7 @@ of the manufactured contact case at k = 2, docs/theory/estimator.md).
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import ngsolve as ngs
 import numpy as np
@@ -92,12 +92,16 @@ class Estimate:
         Wall time of the estimation.
     asymmetry : str
         The norm of as(sigma_h) used ("hdiv" or "l2").
+    edges : BoundaryEdges
+        The boundary edges of the mesh and their elements, with the estimate's rule (for
+        the pressure goal, :func:`ngdual.goal.goal_estimate`, on the same mesh).
     """
 
     terms: dict[str, np.ndarray]
     h: np.ndarray
     seconds: float = 0.0
     asymmetry: str = "l2"
+    edges: BoundaryEdges | None = field(default=None, repr=False)
 
     @property
     def eta_sigma(self) -> np.ndarray:
@@ -336,7 +340,7 @@ def estimate(solution: Solution, asymmetry: str = "l2") -> Estimate:
                  "u_contact", "friction", "neumann"):
         values = on_edges.get(name)
         terms[name] = edges.to_elements(values) if values is not None else np.zeros(mesh.ne)
-    return Estimate(terms, h, time.perf_counter() - start, asymmetry)
+    return Estimate(terms, h, time.perf_counter() - start, asymmetry, edges)
 
 
 def neighbour_ratio(coarse) -> float:

@@ -183,7 +183,7 @@ def goal_estimate(solution: Solution, estimated: Estimate,
     htilde = gamma_c.coarse.edge_lengths()[gamma_c.htilde_edge]
     inside = _in_window(gamma_c.midpoints[:, 0], window)
 
-    edges = BoundaryEdges(mesh, spaces.order)
+    edges = estimated.edges or BoundaryEdges(mesh, spaces.order)
     on_gamma_c = [edges.dof_of_edge[frozenset(map(int, p))] for p in gamma_c.vertices]
     element = edges.element[on_gamma_c]
 
