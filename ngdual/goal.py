@@ -284,7 +284,8 @@ def singular_free_ends(solution: Solution,
     the boundary running straight on: p ~ d^(-1/2)), below 1/2 beyond. So p is not in
     L2(Gamma_C) where the boundary runs straight on or turns re-entrant (turning angle at
     most KINK_ANGLE), and ||p - p_h||_{L2(Gamma_C)} has no finite value for the pressure
-    goal to reach. Contact at an end: lambda_n = g - u_n at its vertex at most
+    goal to reach (with friction the exponent moves off 1/2 with the friction coefficient,
+    to either side; the test is the frictionless one). Contact at an end: lambda_n = g - u_n at its vertex at most
     CONTACT_SHARE of the larger of max |lambda_n| and the displacement scale
     (:func:`ngdual.checks.displacement_scale`; a Gamma_C in contact everywhere has
     lambda_n = 0 to round-off)."""
