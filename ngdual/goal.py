@@ -183,7 +183,8 @@ def goal_estimate(solution: Solution, estimated: Estimate,
     htilde = gamma_c.coarse.edge_lengths()[gamma_c.htilde_edge]
     inside = _in_window(gamma_c.midpoints[:, 0], window)
 
-    edges = estimated.edges or BoundaryEdges(mesh, spaces.order)
+    edges = estimated.edges if estimated.edges is not None else BoundaryEdges(mesh,
+                                                                              spaces.order)
     on_gamma_c = [edges.dof_of_edge[frozenset(map(int, p))] for p in gamma_c.vertices]
     element = edges.element[on_gamma_c]
 
@@ -285,9 +286,9 @@ def singular_free_ends(solution: Solution,
     L2(Gamma_C) where the boundary runs straight on or turns re-entrant (turning angle at
     most KINK_ANGLE), and ||p - p_h||_{L2(Gamma_C)} has no finite value for the pressure
     goal to reach (with friction the exponent moves off 1/2 with the friction coefficient,
-    to either side; the test is the frictionless one). Contact at an end: lambda_n = g - u_n at its vertex at most
-    CONTACT_SHARE of the larger of max |lambda_n| and the displacement scale
-    (:func:`ngdual.checks.displacement_scale`; a Gamma_C in contact everywhere has
+    to either side; the test is the frictionless one). Contact at an end: lambda_n = g - u_n
+    at its vertex at most CONTACT_SHARE of the larger of max |lambda_n| and the displacement
+    scale (:func:`ngdual.checks.displacement_scale`; a Gamma_C in contact everywhere has
     lambda_n = 0 to round-off)."""
     pb = solution.problem
     ends = np.array([point for point, kind, angle in contact_junctions(pb.scene)
