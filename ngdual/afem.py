@@ -250,9 +250,6 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
         # a dict with the record's stopped_by (and stop_message) once the loop ends
         stop = (_reached(scene, goal, window) if tol is not None
                 and record["relative_estimate"] <= tol else _stalled(history, tol))
-        if stop is not None and stop["stopped_by"] == "stall" and goal == "pressure":
-            ends = singular_free_ends(solution, window)
-            stop = _stalled(history, tol, _not_in_l2(ends)) if len(ends) else stop
         # MARK
         marked = None
         if stop is None and step < steps - 1:
@@ -267,9 +264,12 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
         last = marked is None
         if last:
             stop = stop or {"stopped_by": "steps"}
-            if goal == "pressure" and stop["stopped_by"] == "steps":
-                ends = singular_free_ends(solution, window)
-                stop = {**stop, "stop_message": _not_in_l2(ends)} if len(ends) else stop
+            if goal == "pressure" and stop["stopped_by"] in ("stall", "steps"):
+                ends = singular_free_ends(solution, window)   # where p is not in L2
+                if len(ends):
+                    reason = _not_in_l2(ends)
+                    stop = (_stalled(history, tol, reason) if stop["stopped_by"] == "stall"
+                            else {**stop, "stop_message": reason})
             record.update(stop)
             if tol is not None and stop["stopped_by"] != "tol":
                 warnings.warn(f"adapt: the goal's relative estimate "
@@ -316,7 +316,7 @@ def _reached(scene: Scene, goal: str, window: tuple[float, float] | None) -> dic
              and (window is None or window[0] <= point[0] <= window[1])]
     if goal != "pressure" or not kinks:
         return {"stopped_by": "tol"}
-    where = ", ".join(f"({x:.4g}, {y:.4g})" for x, y in kinks)
+    where = _points(kinks)
     low, high = KINK_EFFECTIVITY
     return {"stopped_by": "tol",
             "stop_message": f"Gamma_C has a kink at {where}, where the pressure goal's "
@@ -354,12 +354,16 @@ def _stalled(history: list[dict], tol: float | None,
 def _not_in_l2(ends: np.ndarray) -> str:
     """Why the pressure goal stalls where p is not in L2 at ``ends`` of Gamma_C
     (:func:`ngdual.goal.singular_free_ends`)."""
-    where = ", ".join(f"({x:.4g}, {y:.4g})" for x, y in ends)
-    return (f"the contact zone reaches Gamma_C's end at {where}, where a free side begins, "
+    return (f"the contact zone reaches Gamma_C's end at {_points(ends)}, where a free side begins, "
             f"and the pressure is singular there (like d^(-1/2) at a flat punch's edge, d the "
             f"distance to the end), not in L2: its L2 error on Gamma_C is infinite and the "
             f"goal's estimate measures none; a window away from the end has a finite one "
             f"(window=(lo, hi), ngdual adapt --window)")
+
+
+def _points(points) -> str:
+    """``points`` (x, y) for a stop message: "(x1, y1), (x2, y2)"."""
+    return ", ".join(f"({x:.4g}, {y:.4g})" for x, y in points)
 
 
 def _unresolved(scene: Scene, solution: Solution, estimated: Estimate,
@@ -373,8 +377,7 @@ def _unresolved(scene: Scene, solution: Solution, estimated: Estimate,
     smallest = np.flatnonzero(marked)[np.argmin(estimated.h[marked])]
     where = points[triangles[smallest]].mean(axis=0)
     return {"stopped_by": "resolution",
-            "stop_message": f"the marking reaches triangles near ({where[0]:.4g}, "
-                            f"{where[1]:.4g}) {small}"}
+            "stop_message": f"the marking reaches triangles near {_points([where])} {small}"}
 
 
 def _warm_start(solution: Solution) -> ContactStart | None:
