@@ -214,18 +214,21 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
         :func:`~ngdual.solvers.solve_scene` times one solve, from the checks of the
         arguments on, meshing included). The last record's ``stopped_by`` is ``"tol"``,
         ``"steps"``, ``"stall"`` (with ``tol``: the relative estimate has not fallen below
-        its best for :data:`STALL_STEPS` steps) or ``"resolution"`` (the marking reached a
-        triangle smaller than :data:`RESOLUTION` times the scene's length scale), the last
-        two with a ``stop_message``; so is ``"tol"`` where the goal's estimate is known to be
-        too small (the pressure goal at a kink of Gamma_C, :func:`_reached`), and
-        ``"steps"`` where it measures no finite error (the pressure goal where p is not in
-        L2, :func:`ngdual.goal.singular_free_ends`).
+        its best for :data:`STALL_STEPS` steps), ``"resolution"`` (the marking reached a
+        triangle smaller than :data:`RESOLUTION` times the scene's length scale) or
+        ``"singular"`` (with ``tol`` and the pressure goal: the relative estimate is at most
+        ``tol``, but p is not in L2 where the contact zone reaches an end of Gamma_C, so it
+        measures no finite error; :func:`ngdual.goal.singular_free_ends`), the last three
+        with a ``stop_message``; so is ``"tol"`` where the goal's estimate is known to be
+        too small (the pressure goal at a kink of Gamma_C, :func:`_reached`), and the
+        pressure goal's ``"steps"`` where p is not in L2 (the message of
+        ``"resolution"`` then says so too).
 
     Warns
     -----
     ToleranceWarning
-        With ``tol``, when the run stops without reaching it, or reaches it with an estimate
-        known to be too small.
+        With ``tol``, when the run stops without reaching it (``"singular"`` included), or
+        reaches it with an estimate known to be too small.
     """
     start = time.perf_counter()   # as solve_scene's timings["total"]: checks and mesh too
     scene = with_discretisation(scene, order, multipliers)
@@ -248,7 +251,7 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
         indicators = _goal_indicators(record, solution, estimated, goal, window)
         history.append(record)
         # a dict with the record's stopped_by (and stop_message) once the loop ends
-        stop = (_reached(scene, goal, window) if tol is not None
+        stop = (_reached(scene, solution, goal, window) if tol is not None
                 and record["relative_estimate"] <= tol else _stalled(history, tol))
         # MARK
         marked = None
@@ -264,14 +267,19 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
         last = marked is None
         if last:
             stop = stop or {"stopped_by": "steps"}
-            if goal == "pressure" and stop["stopped_by"] in ("stall", "steps"):
+            if goal == "pressure" and stop["stopped_by"] in ("stall", "steps", "resolution"):
                 ends = singular_free_ends(solution, window)   # where p is not in L2
                 if len(ends):
                     reason = _not_in_l2(ends)
                     stop = (_stalled(history, tol, reason) if stop["stopped_by"] == "stall"
-                            else {**stop, "stop_message": reason})
+                            else {**stop, "stop_message": ": ".join(
+                                filter(None, (stop.get("stop_message"), reason)))})
             record.update(stop)
-            if tol is not None and stop["stopped_by"] != "tol":
+            if tol is not None and stop["stopped_by"] == "singular":
+                warnings.warn(f"adapt: the goal's relative estimate "
+                              f"{record['relative_estimate']:.3g} is below tol = {tol:g}, but "
+                              f"{stop['stop_message']}", ToleranceWarning, stacklevel=2)
+            elif tol is not None and stop["stopped_by"] != "tol":
                 warnings.warn(f"adapt: the goal's relative estimate "
                               f"{record['relative_estimate']:.3g} is above tol = {tol:g}: "
                               + stop.get("stop_message", f"the {steps} steps are spent"),
@@ -297,7 +305,8 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
 
 class ToleranceWarning(UserWarning):
     """An adaptive run given a ``tol`` stopped without reaching it (its last record's
-    ``stopped_by`` is ``"steps"``, ``"stall"`` or ``"resolution"``), or reached it with an
+    ``stopped_by`` is ``"steps"``, ``"stall"``, ``"resolution"`` or ``"singular"``: an
+    estimate below it that measures no finite error), or reached it with an
     estimate known to be too small there (``"tol"`` with a ``stop_message``:
     :func:`_reached`)."""
 
@@ -308,13 +317,24 @@ class ToleranceWarning(UserWarning):
 KINK_EFFECTIVITY = (0.11, 0.65)
 
 
-def _reached(scene: Scene, goal: str, window: tuple[float, float] | None) -> dict:
-    """The stop of a run whose relative estimate is at most its ``tol``; with the pressure
-    goal on a Gamma_C (or a ``window`` of it) that has a kink, where the estimate is too
-    small by a constant (:data:`KINK_EFFECTIVITY`), with a ``stop_message`` that says so."""
+def _reached(scene: Scene, solution: Solution, goal: str,
+             window: tuple[float, float] | None) -> dict:
+    """The stop of a run whose relative estimate is at most its ``tol``.
+
+    With the pressure goal: ``"singular"`` where the contact zone of ``solution`` reaches an
+    end of Gamma_C (in ``window``) at which p is not in L2
+    (:func:`ngdual.goal.singular_free_ends`): the goal's error is infinite, the estimate
+    below tol measures none, and no tol is reached; ``"tol"`` with a ``stop_message`` on a
+    Gamma_C (or a ``window`` of it) that has a kink, where the estimate is too small by a
+    constant (:data:`KINK_EFFECTIVITY`). Else ``"tol"``."""
+    if goal != "pressure":
+        return {"stopped_by": "tol"}
+    ends = singular_free_ends(solution, window)
+    if len(ends):
+        return {"stopped_by": "singular", "stop_message": _not_in_l2(ends)}
     kinks = [point for point, kind, _ in contact_junctions(scene) if kind == "kink"
              and (window is None or window[0] <= point[0] <= window[1])]
-    if goal != "pressure" or not kinks:
+    if not kinks:
         return {"stopped_by": "tol"}
     where = _points(kinks)
     low, high = KINK_EFFECTIVITY

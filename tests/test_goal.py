@@ -217,6 +217,49 @@ def test_a_pressure_tolerance_on_a_pressure_not_in_l2_stalls_and_says_why():
     assert "its L2 error on Gamma_C is infinite" in steps[-1]["stop_message"]
 
 
+def test_a_pressure_tolerance_below_an_estimate_that_measures_no_error_is_not_reached():
+    """The flat punch's pressure estimate on all of Gamma_C is 0.090 on the first mesh,
+    below a tol of 0.1, but its error is infinite (p ~ d^(-1/2) at the punch edges): the run
+    stops there as "singular", not "tol", and warns; with the core's window the same tol is
+    reached, quietly."""
+    punch = load_scene("flat-punch")
+    with pytest.warns(ToleranceWarning, match=r"0.0897 is below tol = 0.1, but the contact "
+                                              r"zone reaches Gamma_C's end at \(-0.25, 0\)"):
+        history = adapt(punch, goal="pressure", tol=0.1)
+    assert len(history) == 1 and history[0]["relative_estimate"] <= 0.1
+    assert history[0]["stopped_by"] == "singular"
+    assert "its L2 error on Gamma_C is infinite" in history[0]["stop_message"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ToleranceWarning)
+        core = adapt(punch, goal="pressure", tol=0.1, window=(-0.125, 0.125))
+    assert core[-1]["stopped_by"] == "tol" and "stop_message" not in core[-1]
+
+
+def test_ngdual_adapt_below_its_tol_on_a_pressure_not_in_l2_exits_with_status_1(tmp_path,
+                                                                               capsys):
+    assert main(["adapt", "flat-punch", "--goal", "pressure", "--tol", "0.1",
+                 "--out", str(tmp_path)]) == 1
+    out, err = capsys.readouterr()
+    assert "(stopped by singular)" in out and "not in L2" in out
+    assert ("not converged: --tol 0.1 not reached, the goal's relative estimate 0.0897 is "
+            "below it but measures no finite error" in err)
+    assert "ToleranceWarning" not in err
+
+
+def test_a_resolution_stop_where_p_is_not_in_l2_says_why(monkeypatch):
+    """A pressure-goal run that the resolution stops at a punch edge says, after where the
+    marking reached, that p is not in L2 there (at order k >= 1 the estimate creeps down
+    instead of stalling, and this is how such a run ends)."""
+    monkeypatch.setattr(afem, "RESOLUTION", 0.02)   # 0.16 of the 8-wide block
+    with pytest.warns(ToleranceWarning, match="above tol = 0.02: the marking reaches"):
+        history = adapt(load_scene("flat-punch"), goal="pressure", tol=0.02)
+    assert history[-1]["stopped_by"] == "resolution"
+    message = history[-1]["stop_message"]
+    assert ("below the smallest the loop refines, 0.16 (0.02 of the scene's length scale): "
+            "the contact zone reaches" in message)
+    assert "not in L2" in message
+
+
 def test_a_marking_below_the_resolution_stops_the_loop_and_warns_of_the_tol(hertz, monkeypatch):
     """A marked triangle smaller than RESOLUTION x the length scale (here raised so that
     hertz-cylinder's first marks reach it) stops the loop before it refines, saying where;

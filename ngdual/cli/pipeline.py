@@ -218,8 +218,10 @@ def _adapt(args) -> int:
           + (", solution_stepNN.vtu)" if args.vtk else ")"))
     last = run["history"][-1]
     if args.tol is not None and last["stopped_by"] != "tol":
-        print(f"ngdual: not converged: --tol {args.tol:g} not reached, the goal's relative "
-              f"estimate is {last['relative_estimate']:.3g} (stopped by "
+        estimate = (f"the goal's relative estimate {last['relative_estimate']:.3g} is below it "
+                    f"but measures no finite error" if last["stopped_by"] == "singular" else
+                    f"the goal's relative estimate is {last['relative_estimate']:.3g}")
+        print(f"ngdual: not converged: --tol {args.tol:g} not reached, {estimate} (stopped by "
               f"{last['stopped_by']})", file=sys.stderr)
         return EXIT_NOT_CONVERGED
     return 0 if all(r["converged"] for r in run["history"]) else EXIT_NOT_CONVERGED
