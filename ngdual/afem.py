@@ -35,6 +35,7 @@ import numpy as np
 
 from . import budget
 from .boundary import BoundaryMeshes, nearest_vertex
+from .checks import thesis_ends_outside_l2
 from .estimator import ASYMMETRY_NORMS, Estimate, estimate
 from .geometry import length_scale
 from .goal import GOALS, goal_estimate, singular_free_ends
@@ -267,13 +268,12 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
         last = marked is None
         if last:
             stop = stop or {"stopped_by": "steps"}
-            if goal == "pressure" and stop["stopped_by"] in ("stall", "steps", "resolution"):
-                ends = singular_free_ends(solution, window)   # where p is not in L2
-                if len(ends):
-                    reason = _not_in_l2(ends)
-                    stop = (_stalled(history, tol, reason) if stop["stopped_by"] == "stall"
-                            else {**stop, "stop_message": ": ".join(
-                                filter(None, (stop.get("stop_message"), reason)))})
+            reason = None if stop["stopped_by"] in ("tol", "singular") else \
+                _infinite_error(solution, goal, window)
+            if reason:
+                stop = (_stalled(history, tol, reason) if stop["stopped_by"] == "stall"
+                        else {**stop, "stop_message": ": ".join(
+                            filter(None, (stop.get("stop_message"), reason)))})
             record.update(stop)
             if tol is not None and stop["stopped_by"] == "singular":
                 warnings.warn(f"adapt: the goal's relative estimate "
@@ -319,19 +319,17 @@ KINK_EFFECTIVITY = (0.11, 0.65)
 
 def _reached(scene: Scene, solution: Solution, goal: str,
              window: tuple[float, float] | None) -> dict:
-    """The stop of a run whose relative estimate is at most its ``tol``.
-
-    With the pressure goal: ``"singular"`` where the contact zone of ``solution`` reaches an
-    end of Gamma_C (in ``window``) at which p is not in L2
-    (:func:`ngdual.goal.singular_free_ends`): the goal's error is infinite, the estimate
-    below tol measures none, and no tol is reached; ``"tol"`` with a ``stop_message`` on a
+    """The stop of a run whose relative estimate is at most its ``tol``: ``"singular"``
+    where the goal's error has no finite value (:func:`_infinite_error`), so that the
+    estimate below tol measures none and no tol is reached; with the pressure goal on a
     Gamma_C (or a ``window`` of it) that has a kink, where the estimate is too small by a
-    constant (:data:`KINK_EFFECTIVITY`). Else ``"tol"``."""
+    constant (:data:`KINK_EFFECTIVITY`), ``"tol"`` with a ``stop_message`` that says so;
+    else ``"tol"``."""
+    reason = _infinite_error(solution, goal, window)
+    if reason:
+        return {"stopped_by": "singular", "stop_message": reason}
     if goal != "pressure":
         return {"stopped_by": "tol"}
-    ends = singular_free_ends(solution, window)
-    if len(ends):
-        return {"stopped_by": "singular", "stop_message": _not_in_l2(ends)}
     kinks = [point for point, kind, _ in contact_junctions(scene) if kind == "kink"
              and (window is None or window[0] <= point[0] <= window[1])]
     if not kinks:
@@ -371,14 +369,41 @@ def _stalled(history: list[dict], tol: float | None,
                             f"steps ({since}): {reason}"}
 
 
+def _infinite_error(solution: Solution, goal: str,
+                    window: tuple[float, float] | None) -> str | None:
+    """Why the ``goal``'s error has no finite value on the solution's scene, None where it
+    has one: with the pressure goal, the contact zone reaches an end of Gamma_C where p is
+    not in L2 (:func:`ngdual.goal.singular_free_ends`); with either goal, the thesis' ends
+    leave sigma (and p) outside L2 at a clamped end of Gamma_C
+    (:func:`ngdual.checks.thesis_ends_outside_l2`; for the pressure goal an end in its
+    ``window``)."""
+    if goal == "pressure":
+        ends = singular_free_ends(solution, window)
+        if len(ends):
+            return _not_in_l2(ends)
+    clamped = thesis_ends_outside_l2(solution)
+    if goal == "pressure" and window is not None:
+        clamped = clamped[(window[0] <= clamped[:, 0]) & (clamped[:, 0] <= window[1])]
+    if not len(clamped):
+        return None
+    ends = "end" if len(clamped) == 1 else "ends"
+    return (f'contact.ends = "thesis" sets lambda = 0 at the clamped {ends} {_points(clamped)} '
+            f"of Gamma_C against g - u_D.n != 0 there, so sigma is not in L2 there: the "
+            f"goal's error is infinite and its estimate measures none; use contact.ends = "
+            f'"consistent"' + (f" or a window away from the {ends}" if goal == "pressure"
+                               else ""))
+
+
 def _not_in_l2(ends: np.ndarray) -> str:
     """Why the pressure goal stalls where p is not in L2 at ``ends`` of Gamma_C
     (:func:`ngdual.goal.singular_free_ends`)."""
-    return (f"the contact zone reaches Gamma_C's end at {_points(ends)}, where a free side begins, "
-            f"and the pressure is singular there (like d^(-1/2) at a flat punch's edge, d the "
-            f"distance to the end), not in L2: its L2 error on Gamma_C is infinite and the "
-            f"goal's estimate measures none; a window away from the end has a finite one "
-            f"(window=(lo, hi), ngdual adapt --window)")
+    one = len(ends) == 1
+    return (f"the contact zone reaches Gamma_C's {'end' if one else 'ends'} at {_points(ends)}, "
+            f"where a free side begins, and the pressure is singular there (like d^(-1/2) at a "
+            f"flat punch's edge, d the distance to the end), not in L2: its L2 error on "
+            f"Gamma_C is infinite and the goal's estimate measures none; a window away from "
+            f"the {'end' if one else 'ends'} has a finite one (window=(lo, hi), ngdual adapt "
+            f"--window)")
 
 
 def _points(points) -> str:

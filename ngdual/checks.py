@@ -374,6 +374,16 @@ def _inconsistent_thesis_ends(solution: Solution, clamped: list) -> list:
     return out
 
 
+def thesis_ends_outside_l2(solution: Solution) -> np.ndarray:
+    """The clamped ends of Gamma_C (points, (n, 2)) where ``contact.ends = "thesis"`` sets
+    lambda = 0 against g - u_D.n != 0, so that sigma is not in L2 there: those of the
+    solution's ``"thesis-ends"`` check (:func:`physics_checks`)."""
+    if not any(w.code == "thesis-ends" for w in solution.warnings):
+        return np.zeros((0, 2))
+    inconsistent = _inconsistent_thesis_ends(solution, _clamped_ends(solution))
+    return np.array([point for point, _ in inconsistent], dtype=float).reshape(-1, 2)
+
+
 def _thesis_ends_warning(inconsistent: list, scale: float) -> CheckWarning:
     point, gap = max(inconsistent, key=lambda item: abs(item[1]))
     return CheckWarning(

@@ -24,6 +24,7 @@ from ngdual.goal import goal_estimate, singular_free_ends
 from ngdual.mesh import build_mesh
 from ngdual.scene import SceneError, SceneTypeError, load_scene
 from ngdual.solvers import solve_on_mesh, solve_scene
+from ngdual.solvers.result import PhysicsWarning
 from ngdual.verification.benchmark import center_coordinate, exact_solution
 from ngdual.verification.overkill import nodes_to_samples, pressure_error, solution_samples
 from ngdual.verification.overkill import pressure_errors as sample_pressure_errors
@@ -202,7 +203,7 @@ def test_a_pressure_tolerance_on_a_pressure_not_in_l2_stalls_and_says_why():
     solves): the stall names the punch edges and the window, and a run without tol says so
     at its end; the core's window reaches tol, quietly."""
     punch = load_scene("flat-punch")
-    with pytest.warns(ToleranceWarning, match=r"reaches Gamma_C's end at \(-0.25, 0\), "
+    with pytest.warns(ToleranceWarning, match=r"reaches Gamma_C's ends at \(-0.25, 0\), "
                                               r"\(0.25, 0\).* not in L2"):
         history = adapt(punch, goal="pressure", tol=0.02)
     assert history[-1]["stopped_by"] == "stall"
@@ -224,7 +225,7 @@ def test_a_pressure_tolerance_below_an_estimate_that_measures_no_error_is_not_re
     reached, quietly."""
     punch = load_scene("flat-punch")
     with pytest.warns(ToleranceWarning, match=r"0.0897 is below tol = 0.1, but the contact "
-                                              r"zone reaches Gamma_C's end at \(-0.25, 0\)"):
+                                              r"zone reaches Gamma_C's ends at \(-0.25, 0\)"):
         history = adapt(punch, goal="pressure", tol=0.1)
     assert len(history) == 1 and history[0]["relative_estimate"] <= 0.1
     assert history[0]["stopped_by"] == "singular"
@@ -244,6 +245,34 @@ def test_ngdual_adapt_below_its_tol_on_a_pressure_not_in_l2_exits_with_status_1(
     assert ("not converged: --tol 0.1 not reached, the goal's relative estimate 0.0897 is "
             "below it but measures no finite error" in err)
     assert "ToleranceWarning" not in err
+
+
+def test_a_tolerance_where_the_thesis_ends_leave_sigma_outside_l2_is_not_reached():
+    """Example 3.46 with the thesis' ends (lambda = 0 at the clamped ends against g - u_D.n
+    = 0.01): sigma ~ 1/r is not in L2 there, so neither goal's error is finite. A stress
+    estimate below tol (0.25 at the second solve) stops as "singular" and warns; with
+    consistent ends the same tol is reached quietly, as is the pressure's in a window away
+    from the clamped ends (one that holds an end is "singular"); a run without tol says it
+    in its last record."""
+    thesis = load_scene("thesis-3.46-frictionless")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PhysicsWarning)
+        with pytest.warns(ToleranceWarning, match=r'is below tol = 0.3, but contact.ends = '
+                                                  r'"thesis" sets lambda = 0 at the clamped '
+                                                  r'ends \(-4, -1\), \(4, -1\)'):
+            history = adapt(thesis, goal="stress", tol=0.3)
+        assert history[-1]["stopped_by"] == "singular"
+        with pytest.warns(ToleranceWarning, match=r"clamped end \(4, -1\)"):
+            one_end = adapt(thesis, goal="pressure", tol=0.3, window=(0.0, 4.0))
+        assert one_end[-1]["stopped_by"] == "singular"
+        steps = adapt(thesis, steps=2)
+        assert "its estimate measures none" in steps[-1]["stop_message"]
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", ToleranceWarning)
+            quiet = [adapt(load_scene("thesis-3.46-frictionless", ["contact.ends=consistent"]),
+                           goal="stress", tol=0.3),
+                     adapt(thesis, goal="pressure", tol=0.3, window=(-2.0, 2.0))]
+    assert all(h[-1]["stopped_by"] == "tol" and "stop_message" not in h[-1] for h in quiet)
 
 
 def test_a_resolution_stop_where_p_is_not_in_l2_says_why(monkeypatch):
