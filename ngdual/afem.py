@@ -217,13 +217,14 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
         ``"steps"``, ``"stall"`` (with ``tol``: the relative estimate has not fallen below
         its best for :data:`STALL_STEPS` steps), ``"resolution"`` (the marking reached a
         triangle smaller than :data:`RESOLUTION` times the scene's length scale) or
-        ``"singular"`` (with ``tol`` and the pressure goal: the relative estimate is at most
-        ``tol``, but p is not in L2 where the contact zone reaches an end of Gamma_C, so it
-        measures no finite error; :func:`ngdual.goal.singular_free_ends`), the last three
-        with a ``stop_message``; so is ``"tol"`` where the goal's estimate is known to be
-        too small (the pressure goal at a kink of Gamma_C, :func:`_reached`), and the
-        pressure goal's ``"steps"`` where p is not in L2 (the message of
-        ``"resolution"`` then says so too).
+        ``"singular"`` (with ``tol``: the goal's error has no finite value, where p is not
+        in L2 at an end of Gamma_C that the contact zone reaches or the thesis' ends leave
+        sigma outside L2 (:func:`_infinite_error`), on a solve whose relative estimate is
+        at most ``tol``, which then measures no error, or on :data:`STALL_STEPS` successive
+        solves), the last three with a ``stop_message``; so is ``"tol"`` where the goal's
+        estimate is known to be too small (the pressure goal at a kink of Gamma_C,
+        :func:`_reached`), and ``"steps"`` where the goal's error is not finite (the
+        message of ``"resolution"`` then says so too).
 
     Warns
     -----
@@ -240,7 +241,7 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
     budget.check_scene(scene, level, "level", allow_large)
     mesh = build_mesh(scene.geometry, level)
     coarse = BoundaryMeshes.for_scene(scene, mesh)
-    history, warm = [], None
+    history, warm, unbounded = [], None, 0
     for step in range(steps):
         # SOLVE
         solution = solve_on_mesh(scene, mesh, coarse, start=warm)
@@ -251,9 +252,10 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
         record["solved_s"] = solved
         indicators = _goal_indicators(record, solution, estimated, goal, window)
         history.append(record)
+        infinite = _infinite_error(solution, goal, window)   # why the goal's error is not finite
+        unbounded = unbounded + 1 if infinite else 0         # on so many successive solves
         # a dict with the record's stopped_by (and stop_message) once the loop ends
-        stop = (_reached(scene, solution, goal, window) if tol is not None
-                and record["relative_estimate"] <= tol else _stalled(history, tol))
+        stop = _tolerance_stop(scene, history, tol, goal, window, infinite, unbounded)
         # MARK
         marked = None
         if stop is None and step < steps - 1:
@@ -268,20 +270,16 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
         last = marked is None
         if last:
             stop = stop or {"stopped_by": "steps"}
-            reason = None if stop["stopped_by"] in ("tol", "singular") else \
-                _infinite_error(solution, goal, window)
-            if reason:
-                stop = (_stalled(history, tol, reason) if stop["stopped_by"] == "stall"
-                        else {**stop, "stop_message": ": ".join(
-                            filter(None, (stop.get("stop_message"), reason)))})
+            if infinite and stop["stopped_by"] in ("steps", "resolution"):
+                stop = {**stop, "stop_message": ": ".join(
+                    filter(None, (stop.get("stop_message"), infinite)))}
             record.update(stop)
-            if tol is not None and stop["stopped_by"] == "singular":
+            if tol is not None and stop["stopped_by"] != "tol":
+                below = record["relative_estimate"] <= tol   # a "singular" stop
                 warnings.warn(f"adapt: the goal's relative estimate "
-                              f"{record['relative_estimate']:.3g} is below tol = {tol:g}, but "
-                              f"{stop['stop_message']}", ToleranceWarning, stacklevel=2)
-            elif tol is not None and stop["stopped_by"] != "tol":
-                warnings.warn(f"adapt: the goal's relative estimate "
-                              f"{record['relative_estimate']:.3g} is above tol = {tol:g}: "
+                              f"{record['relative_estimate']:.3g} is "
+                              + (f"below tol = {tol:g}, but " if below
+                                 else f"above tol = {tol:g}: ")
                               + stop.get("stop_message", f"the {steps} steps are spent"),
                               ToleranceWarning, stacklevel=2)
             elif tol is not None and "stop_message" in stop:
@@ -317,17 +315,31 @@ class ToleranceWarning(UserWarning):
 KINK_EFFECTIVITY = (0.11, 0.65)
 
 
-def _reached(scene: Scene, solution: Solution, goal: str,
-             window: tuple[float, float] | None) -> dict:
-    """The stop of a run whose relative estimate is at most its ``tol``: ``"singular"``
-    where the goal's error has no finite value (:func:`_infinite_error`), so that the
-    estimate below tol measures none and no tol is reached; with the pressure goal on a
-    Gamma_C (or a ``window`` of it) that has a kink, where the estimate is too small by a
-    constant (:data:`KINK_EFFECTIVITY`), ``"tol"`` with a ``stop_message`` that says so;
-    else ``"tol"``."""
-    reason = _infinite_error(solution, goal, window)
-    if reason:
-        return {"stopped_by": "singular", "stop_message": reason}
+def _tolerance_stop(scene: Scene, history: list[dict], tol: float | None, goal: str,
+                    window: tuple[float, float] | None, infinite: str | None,
+                    unbounded: int) -> dict | None:
+    """The stop of a tolerance run after the solve of ``history[-1]`` (None while it goes
+    on, and without ``tol``).
+
+    ``"singular"`` where the goal's error has no finite value (``infinite`` says why,
+    :func:`_infinite_error`) on this solve and its relative estimate is at most ``tol``
+    (the estimate measures no error, so no tol is reached), or on the last
+    :data:`STALL_STEPS` solves (``unbounded``; refining does not make it finite, while the
+    estimate may creep down for a dozen solves); ``"tol"`` at an estimate at most ``tol``
+    (:func:`_reached`); ``"stall"`` (:func:`_stalled`)."""
+    if tol is None:
+        return None
+    if infinite and (history[-1]["relative_estimate"] <= tol or unbounded >= STALL_STEPS):
+        return {"stopped_by": "singular", "stop_message": infinite}
+    if history[-1]["relative_estimate"] <= tol:
+        return _reached(scene, goal, window)
+    return _stalled(history, tol, infinite)
+
+
+def _reached(scene: Scene, goal: str, window: tuple[float, float] | None) -> dict:
+    """The stop of a run whose relative estimate is at most its ``tol``; with the pressure
+    goal on a Gamma_C (or a ``window`` of it) that has a kink, where the estimate is too
+    small by a constant (:data:`KINK_EFFECTIVITY`), with a ``stop_message`` that says so."""
     if goal != "pressure":
         return {"stopped_by": "tol"}
     kinks = [point for point, kind, _ in contact_junctions(scene) if kind == "kink"
@@ -343,11 +355,11 @@ def _reached(scene: Scene, solution: Solution, goal: str,
                             f"Gamma_C'): the pressure error may be several times tol"}
 
 
-def _stalled(history: list[dict], tol: float | None,
-             reason: str = "refining the marked triangles does not reduce it") -> dict | None:
+def _stalled(history: list[dict], tol: float | None, reason: str | None = None
+             ) -> dict | None:
     """The stop of a tolerance run whose relative estimate has not fallen below its best
     for :data:`STALL_STEPS` steps (None while it falls, and without ``tol``), with the
-    ``reason`` its message gives."""
+    ``reason`` its message gives (default: refining does not reduce it)."""
     if tol is None or len(history) <= STALL_STEPS:
         return None
     estimates = [r["relative_estimate"] for r in history]
@@ -366,7 +378,8 @@ def _stalled(history: list[dict], tol: float | None,
     return {"stopped_by": "stall",
             "stop_message": f"the estimate has not fallen below its best, "
                             f"{estimates[best]:.3g} at step {best}, for {STALL_STEPS} "
-                            f"steps ({since}): {reason}"}
+                            f"steps ({since}): "
+                            f"{reason or 'refining the marked triangles does not reduce it'}"}
 
 
 def _infinite_error(solution: Solution, goal: str,

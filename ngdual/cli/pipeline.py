@@ -219,7 +219,7 @@ def _adapt(args) -> int:
     last = run["history"][-1]
     if args.tol is not None and last["stopped_by"] != "tol":
         estimate = (f"the goal's relative estimate {last['relative_estimate']:.3g} is below it "
-                    f"but measures no finite error" if last["stopped_by"] == "singular" else
+                    f"but measures no finite error" if last["relative_estimate"] <= args.tol else
                     f"the goal's relative estimate is {last['relative_estimate']:.3g}")
         print(f"ngdual: not converged: --tol {args.tol:g} not reached, {estimate} (stopped by "
               f"{last['stopped_by']})", file=sys.stderr)
