@@ -272,6 +272,7 @@ def check_solutions(number: int, r: dict) -> None:
     elif number == 10:
         assert r["window"]["stopped_by"] == "tol" and r["window"]["core_share"] >= 0.5
         assert min(r["no_window_estimates"]) > 0.05                 # not in L2: no decay
+        assert r["no_window_stopped_by"] == "singular"
         assert all(o["stopped_by"] == "tol" for o in r["orders"].values()), r["orders"]
         assert r["orders"]["2"]["ndof"] < r["orders"]["0"]["ndof"]
         growth = r["growth"]
