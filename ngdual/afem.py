@@ -303,8 +303,8 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
 
 class ToleranceWarning(UserWarning):
     """An adaptive run given a ``tol`` stopped without reaching it (its last record's
-    ``stopped_by`` is ``"steps"``, ``"stall"``, ``"resolution"`` or ``"singular"``: an
-    estimate below it that measures no finite error), or reached it with an
+    ``stopped_by`` is ``"steps"``, ``"stall"``, ``"resolution"`` or ``"singular"``: the
+    goal's error is not finite, and an estimate below tol measures none), or reached it with an
     estimate known to be too small there (``"tol"`` with a ``stop_message``:
     :func:`_reached`)."""
 
@@ -408,7 +408,7 @@ def _infinite_error(solution: Solution, goal: str,
 
 
 def _not_in_l2(ends: np.ndarray) -> str:
-    """Why the pressure goal stalls where p is not in L2 at ``ends`` of Gamma_C
+    """Why the pressure goal's error is infinite where p is not in L2 at ``ends`` of Gamma_C
     (:func:`ngdual.goal.singular_free_ends`)."""
     one = len(ends) == 1
     return (f"the contact zone reaches Gamma_C's {'end' if one else 'ends'} at {_points(ends)}, "

@@ -114,8 +114,9 @@ def cmd_adapt(args) -> int:
     The failed physics checks of every step are printed below its line and kept in its
     record; with --strict the run stops at the first step that has one, writing nothing
     for that step (history.json then holds the steps before it, if any). A --tol that the
-    run does not reach (it stops by its steps, stalls or reaches the smallest triangle it
-    refines) is exit status 1, with the reason; one reached where the goal's estimate is
+    run does not reach (it stops by its steps, stalls, reaches the smallest triangle it
+    refines, or its goal's error is not finite: "singular", also below the tol) is exit
+    status 1, with the reason; one reached where the goal's estimate is
     known to be too small (the pressure goal at a kink of Gamma_C) is 0, with that caution
     below the last step."""
     from ..afem import ToleranceWarning
@@ -218,10 +219,10 @@ def _adapt(args) -> int:
           + (", solution_stepNN.vtu)" if args.vtk else ")"))
     last = run["history"][-1]
     if args.tol is not None and last["stopped_by"] != "tol":
-        estimate = (f"the goal's relative estimate {last['relative_estimate']:.3g} is below it "
+        measured = (f"the goal's relative estimate {last['relative_estimate']:.3g} is below it "
                     f"but measures no finite error" if last["relative_estimate"] <= args.tol else
                     f"the goal's relative estimate is {last['relative_estimate']:.3g}")
-        print(f"ngdual: not converged: --tol {args.tol:g} not reached, {estimate} (stopped by "
+        print(f"ngdual: not converged: --tol {args.tol:g} not reached, {measured} (stopped by "
               f"{last['stopped_by']})", file=sys.stderr)
         return EXIT_NOT_CONVERGED
     return 0 if all(r["converged"] for r in run["history"]) else EXIT_NOT_CONVERGED
