@@ -38,7 +38,7 @@ from .boundary import BoundaryMeshes, nearest_vertex
 from .checks import thesis_ends_outside_l2
 from .estimator import ASYMMETRY_NORMS, Estimate, estimate
 from .geometry import length_scale
-from .goal import GOALS, goal_estimate, singular_free_ends
+from .goal import GOALS, goal_estimate, in_window, singular_free_ends
 from .marking import STRATEGIES, mark
 from .mesh import build_mesh, element_diameters, mesh_arrays
 from .quantities import norms
@@ -274,18 +274,15 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
                 stop = {**stop, "stop_message": ": ".join(
                     filter(None, (stop.get("stop_message"), infinite)))}
             record.update(stop)
-            if tol is not None and stop["stopped_by"] != "tol":
-                below = record["relative_estimate"] <= tol   # a "singular" stop
+            # not reached, or reached with an estimate known to be too small (a kink)
+            if tol is not None and (stop["stopped_by"] != "tol" or "stop_message" in stop):
+                below = record["relative_estimate"] <= tol   # "singular", or the kink's "tol"
                 warnings.warn(f"adapt: the goal's relative estimate "
                               f"{record['relative_estimate']:.3g} is "
                               + (f"below tol = {tol:g}, but " if below
                                  else f"above tol = {tol:g}: ")
                               + stop.get("stop_message", f"the {steps} steps are spent"),
                               ToleranceWarning, stacklevel=2)
-            elif tol is not None and "stop_message" in stop:
-                warnings.warn(f"adapt: the goal's relative estimate "
-                              f"{record['relative_estimate']:.3g} is below tol = {tol:g}, "
-                              f"but {stop['stop_message']}", ToleranceWarning, stacklevel=2)
         if on_step is not None:
             called = time.perf_counter()
             on_step(record, solution, estimated, marked)
@@ -342,9 +339,10 @@ def _reached(scene: Scene, goal: str, window: tuple[float, float] | None) -> dic
     small by a constant (:data:`KINK_EFFECTIVITY`), with a ``stop_message`` that says so."""
     if goal != "pressure":
         return {"stopped_by": "tol"}
-    kinks = [point for point, kind, _ in contact_junctions(scene) if kind == "kink"
-             and (window is None or window[0] <= point[0] <= window[1])]
-    if not kinks:
+    kinks = np.array([point for point, kind, _ in contact_junctions(scene) if kind == "kink"],
+                     dtype=float).reshape(-1, 2)
+    kinks = kinks[in_window(kinks[:, 0], window)]
+    if not len(kinks):
         return {"stopped_by": "tol"}
     where = _points(kinks)
     low, high = KINK_EFFECTIVITY
@@ -395,8 +393,8 @@ def _infinite_error(solution: Solution, goal: str,
         if len(ends):
             return _not_in_l2(ends)
     clamped = thesis_ends_outside_l2(solution)
-    if goal == "pressure" and window is not None:
-        clamped = clamped[(window[0] <= clamped[:, 0]) & (clamped[:, 0] <= window[1])]
+    if goal == "pressure":
+        clamped = clamped[in_window(clamped[:, 0], window)]
     if not len(clamped):
         return None
     ends = "end" if len(clamped) == 1 else "ends"

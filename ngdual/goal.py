@@ -294,8 +294,7 @@ def singular_free_ends(solution: Solution,
     ends = np.array([point for point, kind, angle in contact_junctions(pb.scene)
                      if kind == "neumann" and angle <= KINK_ANGLE],
                     dtype=float).reshape(-1, 2)
-    if window is not None:
-        ends = ends[(window[0] <= ends[:, 0]) & (ends[:, 0] <= window[1])]
+    ends = ends[in_window(ends[:, 0], window)]
     if not len(ends):
         return ends
     gamma_c = pb.spaces.gamma_c
@@ -308,12 +307,19 @@ def singular_free_ends(solution: Solution,
     return ends[lam_n[nearest] <= CONTACT_SHARE * scale]
 
 
-def _in_window(x: np.ndarray, window: tuple[float, float] | None) -> np.ndarray:
-    """Which of the fine Gamma_C edges (midpoint abscissae ``x``) belong to the goal's W."""
+def in_window(x: np.ndarray, window: tuple[float, float] | None) -> np.ndarray:
+    """Which of the abscissae ``x`` lie in the goal's ``window`` [lo, hi] (all of them
+    without one)."""
     if window is None:
         return np.ones(len(x), dtype=bool)
-    inside = (window[0] <= x) & (x <= window[1])
-    if not inside.any():
+    return (window[0] <= x) & (x <= window[1])
+
+
+def _in_window(x: np.ndarray, window: tuple[float, float] | None) -> np.ndarray:
+    """Which of the fine Gamma_C edges (midpoint abscissae ``x``) belong to the goal's W; a
+    SceneError where none does."""
+    inside = in_window(x, window)
+    if window is not None and not inside.any():
         raise SceneError("window", f"[{window[0]:g}, {window[1]:g}] holds no edge of Gamma_C "
                                    f"(its midpoints lie in [{x.min():g}, {x.max():g}])")
     return inside
