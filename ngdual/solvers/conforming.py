@@ -69,12 +69,11 @@ from ..friction import MomentFriction, build_friction_forms, tresca_moments
 from ..tolerances import COULOMB_FIXED_POINT_TOL
 from .active_set import ContactStart, _coulomb_bound, coulomb_fixed_point
 from .linear import Factorization
-from .qp import product_residuals
 from .result import ConvergenceError, Solution
+from .scales import TOLERANCE, Scales
 from .semismooth import EPS, SAFETY, BoundarySolution, condition_number, semismooth_newton
 from .settings import ActiveSetSettings
 
-TOLERANCE = 1e-9   # relative residuals of (3.103) accepted as round-off
 REGULAR = 1e-8     # the free solve of a regular K leaves relative residuals below this
 CONTACT_START = 1e-8  # a warm start's lambda_n in contact: below this of its largest value
 DEEPEST = 0.5      # candidates per round: penetrations of at least this share of the deepest
@@ -409,48 +408,46 @@ def moments(problem: DiscreteProblem, x: np.ndarray) -> tuple[np.ndarray, np.nda
 def residuals(problem: DiscreteProblem, x: np.ndarray, law: str, mu_f: float,
               F: np.ndarray | None) -> dict:
     """Relative residuals of (3.103) on ``problem.K`` and, with the bound F on the
-    coefficients, of the friction law: |t_t,i| <= F_i (``friction_bound``),
-    F_i |lambda_t,i| = lambda_t,i t_t,i (``slip``: stick where |t_t,i| < F_i, slip along
-    t_t,i) and, for Coulomb, F_i = mu_f (-t_n,i), zero where that vanishes
-    (``coulomb_bound``; a moment at 1e-7 of the largest at the end of the contact zone
-    has F_i = 0, as the fixed point sets it).
+    coefficients, of the friction law, each against the scales of the problem
+    (:class:`~ngdual.solvers.scales.Scales`: the displacement scale D and the size of each
+    equation, never the residual's own quantity):
 
-    The sign conditions and the complementarity of lambda_n are measured against the
-    displacement scale, the largest of lambda_n, lambda_t and u: with g = 0 a whole side
-    is in contact, lambda_n = 0 up to round-off, and relative to its own size that
-    round-off would count as a violation of order one.
+    * ``stationarity``, ``equality``: the backward errors of the stress rows and of the
+      multiplier rows (equilibrium, symmetry, phi, and lambda_t: their rows carry Q_F^T nu
+      = t_t with friction);
+    * ``lambda_n_negative`` = max(-lambda_n) / D; ``sigma_n_positive`` = max t_n,i / T_i
+      and ``complementarity`` = max |lambda_n,i t_n,i| / (D T_i), T_i the size of the
+      moment row i;
+    * with F: ``friction_bound`` = max (|t_t,i| - F_i)^+ / (T_i + F_i); ``slip`` = max
+      |F_i |lambda_t,i| - lambda_t,i t_t,i| / (D (T_i + F_i)) (stick where |t_t,i| < F_i,
+      slip along t_t,i); for Coulomb ``coulomb_bound`` = max |F_i - mu_f (-t_n,i)| /
+      (mu_f T_i), zero where that vanishes (a moment at 1e-6 of the largest, as the
+      fixed point sets it: :func:`ngdual.tolerances.friction_vanishes`).
     """
-    i_sigma, i_mult, i_lam = problem.sigma, problem.mult, problem.lam_n
-    b = problem.rhs[i_mult].copy()
-    # K applied to sigma alone and to the rest: (A sigma, B^T sigma, C_n^T sigma) and
-    # (B y + C_n lambda_n, 0, 0), without the blocks of K
-    only_sigma = np.zeros_like(x)
-    only_sigma[i_sigma] = x[i_sigma]
-    of_sigma, of_rest = problem.apply(only_sigma), problem.apply(x - only_sigma)
-    residual = of_sigma + of_rest - problem.rhs
-    t_n, t_t = residual[i_lam], residual[problem.index("lam_t")]
-    lam_t_rows = problem.index("lam_t") - len(i_sigma)
-    if F is not None:  # the lambda_t rows carry Q_F^T nu = t_t
-        b[lam_t_rows] += t_t
-    found = product_residuals(of_sigma[i_sigma], of_rest[i_sigma], of_sigma[i_mult],
-                              of_sigma[i_lam], problem.rhs[i_sigma], b, x[i_lam])
-    lam_n, lam_t = x[i_lam], x[problem.index("lam_t")]
-    displacement = float(np.max(np.abs(x[problem.index("u1", "u2", "lam_n", "lam_t")]),
-                                initial=0.0)) or 1.0
-    n_scale = float(np.max(np.abs(t_n), initial=0.0)) or 1.0
-    found["lambda_n_negative"] = float(max(0.0, -lam_n.min(initial=0.0))) / displacement
-    found["complementarity"] = float(np.max(np.abs(lam_n * t_n), initial=0.0)) / (
-        displacement * n_scale)
+    scales = Scales.of(problem, x)
+    i_lam, i_lam_t = problem.lam_n, problem.index("lam_t")
+    residual = problem.apply(x) - problem.rhs
+    t_n, t_t = residual[i_lam], residual[i_lam_t]
+    rows = problem.mult
+    if F is not None:  # the lambda_t rows carry Q_F^T nu = t_t: no equation of their own
+        rows = np.setdiff1d(rows, i_lam_t)
+    D = scales.displacement
+    lam_n, lam_t = x[i_lam], x[i_lam_t]
+    found = {
+        "stationarity": scales.relative(residual[problem.sigma], problem.sigma),
+        "equality": scales.relative(residual[rows], rows),
+        "lambda_n_negative": float(max(0.0, -lam_n.min(initial=0.0))) / (D or 1.0),
+        "sigma_n_positive": scales.per_row(np.maximum(t_n, 0.0), i_lam),
+        "complementarity": scales.per_row(lam_n * t_n, i_lam) / (D or 1.0),
+    }
     if F is not None:
-        t_scale = max(n_scale, float(np.max(np.abs(t_t), initial=0.0)))
-        work = float(np.max(F, initial=0.0) * np.max(np.abs(lam_t), initial=0.0)) or 1.0
-        found["friction_bound"] = float(np.max(np.abs(t_t) - F, initial=0.0)) / t_scale
-        found["slip"] = float(np.max(np.abs(F * np.abs(lam_t) - lam_t * t_t),
-                                     initial=0.0)) / work
+        bounded = Scales(D, scales.stress, scales.rows[i_lam_t] + F)
+        every = np.arange(len(F))
+        found["friction_bound"] = bounded.per_row(np.maximum(np.abs(t_t) - F, 0.0), every)
+        found["slip"] = bounded.per_row(F * np.abs(lam_t) - lam_t * t_t, every) / (D or 1.0)
     if law == "coulomb":
         # F of the moments on K as the solver defines it: zero where it vanishes (at most
         # 1e-6 of its largest value, tolerances.friction_vanishes), as the F it returns
         mapped = _coulomb_bound(MomentFriction(), t_n, mu_f, 0.0)
-        found["coulomb_bound"] = float(np.max(np.abs(mapped - F), initial=0.0) / (
-            mu_f * np.max(np.abs(t_n), initial=0.0) or 1.0))
+        found["coulomb_bound"] = scales.per_row(mapped - F, i_lam) / mu_f
     return found
