@@ -185,7 +185,9 @@ class Contact:
     (C_h~ of (3.61)), as in the thesis; it is consistent only where g = u_D.n at the
     ends (with g(+-4) = 0.01 and u_D = 0 in Example 3.46 it is not: the solution is
     forced to u_n = g at the clamped corners, so that the thesis scenes, which set it,
-    reproduce the thesis tables, tension included).
+    reproduce the thesis tables, tension included). It is a property of the thesis' P1 hats
+    of order 0: at order k >= 1, and with the facet multipliers at any order, the scene is
+    refused (:func:`ngdual.scene.validate.validate`) and ``"consistent"`` is the choice.
 
     ``discrete_gap`` says which gap the discrete problem (3.62) sees. ``"nodal"``
     (default): g_h = I_h~ g, the P1 interpolant of g on the h~ mesh of lambda_n, so that

@@ -24,6 +24,7 @@ from .tables import (
     SOLVER_METHODS,
     STRESS_UNITS,
     Contact,
+    Discretisation,
     Material,
     Problems,
     Scene,
@@ -202,19 +203,35 @@ def _validate_discretisation(scene: Scene) -> None:
                          "(or \"auto\")")
         for f, m in _facet_contact_settings(scene.contact):
             problems.add(f, m)
+    if scene.contact.ends == "thesis" and (disc.order > 0 or disc.family == "facet"):
+        problems.add("contact.ends", _thesis_ends_elsewhere(disc))
     problems.raise_any()
 
 
-def _facet_contact_settings(con: Contact) -> list[tuple[str, str]]:
-    """``(field, message)`` for every contact setting of the coarse multipliers that the facet
-    multipliers would ignore.
+def _thesis_ends_elsewhere(disc: Discretisation) -> str:
+    """Why ``contact.ends = "thesis"`` is refused at ``disc``: one rule for both families.
 
-    The facet multipliers live on the fine edges, discontinuous from edge to edge: there is
-    no h~ or h^ mesh to size, and no value at an end of Gamma_C to prescribe, so the end
-    value of lambda_n = g - u_n is left to the solution, which is the physics of
-    ``"consistent"`` (``"thesis"``, zero at every end, is the inconsistency of (3.61) kept
-    to reproduce the thesis' tables at order 0). The defaults describe that; other values
-    would do nothing.
+    The thesis' C_h~ of (3.61) sets the P1 hats of order 0 to zero at every end of Gamma_C, a
+    property of that space kept to reproduce the thesis' tables (and inconsistent where
+    g - u_D.n is not zero at a clamped end: sigma leaves L2 there). At order k >= 1 there is
+    no thesis table to reproduce, and the facet multipliers have no end value to set; both
+    families take the end values the data prescribe, ``"consistent"``.
+    """
+    why = ("the facet multipliers have no value at an end of Gamma_C to prescribe"
+           if disc.family == "facet" else "there is no thesis table to reproduce, only the "
+           "force its zero end values put into the clamped corners")
+    return ('"thesis" (lambda = 0 at every end of Gamma_C, C_h~ of (3.61)) is the thesis\' '
+            "space of order 0 with the coarse multipliers; at discretisation.order = "
+            f'{disc.order} with discretisation.multipliers = "{disc.family}" {why}: set '
+            'contact.ends = "consistent"')
+
+
+def _facet_contact_settings(con: Contact) -> list[tuple[str, str]]:
+    """``(field, message)`` for every coarse mesh size that the facet multipliers would ignore.
+
+    The facet multipliers live on the fine edges: there is no h~ or h^ mesh to size, so
+    values other than the defaults would do nothing (``contact.ends`` is the one rule of
+    :func:`_thesis_ends_elsewhere`, for both families).
     """
     default, found = Contact(), []
     for key, what in (("htilde_factor", "h~ = htilde_factor h"),
@@ -224,12 +241,6 @@ def _facet_contact_settings(con: Contact) -> list[tuple[str, str]]:
                           "multipliers; the facet multipliers live on the fine edges and have "
                           "none, so it does nothing with discretisation.multipliers = "
                           f"\"facet\"; remove it (default {getattr(default, key)})"))
-    if con.ends != default.ends:
-        found.append(("contact.ends", f"{show(con.ends)} prescribes the multipliers at the ends "
-                      "of Gamma_C, and the facet multipliers have no value there to prescribe: "
-                      "discontinuous from edge to edge, they leave lambda_n = g - u_n at an end "
-                      "to the solution, which is what \"consistent\" means; set "
-                      "contact.ends = \"consistent\""))
     return found
 
 
