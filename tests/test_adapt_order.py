@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from ngdual import budget
-from ngdual.afem import adapt
+from ngdual.afem import AdaptWarning, adapt
 from ngdual.cli import main
 from ngdual.quantities import fields
 from ngdual.scene import SceneError, load_scene
@@ -66,18 +66,26 @@ def test_ngdual_adapt_takes_the_order_on_the_command_line(tmp_path):
     assert steps[0]["dofs"]["M"] == 2 * 3 * steps[0]["elements"]
 
 
-def test_a_refinement_is_refused_by_the_memory_its_order_needs(monkeypatch):
+def test_a_refinement_that_would_not_fit_the_memory_its_order_needs_ends_the_loop(monkeypatch):
     """Refining all 32 triangles of Example 3.46's level 1 gives about 160: PEERS_0 would
     need 384 MiB, PEERS_2 with the facet multipliers 421 MiB (:mod:`ngdual.budget`); with
-    400 MiB available the loop at order 2 refuses the refinement, naming ``steps``."""
+    400 MiB available the loop at order 2 stops before that refinement ("memory", with the
+    memory needed and the remedy of a run of steps) and says so, at order 0 it refines."""
     scene = load_scene("thesis-3.46-frictionless",
                        ["discretisation.order=2", "contact.ends=consistent"])
     have = 400 * 2**20
     assert budget.solve_memory(160) < have < budget.solve_memory(160, "auto", 2, "facet")
     monkeypatch.setattr(budget, "available_memory", lambda: have)
-    with pytest.raises(SceneError) as err:
-        adapt(scene, marking="max", theta=0.0, steps=2, level=1)
-    assert err.value.field == "steps"
+    with pytest.warns(AdaptWarning, match="the next refinement would have about 160 triangles"):
+        history = adapt(scene, marking="max", theta=0.0, steps=2, level=1)
+    assert len(history) == 1 and history[0]["stopped_by"] == "memory"
+    assert history[0]["marked"] == 0 and history[0]["timings_s"]["refine"] == 0.0
+    need = budget.solve_memory(160, "auto", 2, "facet")
+    assert f"need about {need / 2**30:.3g} GiB" in history[0]["stop_message"]
+    assert "use fewer steps, or allow_large=True" in history[0]["stop_message"]
+    order_0 = adapt(scene, marking="max", theta=0.0, steps=2, level=1, order=0,
+                    multipliers="coarse")
+    assert [r.get("stopped_by") for r in order_0] == [None, "steps"]
 
 
 @pytest.mark.slow

@@ -17,10 +17,12 @@ from ngdual.afem import (
     adapt,
     loop_defaults,
     refine_towards,
+    refinement,
 )
+from ngdual.afem.stops import Stalled, Step
 from ngdual.cli import main
 from ngdual.estimator import estimate
-from ngdual.goal import goal_estimate, singular_free_ends
+from ngdual.goal import goal_estimate, goal_for, singular_free_ends
 from ngdual.mesh import build_mesh
 from ngdual.scene import SceneError, SceneTypeError, load_scene
 from ngdual.solvers import solve_on_mesh, solve_scene
@@ -149,15 +151,16 @@ def test_ngdual_adapt_with_goal_and_tol_records_them_and_stops(tmp_path, capsys)
 def test_a_tolerance_run_whose_estimate_stops_falling_stops_as_stalled():
     """A new best within STALL_STEPS steps keeps the run going; STALL_STEPS steps without
     one stop it, naming the best; a run without tol never stalls."""
-    def history(*estimates):
-        return [{"relative_estimate": e} for e in estimates]
+    def stalled(tol, *estimates):
+        return Stalled(tol, goal_for("stress"))(Step([{"relative_estimate": e}
+                                                      for e in estimates]))
 
     assert STALL_STEPS == 3
-    assert afem._stalled(history(0.1, 0.05, 0.06, 0.07, 0.049), 0.01) is None
-    assert afem._stalled(history(0.1, 0.05, 0.06), 0.01) is None
-    stop = afem._stalled(history(0.1, 0.05, 0.06, 0.07, 0.05), 0.01)
-    assert stop["stopped_by"] == "stall" and "0.05 at step 1" in stop["stop_message"]
-    assert afem._stalled(history(0.1, 0.05, 0.06, 0.07, 0.05), None) is None
+    assert stalled(0.01, 0.1, 0.05, 0.06, 0.07, 0.049) is None
+    assert stalled(0.01, 0.1, 0.05, 0.06) is None
+    stop = stalled(0.01, 0.1, 0.05, 0.06, 0.07, 0.05)
+    assert stop.stopped_by == "stall" and "0.05 at step 1" in stop.message
+    assert stalled(None, 0.1, 0.05, 0.06, 0.07, 0.05) is None
 
 
 def test_a_tolerance_run_with_nothing_to_measure_says_so():
@@ -170,14 +173,14 @@ def test_a_tolerance_run_with_nothing_to_measure_says_so():
     assert afem.relative_estimate(record(75.2, 0.0)) == float("inf")
     assert afem.relative_estimate(record(0.0, 0.0)) == 0.0
     assert afem.relative_estimate(record(1.0, 4.0)) == 0.25
-    history = [{**record(e, 0.0), "relative_estimate": float("inf")} for e in (75, 60, 26, 12)]
-    stop = afem._stalled(history, 0.05)
-    assert stop["stopped_by"] == "stall"
-    assert stop["stop_message"].startswith("||p_h|| is 0 at every step")
-    assert "no contact where the goal measures the pressure" in stop["stop_message"]
-    assert "inf" not in stop["stop_message"]
-    stress = [{**r, "goal": "stress"} for r in history]
-    assert afem._stalled(stress, 0.05)["stop_message"].startswith("||sigma_h|| is 0")
+    history = Step([{**record(e, 0.0), "relative_estimate": float("inf")}
+                    for e in (75, 60, 26, 12)])
+    stop = Stalled(0.05, goal_for("pressure"))(history)
+    assert stop.stopped_by == "stall"
+    assert stop.message.startswith("||p_h|| is 0 at every step")
+    assert "no contact where the goal measures the pressure" in stop.message
+    assert "inf" not in stop.message
+    assert Stalled(0.05, goal_for("stress"))(history).message.startswith("||sigma_h|| is 0")
 
 
 def test_the_pressure_is_not_in_l2_where_contact_reaches_a_straight_free_end():
@@ -282,7 +285,7 @@ def test_a_tolerance_where_the_thesis_ends_leave_sigma_outside_l2_is_not_reached
 def test_a_resolution_stop_where_p_is_not_in_l2_says_why(monkeypatch):
     """A pressure-goal run that the resolution stops at a punch edge (here on its first
     mesh) says, after where the marking reached, that p is not in L2 there."""
-    monkeypatch.setattr(afem, "RESOLUTION", 0.02)   # 0.16 of the 8-wide block
+    monkeypatch.setattr(refinement, "RESOLUTION", 0.02)   # 0.16 of the 8-wide block
     with pytest.warns(ToleranceWarning, match="above tol = 0.02: the marking reaches"):
         history = adapt(load_scene("flat-punch"), goal="pressure", tol=0.02)
     assert history[-1]["stopped_by"] == "resolution"
@@ -296,7 +299,7 @@ def test_a_marking_below_the_resolution_stops_the_loop_and_warns_of_the_tol(hert
     """A marked triangle smaller than RESOLUTION x the length scale (here raised so that
     hertz-cylinder's first marks reach it) stops the loop before it refines, saying where;
     a run with a tol it did not reach warns (ToleranceWarning), one without does not."""
-    monkeypatch.setattr(afem, "RESOLUTION", 0.02)   # 0.16 of the 8-wide block
+    monkeypatch.setattr(refinement, "RESOLUTION", 0.02)   # 0.16 of the 8-wide block
     with pytest.warns(ToleranceWarning, match="above tol = 1e-06: the marking reaches"):
         history = adapt(hertz, goal="pressure", tol=1e-6, steps=6)
     last = history[-1]
@@ -310,7 +313,7 @@ def test_a_marking_below_the_resolution_stops_the_loop_and_warns_of_the_tol(hert
 
 def test_ngdual_adapt_that_misses_its_tol_says_why_with_exit_status_1(tmp_path, capsys,
                                                                        monkeypatch):
-    monkeypatch.setattr(afem, "RESOLUTION", 0.02)
+    monkeypatch.setattr(refinement, "RESOLUTION", 0.02)
     assert main(["adapt", "hertz-cylinder", "--goal", "pressure", "--tol", "1e-6",
                  "--out", str(tmp_path)]) == 1
     out, err = capsys.readouterr()
@@ -535,7 +538,7 @@ def test_the_vertex_jumps_of_the_order_k_pressure_are_those_read_on_each_side():
     search; against p_h read by NGSolve's point search a thousandth of an edge from every
     interior vertex on either side (p_h is P_1 on every edge: the offset moves it by a
     thousandth of its change along the edge)."""
-    from ngdual.goal import _pressure, _vertex_jumps
+    from ngdual.goal.indicators import _pressure, _vertex_jumps
 
     scene = load_scene("hertz-cylinder", ["discretisation.order=1"])
     mesh = build_mesh(scene.geometry, 2)

@@ -1,4 +1,4 @@
-"""A goal for the adaptive loop: the error of the contact pressure on Gamma_C.
+"""The indicators of the pressure goal: the error of the contact pressure on Gamma_C.
 
 The estimator of Chapter 4 (4.50) bounds the whole stress error; on a contact problem it
 refines the clamped corners first and does not see the pressure. :func:`goal_estimate`
@@ -58,19 +58,17 @@ import ngsolve as ngs  # the pressure of order k, a trace of sigma_h
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .checks import displacement_scale, friction_forms_of
-from .estimator import BoundaryEdges, Estimate
-from .friction import hat_projection
-from .mesh import boundary_segments, mesh_arrays
-from .quantities import fields  # the trace of sigma_h at order k
-from .scene import SceneError, contact_junctions
-from .scene.contact import KINK_ANGLE
-from .solvers.result import Solution
+from ..checks import friction_forms_of
+from ..estimator import BoundaryEdges, Estimate
+from ..friction import hat_projection
+from ..mesh import boundary_segments, mesh_arrays
+from ..quantities import fields  # the trace of sigma_h at order k
+from ..scene import SceneError
+from ..solvers.result import Solution
 
-__all__ = ["CALIBRATION", "CALIBRATION_ORDER_K", "CALIBRATION_WINDOW_ORDER_K", "GOALS", "TERMS",
-           "PressureEstimate", "calibration", "goal_estimate"]
+__all__ = ["CALIBRATION", "CALIBRATION_ORDER_K", "CALIBRATION_WINDOW_ORDER_K", "TERMS",
+           "PressureEstimate", "calibration", "goal_estimate", "in_window"]
 
-GOALS = ("stress", "pressure")
 TERMS = ("residual", "complementarity", "kink", "jump", "far")
 # terms of (4.15) in units of stress x length, and those of w_h ~ grad u (strain x length);
 # not jump_contact: on Gamma_C the contact-zone terms stand for it, and where the body
@@ -109,14 +107,16 @@ CONTACT_SHARE = 1e-6
 
 @dataclass
 class PressureEstimate:
-    """The indicators of ||p - p_h||_{L2(Gamma_C)}: ``terms[k]`` squared per element.
+    """The indicators of ||p - p_h||_{L2(W)}: ``terms[k]`` squared per element.
 
-    ``size`` is ||p_h||_{L2(Gamma_C)}, the size the relative estimate is taken against;
-    ``calibration`` the constant C_k of every term (:func:`calibration`).
+    ``size`` is ||p_h||_{L2(W)}, the size the relative estimate is taken against, and
+    ``whole`` ||p_h||_{L2(Gamma_C)} (the same without a window); ``calibration`` the
+    constant C_k of every term (:func:`calibration`).
     """
 
     terms: dict[str, np.ndarray]
     size: float
+    whole: float
     calibration: dict[str, float]
 
     @property
@@ -242,7 +242,7 @@ def goal_estimate(solution: Solution, estimated: Estimate,
                         * _order_decay(estimated.h, distance, spaces.order))
     else:
         terms["far"] = eta_sigma * _dipole_weight(estimated.h, distance, h_near, spaces.order)
-    return PressureEstimate(terms, size,
+    return PressureEstimate(terms, size, float(np.sqrt(np.sum(p_squared))),
                             calibration(spaces.family, spaces.order, window is not None))
 
 
@@ -268,43 +268,6 @@ def _order_decay(h_t: np.ndarray, distance: np.ndarray, order: int) -> np.ndarra
     better than PEERS_0, squared in the squared indicator, as in :func:`_dipole_weight`
     (docs/theory/estimator.md, "The pressure goal at order k"); 1 at k = 0, to the bit."""
     return (h_t / (h_t + distance))**(2 * order)
-
-
-def singular_free_ends(solution: Solution,
-                       window: tuple[float, float] | None = None) -> np.ndarray:
-    """The ends of Gamma_C where the contact pressure is not in L2: an array of points (n, 2),
-    those in ``window`` (abscissa) if one is given.
-
-    At an end of Gamma_C where a traction-free or loaded side begins (a ``"neumann"``
-    junction of :func:`ngdual.scene.contact_junctions`) and the contact zone reaches it, the
-    normal traction drops from the contact pressure to the side's. Mirrored across the
-    frictionless contact side, the body's corner of interior angle phi (pi less the
-    boundary's turning angle there) is a free wedge of angle 2 phi, whose symmetric stress
-    modes r^(lambda - 1) solve lambda sin(2 phi) + sin(2 lambda phi) = 0 (Williams): lambda
-    = 1 at phi = pi/2 (a block on a plane: bounded), 1/2 at phi = pi (a flat punch's edge,
-    the boundary running straight on: p ~ d^(-1/2)), below 1/2 beyond. So p is not in
-    L2(Gamma_C) where the boundary runs straight on or turns re-entrant (turning angle at
-    most KINK_ANGLE), and ||p - p_h||_{L2(Gamma_C)} has no finite value for the pressure
-    goal to reach (with friction the exponent moves off 1/2 with the friction coefficient,
-    to either side; the test is the frictionless one). Contact at an end: lambda_n = g - u_n
-    at its vertex at most CONTACT_SHARE of the larger of max |lambda_n| and the displacement
-    scale (:func:`ngdual.checks.displacement_scale`; a Gamma_C in contact everywhere has
-    lambda_n = 0 to round-off)."""
-    pb = solution.problem
-    ends = np.array([point for point, kind, angle in contact_junctions(pb.scene)
-                     if kind == "neumann" and angle <= KINK_ANGLE],
-                    dtype=float).reshape(-1, 2)
-    ends = ends[in_window(ends[:, 0], window)]
-    if not len(ends):
-        return ends
-    gamma_c = pb.spaces.gamma_c
-    fine = pb.to_fine(solution.x)
-    rng = pb.fes.Range(pb.names.index("lam_n"))
-    lam_n = gamma_c.vertex_values(fine[rng.start:rng.stop])
-    vertices = np.vstack([chain.path_points for chain in gamma_c.coarse.chains])
-    _, nearest = cKDTree(vertices).query(ends)
-    scale = max(float(np.max(np.abs(lam_n), initial=0.0)), displacement_scale(solution))
-    return ends[lam_n[nearest] <= CONTACT_SHARE * scale]
 
 
 def in_window(x: np.ndarray, window: tuple[float, float] | None) -> np.ndarray:
