@@ -25,9 +25,11 @@ stored in ``result.json`` under ``warnings``; ``adapt`` prints them below each s
 Exit status: 0 solved and converged, 1 not converged, 2 bad input (one message naming
 every field or flag at fault; nothing is written), 3 an internal error (a bug: the message
 says so; ``ngdual --debug ...`` shows the traceback), 4 a physics check failed under
-``--strict`` (``solve`` writes nothing; ``adapt`` stops at that step). Runs whose
-estimated size exceeds the memory available are refused before meshing;
-``--allow-large`` runs them anyway.
+``--strict`` (``solve`` writes nothing; ``adapt`` stops at that step), 5 ``adapt`` stopped
+by the memory (its next refinement would not fit in the memory available, or a solve ran
+out of it; ``history.json`` keeps the steps before, the last with ``stopped_by =
+"memory"``). Runs whose estimated size exceeds the memory available are refused before
+meshing (status 2); ``--allow-large`` runs them, and lets ``adapt`` refine, anyway.
 """
 
 from __future__ import annotations
@@ -46,7 +48,7 @@ from .output import (
     EXIT_NOT_CONVERGED,
     EXIT_WARNINGS,
 )
-from .pipeline import cmd_adapt, cmd_dofs, cmd_scenes, cmd_solve
+from .pipeline import EXIT_MEMORY, cmd_adapt, cmd_dofs, cmd_scenes, cmd_solve
 from .studies import cmd_bench, cmd_figures, cmd_tutorials, cmd_verify
 
 
@@ -57,7 +59,8 @@ def parser() -> argparse.ArgumentParser:
         prog="ngdual", description=__doc__.splitlines()[0],
         epilog=f"exit status: 0 solved and converged, {EXIT_NOT_CONVERGED} not converged, "
                f"{EXIT_BAD_INPUT} bad input (nothing written), {EXIT_INTERNAL} internal error, "
-               f"{EXIT_WARNINGS} a physics check failed under --strict")
+               f"{EXIT_WARNINGS} a physics check failed under --strict, {EXIT_MEMORY} adapt "
+               f"stopped by the memory (history.json kept)")
     p.add_argument("--version", action="version", version=f"ngdual {__version__}",
                    help="print the version of ngdual and exit")
     p.add_argument("--debug", action="store_true",
@@ -119,12 +122,14 @@ def parser() -> argparse.ArgumentParser:
                          "solution's size (||sigma_h|| in H(div), ||p_h|| on Gamma_C) is at "
                          "most TOL; a run that stops short of it (by --steps, a stalled "
                          "estimate or the smallest triangle the loop refines) exits with "
-                         "status 1")
+                         f"status 1, one whose next refinement would not fit in memory "
+                         f"with status {EXIT_MEMORY}")
     ad.add_argument("--window", type=float, nargs=2, default=None, metavar=("LO", "HI"),
                     help="with --goal pressure: the error of the pressure on the part of "
                          "Gamma_C with LO <= x <= HI only (default: all of Gamma_C), e.g. "
                          "--window -0.125 0.125 for the flat punch's core, whose pressure "
-                         "is not in L2 at the punch edges")
+                         "is not in L2 at the punch edges; a window without contact stops "
+                         "on the first solve, with status 1")
     ad.add_argument("--level", type=int, default=None,
                     help="initial mesh level (default: the scene's; with --tol 1)")
     ad.add_argument("--asymmetry", choices=["hdiv", "l2"], default="l2",

@@ -21,6 +21,10 @@ from .output import (
     warning_lines,
 )
 
+# adapt stopped by the memory budget (stopped_by = "memory"): before a refinement that would
+# not fit, or at a solve that ran out of memory; history.json keeps the steps before
+EXIT_MEMORY = 5
+
 
 def cmd_solve(args) -> int:
     from .. import budget, post
@@ -118,12 +122,15 @@ def cmd_adapt(args) -> int:
     refines, or its goal's error is not finite: "singular", also below the tol) is exit
     status 1, with the reason; one reached where the goal's estimate is
     known to be too small (the pressure goal at a kink of Gamma_C) is 0, with that caution
-    below the last step."""
-    from ..afem import ToleranceWarning
+    below the last step. A pressure goal whose window holds no contact stops on the first
+    solve ("no_contact", status 1). A run whose next refinement would not fit in memory
+    stops before it, and one whose solve runs out of memory stops there ("memory", status
+    EXIT_MEMORY = 5, history.json kept)."""
+    from ..afem import AdaptWarning
 
     with warnings.catch_warnings():  # the reference solves' checks are not the run's
         warnings.simplefilter("ignore", PhysicsWarning)
-        warnings.simplefilter("ignore", ToleranceWarning)   # said below (stop_message)
+        warnings.simplefilter("ignore", AdaptWarning)   # said below (stop_message)
         return _adapt(args)
 
 
@@ -214,10 +221,25 @@ def _adapt(args) -> int:
         return not_converged(err)
     except StrictFailure as err:
         return strict_failure(err)
+    except MemoryError:   # on the initial mesh: later solves end the loop ("memory")
+        run.update(stopped_by="memory", stop_message=f"the solve on the initial mesh (level "
+                                                     f"{level}) ran out of memory")
+        write_json(run, out / "history.json")
+        print(f"ngdual: stopped by memory: {run['stop_message']} within "
+              f"{budget.describe_available()}; choose a coarser --level or maxh",
+              file=sys.stderr)
+        return EXIT_MEMORY
     write_json(run, out / "history.json")
     print(f"wrote {out / 'history.json'} and {len(run['history'])} meshes (.vol, .png"
           + (", solution_stepNN.vtu)" if args.vtk else ")"))
     last = run["history"][-1]
+    if last["stopped_by"] == "memory":
+        print(f"ngdual: stopped by memory: {last['stop_message']}", file=sys.stderr)
+        return EXIT_MEMORY
+    if last["stopped_by"] == "no_contact":
+        print(f"ngdual: not converged: the pressure goal has nothing to measure (stopped by "
+              f"no_contact): {last['stop_message']}", file=sys.stderr)
+        return EXIT_NOT_CONVERGED
     if args.tol is not None and last["stopped_by"] != "tol":
         measured = (f"the goal's relative estimate {last['relative_estimate']:.3g} is below it "
                     f"but measures no finite error" if last["relative_estimate"] <= args.tol else
