@@ -14,13 +14,15 @@ notebook needs:
 Scenes: :func:`load_scene`, :func:`validate`, :func:`shipped_scenes`, :class:`Scene`,
 :class:`SceneError`. Solving: :func:`solve` (mesh, assemble, solve; Algorithms 3.38/3.41
 or the active-set method; ``order=k`` for PEERS of order k, ``multipliers=`` for the family
-of the boundary multipliers), :class:`Solution`. Adaptivity (Chapter 4): :func:`estimate`
-(the indicators of eq. 4.50), :func:`mark`, :func:`adapt` (SOLVE, ESTIMATE, MARK,
-REFINE). Post-processing: :func:`fields`, :func:`norms`, :func:`contact_traces`,
-:func:`force_balance`, :func:`result_record`. Plotting (each returns a matplotlib figure):
-:func:`plot_geometry` (the domain, its boundary parts and the mesh), :func:`plot_contact_traces`,
-:func:`plot_element_field`, :func:`plot_von_mises`, :func:`plot_mesh`; saving one is the
-caller's choice, :func:`save_figure`.
+of the boundary multipliers), :class:`Solution`. Adaptivity (Chapter 4): :func:`adapt` (the
+loop SOLVE, ESTIMATE, MARK, REFINE) and its steps, to write the loop by hand:
+:func:`build_mesh` and :class:`BoundaryMeshes` (the coarse meshes h~, h^ of its boundary),
+:func:`solve_on_mesh`, :func:`estimate` (the indicators of eq. 4.50), :func:`mark`,
+:func:`refine_with_boundary`. Post-processing: :func:`fields`, :func:`norms`,
+:func:`contact_traces`, :func:`force_balance`, :func:`result_record`. Plotting (each returns
+a matplotlib figure): :func:`plot_geometry` (the domain, its boundary parts and the mesh),
+:func:`plot_contact_traces`, :func:`plot_element_field`, :func:`plot_von_mises`,
+:func:`plot_mesh`; saving one is the caller's choice, :func:`save_figure`.
 
 The names are loaded lazily (PEP 562): ``import ngdual`` imports neither NGSolve nor
 matplotlib, so that the command line starts fast; the first use of a name imports its
@@ -44,8 +46,12 @@ _PUBLIC = {
     "solve": ("ngdual.solvers", "solve_scene"),
     "Solution": ("ngdual.solvers", "Solution"),
     "adapt": ("ngdual.afem", "adapt"),
+    "build_mesh": ("ngdual.mesh", "build_mesh"),
+    "BoundaryMeshes": ("ngdual.boundary", "BoundaryMeshes"),
+    "solve_on_mesh": ("ngdual.solvers", "solve_on_mesh"),
     "estimate": ("ngdual.estimator", "estimate"),
     "mark": ("ngdual.marking", "mark"),
+    "refine_with_boundary": ("ngdual.afem", "refine_with_boundary"),
     "fields": ("ngdual.quantities", "fields"),
     "norms": ("ngdual.quantities", "norms"),
     "contact_traces": ("ngdual.post", "contact_traces"),

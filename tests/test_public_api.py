@@ -15,7 +15,7 @@ import ngdual as nd
 
 
 def test_every_public_name_resolves_and_has_a_docstring():
-    assert len(nd.__all__) == len(set(nd.__all__)) and 10 <= len(nd.__all__) <= 25
+    assert len(nd.__all__) == len(set(nd.__all__)) and 10 <= len(nd.__all__) <= 30
     for name in nd.__all__:
         value = getattr(nd, name)
         if name == "__version__":
@@ -26,13 +26,17 @@ def test_every_public_name_resolves_and_has_a_docstring():
 
 
 def test_public_names_are_the_pipeline_functions():
-    from ngdual import afem, estimator, marking, post, quantities, scene, solvers
+    from ngdual import afem, boundary, estimator, marking, mesh, post, quantities, scene, solvers
 
     assert nd.solve is solvers.solve_scene
     assert nd.load_scene is scene.load_scene and nd.Scene is scene.Scene
     assert nd.adapt is afem.adapt and nd.estimate is estimator.estimate
     assert nd.mark is marking.mark and nd.contact_traces is post.contact_traces
     assert nd.norms is quantities.norms and nd.fields is quantities.fields
+    # the steps of the adaptive loop, to write it by hand (tutorial 07)
+    assert nd.solve_on_mesh is solvers.solve_on_mesh and nd.build_mesh is mesh.build_mesh
+    assert nd.refine_with_boundary is afem.refine_with_boundary
+    assert nd.BoundaryMeshes is boundary.BoundaryMeshes
 
 
 def test_dir_lists_the_public_names_and_unknown_names_raise():

@@ -65,13 +65,18 @@ def refine_with_boundary(scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes,
 
     Examples
     --------
-    >>> import ngdual as nd, numpy as np
-    >>> scene = nd.load_scene("thesis-3.46-frictionless")
+    One step of the adaptive loop by hand, on Example 3.46's coarsest mesh:
+
+    >>> import ngdual as nd
+    >>> scene = nd.load_scene("thesis-3.46-frictionless", ["contact.ends='consistent'"])
     >>> mesh = nd.build_mesh(scene.geometry, 1)
     >>> coarse = nd.BoundaryMeshes.for_scene(scene, mesh)
-    >>> fine, coarse = nd.refine_with_boundary(scene, mesh, coarse, np.ones(mesh.ne, bool))
-    >>> mesh.ne, fine.ne
-    (32, 128)
+    >>> solution = nd.solve_on_mesh(scene, mesh, coarse)                   # SOLVE
+    >>> indicators = nd.estimate(solution).indicators                      # ESTIMATE
+    >>> marked = nd.mark(indicators, 0.5, "dorfler")                       # MARK
+    >>> fine, coarse = nd.refine_with_boundary(scene, mesh, coarse, marked)  # REFINE
+    >>> mesh.ne, fine.ne > mesh.ne
+    (32, True)
     """
     fine = refine(mesh, marked)
     return fine, coarse.follow(scene, fine)
