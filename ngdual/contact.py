@@ -235,7 +235,9 @@ class ContactBoundary:
 
     def gap_interpolant(self, prolongation: sp.csr_matrix, end_hats: sp.csr_matrix
                         ) -> np.ndarray:
-        """Fine trace coefficients of g_h = I_h~ g, the P1 interpolant of g on the h~ mesh.
+        """Fine trace coefficients of g_h, the interpolant of g in the multiplier space:
+        I_h~ g, P1 on the h~ mesh for the thesis' hats; for the Bernstein bases of degree
+        p >= 2 the interpolant with its negative coefficients raised to zero.
 
         ``prolongation`` and ``end_hats`` are :meth:`prolongation` without and with
         ``ends=True``. With g_h for g in g(tau) of (3.32), lambda_n - g_h = -u_n lies in the
@@ -243,15 +245,27 @@ class ContactBoundary:
         the contact condition lambda_n >= 0 is u_n <= g at the h~ nodes, and without load
         lambda_n = g_h, sigma = 0 solves (3.62) for any g >= 0 (g itself would prescribe
         u_n = g - lambda_n on the fine edges wherever g is not P1 on h~).
+
+        At degree p >= 2 the contact condition acts on the Bernstein coefficients of
+        lambda_n, and a nonnegative polynomial may have a negative one: x^2 on [-h, h] has
+        the middle coefficient -h^2. The interpolant of a gap that touches zero inside an
+        edge (a curved body at its first point of contact) would then be no admissible
+        lambda_n, and without load the discrete problem would push the body off by about
+        h^2 / R (a stress of 1e-5 of the loaded Hertz run at k = 1). Raised to zero, those
+        coefficients give a g_h >= 0 with lambda_n = g_h admissible, so no load gives no
+        stress at every order; g_h moves by at most the negative coefficients, O(h^2 g'')
+        on the few edges where g vanishes (docs/theory/order.md).
         """
         if isinstance(self.coarse, FacetMesh):
             # the facet multipliers: g of the boundary curve interpolated on every fine edge
-            return prolongation @ self.coarse.interpolant(
-                lambda points, edges: gap_at(self.scene.contact, *self.on_curve(points, edges)))
+            return prolongation @ np.maximum(self.coarse.interpolant(
+                lambda points, edges: gap_at(self.scene.contact, *self.on_curve(points, edges))),
+                0.0)
         if isinstance(self.coarse, CoarseOrderMesh):
             # degree k + 1 on every h~ edge, g of the boundary curve at its control points
             at_dofs, at_ends = self.coarse.interpolant(
                 lambda points, edges: gap_at(self.scene.contact, *self.on_curve(points, edges)))
+            at_dofs = np.maximum(at_dofs, 0.0)
         else:
             at_dofs, at_ends = self.gap_at_nodes()
         return prolongation @ at_dofs + end_hats @ at_ends

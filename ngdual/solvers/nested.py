@@ -42,6 +42,7 @@ from ..friction import FrictionForms, build_friction_forms, tresca_bound
 from ..tolerances import CLARABEL_TOLERANCES, DIVERGENCE_FACTOR, friction_vanishes
 from .condensed import CondensedResponse
 from .result import ConvergenceError, Solution
+from .scales import Scales
 from .settings import Model, NestedUzawaSettings
 from .uzawa import ContactLoop
 
@@ -67,14 +68,17 @@ def _relative(new: np.ndarray, old: np.ndarray) -> float:
     return float(np.linalg.norm(new - old) / (np.linalg.norm(new) or 1.0))
 
 
-def sign_residual(Q: sp.spmatrix, nu: np.ndarray, lam_t: np.ndarray) -> float:
-    """Residual of (3.62)_7, sum_j (|q_j| - nu_j q_j) / j(lambda_t) with q = Q_F lambda_t.
+def sign_residual(Q: sp.spmatrix, nu: np.ndarray, lam_t: np.ndarray,
+                  displacement: float = 0.0) -> float:
+    """Residual of (3.62)_7, sum_j (|q_j| - nu_j q_j) / j with q = Q_F lambda_t.
 
-    Zero iff nu_j = sign q_j wherever q_j != 0; relative to the friction work
-    j(lambda_t) = int F |lambda_t| ds, so that stick (q = 0) counts as exact.
+    Zero iff nu_j = sign q_j wherever q_j != 0; relative to the friction work j =
+    max(int F |lambda_t| ds, int F ds times the problem's ``displacement`` scale D
+    (:class:`~ngdual.solvers.scales.Scales`)), so that stick (q = 0) counts as exact and
+    the round-off of a vanishing lambda_t (no load) is not measured against itself.
     """
     q = Q @ lam_t
-    work = float(np.sum(Q @ np.abs(lam_t)))
+    work = max(float(np.sum(Q @ np.abs(lam_t))), float(np.sum(Q)) * displacement)
     return float(np.sum(np.abs(q) - nu * q) / work) if work > 0 else 0.0
 
 
@@ -103,7 +107,7 @@ def friction_residuals(forms: FrictionForms, problem: DiscreteProblem, x: np.nda
     scale = max(np.max(np.abs(tangential), initial=0.0), np.max(np.abs(normal), initial=0.0),
                 np.max(hat_bound, initial=0.0), traction_scale) or 1.0
     return {
-        "nu_sign": sign_residual(Q, nu, lam_t),
+        "nu_sign": sign_residual(Q, nu, lam_t, Scales.of(problem, x).displacement),
         "nu_bound": float(max(0.0, np.abs(nu).max(initial=0.0) - 1.0)),
         "tangential": float(np.max(np.abs(tangential - Q.T @ nu), initial=0.0) / scale),
         "sigma_t_bound": float(max(0.0, np.max(np.abs(tangential) - hat_bound, initial=0.0))
