@@ -17,10 +17,11 @@
 # (Tutorial 6) say where to refine.
 #
 # **What you will learn.** The adaptive loop SOLVE → ESTIMATE → MARK → REFINE, one step
-# of each by hand with the public API, then `nd.adapt`, which runs the loop and returns its
-# history: with the maximum, fixed-fraction (Section 4.2) or Dörfler marking it restores
-# the optimal rate $N^{-1/2}$ on the L-shape (`ngdual.rates.fitted_rate`: the order in
-# $h_N = N^{-1/2}$, $e \sim N^{-\mathrm{rate}/2}$).
+# of each by hand with the public API, then the whole loop by hand, five lines a step: with
+# the maximum, fixed-fraction (Section 4.2) or Dörfler marking it restores the optimal rate
+# $N^{-1/2}$ on the L-shape (`nd.rates.fitted_rate`: the order in $h_N = N^{-1/2}$,
+# $e \sim N^{-\mathrm{rate}/2}$). `nd.adapt` is the same loop, with stopping rules and a
+# history of every step.
 #
 # **References.** M. Andres, *Dual-dual formulations for frictional contact problems in
 # mechanics*, PhD thesis, Leibniz Universität Hannover, 2011:
@@ -42,13 +43,11 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import ngdual as nd
-from ngdual.afem import refine
-from ngdual.mesh import mesh_arrays
-from ngdual.rates import fitted_rate
-from ngdual.studies.tutorials import Lesson
-from ngdual.verification import corner
+from ngdual.studies.tutorials import Lesson  # where figures and results.json go
+from ngdual.verification import corner  # the L-shape and its exact solution
 
-lesson = Lesson("07_adaptivity")               # figures and results.json go here
+mesh_arrays = nd.mesh.mesh_arrays              # vertices and triangles, for the plots
+lesson = Lesson("07_adaptivity")
 QUICK = lesson.quick
 RUNS = {"uniform": ("max", 0.0, 3 if QUICK else 5),
         "max": ("max", 0.5, 4 if QUICK else 10),
@@ -76,13 +75,16 @@ print(f"corner exponent alpha = {alpha:.4f}: the rate of uniform refinement")
 # %% [markdown]
 # ## SOLVE
 #
-# `nd.solve` meshes, assembles and solves. The von Mises stress shows the singularity:
-# the colour scale ends at a percentile (stated on the colour bar), else the re-entrant
-# corner would take all of it.
+# `nd.build_mesh` meshes the geometry on a level; `nd.BoundaryMeshes` groups the fine
+# boundary edges into the coarse meshes $\tilde h$, $\hat h$ of the boundary multipliers;
+# `nd.solve_on_mesh` assembles and solves on that mesh. The von Mises stress shows the
+# singularity: the colour scale ends at a percentile (stated on the colour bar), else the
+# re-entrant corner would take all of it.
 
 # %%
-solution = nd.solve(l_shape, 1)
-mesh = solution.problem.fes.mesh
+mesh = nd.build_mesh(l_shape.geometry, 1)
+coarse = nd.BoundaryMeshes.for_scene(l_shape, mesh)
+solution = nd.solve_on_mesh(l_shape, mesh, coarse)
 print(f"{mesh.ne} triangles, exact error {corner.exact_error(solution, exact):.3e}")
 lesson.save(nd.plot_von_mises(mesh, nd.fields(solution).sigma, l_shape.material.nu,
                               "SOLVE: von Mises stress on the initial mesh"), "solve")
@@ -124,37 +126,41 @@ lesson.save(nd.plot_mesh(points, triangles, "MARK: Dörfler, theta = 0.5",
 # %% [markdown]
 # ## REFINE
 #
-# `refine` bisects the marked triangles and closes the mesh conformingly; the coarse
-# boundary meshes follow inside `nd.adapt` (`BoundaryMeshes.follow`).
+# `nd.refine_with_boundary` bisects the marked triangles, closes the mesh conformingly and
+# carries the coarse boundary meshes over to it: nested, with $\tilde h \approx 2h$ locally.
 
 # %%
-refined = refine(mesh, marked["dorfler"])
+refined, refined_coarse = nd.refine_with_boundary(l_shape, mesh, coarse, marked["dorfler"])
 lesson.save(nd.plot_mesh(*mesh_arrays(refined), f"REFINE: {mesh.ne} -> {refined.ne} triangles"),
             "refine")
 
 # %% [markdown]
-# ## The loop: `nd.adapt`
+# ## The loop
 #
-# `nd.adapt(scene, marking, theta, steps)` repeats the four steps and returns one record
-# per step: DOFs, $\eta$ and its terms, the norms of Tables 3.2/3.3, timings. An `on_step`
-# callback sees the solution, the estimate and the marks of every step; here it computes
-# the exact error and keeps the mesh. Four runs from the same initial mesh:
+# The four steps, repeated from the same initial mesh; each step keeps the number of
+# unknowns $N$, the estimate $\eta$, the exact error and the mesh. The last solve is not
+# marked. Four runs:
 
 
 # %%
 def run(marking: str, theta: float, steps: int) -> dict:
-    """nd.adapt on the L-shape with the exact error and the mesh of every step kept."""
-    kept = {"errors": [], "meshes": []}
-
-    def on_step(record, solution, estimate, marked):
+    """SOLVE, ESTIMATE, MARK, REFINE on the L-shape from level 1: ``steps`` solves."""
+    kept = {"ndofs": [], "etas": [], "errors": [], "meshes": []}
+    mesh = nd.build_mesh(l_shape.geometry, 1)
+    coarse = nd.BoundaryMeshes.for_scene(l_shape, mesh)
+    for step in range(steps):
+        solution = nd.solve_on_mesh(l_shape, mesh, coarse)                      # SOLVE
+        estimate = nd.estimate(solution)                                        # ESTIMATE
+        last = step == steps - 1
+        marked = None if last else nd.mark(estimate.indicators, theta, marking)  # MARK
+        kept["ndofs"].append(int(sum(solution.problem.spaces.dofs().values())))
+        kept["etas"].append(estimate.total)
         kept["errors"].append(corner.exact_error(solution, exact))
-        kept["meshes"].append((*mesh_arrays(solution.problem.fes.mesh), marked))
-
-    kept["history"] = nd.adapt(l_shape, marking, theta, steps, level=1, on_step=on_step)
-    kept["ndofs"] = [r["dofs"]["total"] for r in kept["history"]]
-    kept["etas"] = [r["estimator"] for r in kept["history"]]
-    kept["rates"] = {"error": fitted_rate(kept["ndofs"][-3:], kept["errors"][-3:]),
-                     "eta": fitted_rate(kept["ndofs"][-3:], kept["etas"][-3:])}
+        kept["meshes"].append((*mesh_arrays(mesh), marked))
+        if not last:
+            mesh, coarse = nd.refine_with_boundary(l_shape, mesh, coarse, marked)  # REFINE
+    kept["rates"] = {"error": nd.rates.fitted_rate(kept["ndofs"][-3:], kept["errors"][-3:]),
+                     "eta": nd.rates.fitted_rate(kept["ndofs"][-3:], kept["etas"][-3:])}
     kept["effectivity"] = [e / error for e, error in zip(kept["etas"], kept["errors"])]
     return kept
 
@@ -170,6 +176,19 @@ for name, kept in runs.items():
 # Uniform refinement converges at about the corner exponent $\alpha \approx 0.54$, all
 # adaptive strategies at about the optimal rate 1 (rates from three steps are rough). The
 # estimator follows the error: it overestimates it by a factor between about 2 and 5.
+
+# %% [markdown]
+# `nd.adapt(scene, marking, theta, steps)` runs this loop and returns one record per step
+# (DOFs, $\eta$ and its terms, the norms of Tables 3.2/3.3, timings), and it stops by
+# itself: at a tolerance `tol` of the relative estimate, when the estimate stalls, when the
+# next mesh would not fit in memory, ... (`stopped_by` in its last record says which). On
+# the Dörfler run it computes what the loop above computed:
+
+# %%
+history = nd.adapt(l_shape, *RUNS["dorfler"], level=1)
+same = [r["dofs"]["total"] for r in history] == runs["dorfler"]["ndofs"]
+print(f"nd.adapt: the same unknowns at every step: {same}; stopped by "
+      f"{history[-1]['stopped_by']}")
 
 # %%
 fig, ax = plt.subplots(figsize=(7, 5))
@@ -205,6 +224,7 @@ lesson.results({
     "marking_share": {s: float(np.sum(indicators[m] ** 2) / np.sum(indicators**2))
                       for s, m in marked.items()},
     "refined_elements": int(refined.ne),
+    "adapt_matches_the_loop": same,
     "l_shape": {name: {k: kept[k] for k in ("ndofs", "errors", "etas", "rates", "effectivity")}
                 for name, kept in runs.items()},
 })
@@ -217,11 +237,11 @@ lesson.results({
 #    $\theta \in \{0.2, 0.5, 0.8\}$. Compare the rates, the number of SOLVE steps needed
 #    to reach $N \approx 5000$ and the error there. What happens as $\theta \to 1$?
 # 2. **Which terms refine Example 3.46?** Run the fraction strategy with the indicator
-#    restricted to $\eta_{\sigma,T}$ (4.15) (mark with `Estimate.eta_sigma` in a loop of
-#    your own, using `ngdual.afem.refine` and `BoundaryMeshes.follow`) and compare the
+#    restricted to $\eta_{\sigma,T}$ (4.15) (mark with `Estimate.eta_sigma` in the loop
+#    above) and compare the
 #    meshes with those of $\eta_{tot,T}$. Which terms put the refinement on $\Gamma_N$ and
 #    $\Gamma_C$?
 # 3. **The corners of Example 3.46.** Refine `thesis-3.46-frictionless` uniformly and
 #    with Dörfler marking ($\theta = 0.5$), once with the gap $g = 0.01$ and once with
 #    $g = 0$ (`nd.load_scene(..., ["contact.gap='0'"])`). Compare $\eta$, its rate
-#    (`fitted_rate`) and the largest asymmetry indicator. Explain the difference.
+#    (`nd.rates.fitted_rate`) and the largest asymmetry indicator. Explain the difference.
