@@ -31,7 +31,7 @@ from .boundary import BoundaryMeshes, CoarseMesh, FacetMesh, end_rule, host_spac
 from .boundary.coarse_order import CoarseOrderMesh
 from .contact import ContactBoundary, curve_normal, gap_coefficient, trace_space
 from .expr import Expression
-from .geometry import tangent
+from .geometry import length_scale, tangent
 from .scene import Scene
 from .sparse import to_scipy
 
@@ -460,6 +460,15 @@ class DiscreteProblem:
     def n_peers(self) -> int:
         """The number of PEERS unknowns (sigma, u, eta: they come first; K's PEERS block)."""
         return max(self.blocks[name].stop for name in peers.PEERS if name in self.blocks)
+
+    @property
+    def units(self) -> tuple[float, float]:
+        """(E*, L): the plane-strain modulus E / (1 - nu^2) and the body's length scale
+        (:func:`ngdual.geometry.length_scale`), the units in which a solver judges its
+        residuals (:class:`ngdual.solvers.scales.Scales`)."""
+        material = self.scene.material
+        return (material.E / (1.0 - material.nu ** 2),
+                length_scale(self.scene.geometry.curves()))
 
     def apply(self, x: np.ndarray) -> np.ndarray:
         """K x, without forming K if it is not formed yet (:meth:`BrokenPeers.apply`)."""

@@ -32,7 +32,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..forms import DiscreteProblem
-from ..geometry import length_scale
 from ..peers import STRESS
 
 TOLERANCE = 1e-9   # relative residuals of (3.62) accepted as round-off
@@ -60,12 +59,10 @@ class Scales:
     @classmethod
     def of(cls, problem: DiscreteProblem, x: np.ndarray) -> Scales:
         """The scales of ``problem`` at its solution ``x``."""
-        scene = problem.scene
         moved = np.abs(x[problem.index(*DISPLACEMENTS)])
         D = max(float(np.max(moved, initial=0.0)), float(np.max(np.abs(problem.lift),
                                                                 initial=0.0)))
-        modulus = scene.material.E / (1.0 - scene.material.nu ** 2)
-        L = length_scale(scene.geometry.curves())
+        modulus, L = problem.units
         sigma = problem.index(*STRESS)
         S = max(modulus * D / L, float(np.max(np.abs(x[sigma]), initial=0.0)))
         reference = np.full(problem.n, D)
