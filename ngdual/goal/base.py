@@ -23,13 +23,14 @@ class Measure:
     root-sum-square ``total`` (the estimate of the goal's error), the ``size`` of the
     solution it is relative to, the same size on the whole of what the goal can measure
     (``whole``: the pressure on all of Gamma_C for a window of it) and, where the goal has
-    them, its summed ``terms``."""
+    its own indicators, their summed ``terms`` and the wall time they took (``seconds``)."""
 
     indicators: np.ndarray
     total: float
     size: float
     whole: float
     terms: dict[str, float] = field(default_factory=dict)
+    seconds: float | None = None
 
 
 class Goal:
