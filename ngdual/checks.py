@@ -75,6 +75,7 @@ import numpy as np
 
 from . import peers
 from .expr import Expression
+from .forms import traction_coefficient
 from .friction import FrictionForms, build_friction_forms
 from .geometry import round_off
 from .scene import Contact, contact_junctions
@@ -217,7 +218,7 @@ def applied_load(solution: Solution) -> np.ndarray:
     load = np.array(ngs.Integrate(field(scene.loads.body_force), mesh, order=6))
     if scene.labels("neumann"):
         region = mesh.Boundaries("|".join(scene.labels("neumann")))
-        load = load + np.array(ngs.Integrate(field(scene.loads.traction), mesh, ngs.BND,
+        load = load + np.array(ngs.Integrate(traction_coefficient(scene, mesh), mesh, ngs.BND,
                                              order=6, definedon=region))
     return load
 

@@ -63,7 +63,7 @@ import numpy as np
 from . import peers
 from .contact import gap_coefficient
 from .expr import Expression
-from .forms import boundary_regex, parallel_tasks
+from .forms import boundary_regex, parallel_tasks, traction_coefficient
 from .geometry import tangent
 from .mesh import element_diameters
 from .quantities import fields, require_solution
@@ -317,7 +317,7 @@ def estimate(solution: Solution, asymmetry: str = "l2") -> Estimate:
     if f.phi is not None:
         gf = dict(zip(pb.names, f.gf.components))
         dphi = ngs.CF((ngs.grad(gf["phi1"]) * t, ngs.grad(gf["phi2"]) * t))
-        t0 = ngs.CF(tuple(Expression(e).coefficient() for e in scene.loads.traction))
+        t0 = traction_coefficient(scene, mesh)
         on_edges["jump_neumann"] = he * edges.integrals(squared(w_t + dphi), labels_n)
         on_edges["u_neumann"] = he * edges.integrals(squared(f.phi + u_gamma), labels_n)
         on_edges["neumann"] = (np.log(1 + neighbour_ratio(spaces.neumann))

@@ -523,6 +523,26 @@ class DiscreteProblem:
         return self.P @ x + self.lift
 
 
+def traction_coefficient(scene: Scene, mesh: ngs.Mesh) -> ngs.CoefficientFunction:
+    """The traction t0 on Gamma_N as one vector coefficient: the formula pair of each
+    Gamma_N side on that side (:meth:`~ngdual.scene.Scene.tractions`), zero elsewhere.
+
+    >>> from ngdual.mesh import build_mesh
+    >>> from ngdual.scene import load_scene
+    >>> scene = load_scene("hertz-cylinder", ['loads.traction={left = ["1", "0"]}'])
+    >>> mesh = build_mesh(scene.geometry, 1)
+    >>> t0 = traction_coefficient(scene, mesh)
+    >>> gamma_n = mesh.Boundaries("left|right")          # the sides are 4 long, right is free
+    >>> [round(v, 6) for v in ngs.Integrate(t0, mesh, ngs.BND, definedon=gamma_n)]
+    [4.0, 0.0]
+    """
+    pairs = {label: tuple(both) for label, both in scene.tractions().items()}
+    if len(set(pairs.values())) == 1:  # one formula pair on every side: no per-side switch
+        return ngs.CF(tuple(Expression(e).coefficient() for e in next(iter(pairs.values()))))
+    return mesh.BoundaryCF({label: ngs.CF(tuple(Expression(e).coefficient() for e in both))
+                            for label, both in pairs.items()}, default=ngs.CF((0.0, 0.0)))
+
+
 def _forms(scene: Scene, fes: ngs.FESpace, names: list[str]):
     """The forms of (3.62) besides the PEERS block (:func:`broken_peers`): the couplings d_N,
     d_C with the boundary multipliers (None without Gamma_N and Gamma_C) and the right-hand
@@ -552,8 +572,7 @@ def _forms(scene: Scene, fes: ngs.FESpace, names: list[str]):
                       intrules=TRACE_RULES)
         phi, psi = ngs.CF((trial["phi1"], trial["phi2"])), ngs.CF((test["phi1"], test["phi2"]))
         d += (phi * trac_tau + psi * trac_sig) * ds_n                         # d_N(phi, tau)
-        t0 = ngs.CF(tuple(Expression(e).coefficient() for e in scene.loads.traction))
-        rhs += t0 * psi * ds_n                                                # t0(psi)
+        rhs += traction_coefficient(scene, mesh) * psi * ds_n                 # t0(psi)
     if "lam_n" in names:
         ds_c = ngs.ds(definedon=mesh.Boundaries(boundary_regex(scene.labels("contact"))),
                       intrules=TRACE_RULES)

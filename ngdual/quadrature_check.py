@@ -38,8 +38,12 @@ def formulas_on_mesh(scene: Scene) -> list[tuple[str, Expression, str | None]]:
     out = [(f"loads.body_force[{i}]", Expression(e), None)
            for i, e in enumerate(scene.loads.body_force)]
     if scene.labels("neumann"):
-        out += [(f"loads.traction[{i}]", Expression(e), "neumann")
-                for i, e in enumerate(scene.loads.traction)]
+        if isinstance(scene.loads.traction, dict):  # a pair per side (Scene.tractions)
+            out += [(f"loads.traction.{label}[{i}]", Expression(e), "neumann")
+                    for label, both in scene.tractions().items() for i, e in enumerate(both)]
+        else:
+            out += [(f"loads.traction[{i}]", Expression(e), "neumann")
+                    for i, e in enumerate(scene.loads.traction)]
     out += [(f"loads.displacement[{i}]", Expression(e), "dirichlet")
             for i, e in enumerate(scene.loads.displacement)]
     if scene.has_contact and scene.contact.foundation is None:

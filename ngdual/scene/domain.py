@@ -164,19 +164,25 @@ def validate_formulas_on_sides(scene: Scene, loads: dict[str, list[Expression]])
     """
     problems = Problems()
     curves = scene.geometry.curves()
-    where = {"neumann": "Gamma_N", "dirichlet": "Gamma_D", "contact": "Gamma_C"}
-    fields = [(f"loads.traction[{i}]", e, "neumann") for i, e in enumerate(loads["traction"])]
-    fields += [(f"loads.displacement[{i}]", e, "dirichlet")
+    if isinstance(scene.loads.traction, dict):  # each pair on its own side
+        fields = [(f"loads.traction.{label}[{i}]", e, [label], "Gamma_N")
+                  for label, both in loads["traction"].items() for i, e in enumerate(both)]
+    else:  # the one pair of every side, checked on all of them together
+        both = next(iter(loads["traction"].values()), [])
+        fields = [(f"loads.traction[{i}]", e, scene.labels("neumann"), "Gamma_N")
+                  for i, e in enumerate(both)]
+    fields += [(f"loads.displacement[{i}]", e, scene.labels("dirichlet"), "Gamma_D")
                for i, e in enumerate(loads["displacement"])]
     con, fr = scene.contact, scene.friction
     if scene.has_contact and con.foundation is None:
-        fields.append(("contact.gap", Expression(con.gap_formula), "contact"))
+        fields.append(("contact.gap", Expression(con.gap_formula), scene.labels("contact"),
+                       "Gamma_C"))
     if fr.law == "tresca":
-        fields.append(("friction.bound", Expression(fr.bound), "contact"))
-    for name, expr, role in fields:
+        fields.append(("friction.bound", Expression(fr.bound), scene.labels("contact"),
+                       "Gamma_C"))
+    for name, expr, labels, where in fields:
         with problems.check():
-            _formula_on_sides(expr, name, [c for c in curves if c.label in scene.labels(role)],
-                              where[role])
+            _formula_on_sides(expr, name, [c for c in curves if c.label in labels], where)
     problems.raise_any()
 
 

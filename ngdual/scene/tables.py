@@ -156,10 +156,15 @@ class Material:
 
 @dataclass
 class Loads:
-    """Body force f, traction t0 on Gamma_N, prescribed displacement on Gamma_D."""
+    """Body force f, traction t0 on Gamma_N, prescribed displacement on Gamma_D.
+
+    ``traction`` is one formula pair ``[tx, ty]`` for every side of Gamma_N, or a table
+    keyed by Gamma_N label, ``{top = ["0", "-1000"], left = ["0", "0"]}``, whose sides not
+    listed are traction-free (:meth:`Scene.tractions`).
+    """
 
     body_force: list = field(default_factory=lambda: ["0", "0"])
-    traction: list = field(default_factory=lambda: ["0", "0"])
+    traction: list | dict = field(default_factory=lambda: ["0", "0"])
     displacement: list = field(default_factory=lambda: ["0", "0"])
 
 
@@ -372,6 +377,20 @@ class Scene:
     def labels(self, role: str) -> list[str]:
         """Boundary labels with the given role (dirichlet, neumann, contact)."""
         return list(self.boundary.get(role, []))
+
+    def tractions(self) -> dict[str, list]:
+        """The traction t0 on each side of Gamma_N: ``{label: [tx, ty]}``, one formula pair
+        per Gamma_N label (``["0", "0"]`` for a side the ``loads.traction`` table omits).
+
+        >>> from ngdual.scene import load_scene
+        >>> scene = load_scene("hertz-cylinder", ['loads.traction={left = ["0", "-1"]}'])
+        >>> scene.labels("neumann"), scene.tractions()
+        (['left', 'right'], {'left': ['0', '-1'], 'right': ['0', '0']})
+        """
+        given = self.loads.traction
+        if not isinstance(given, dict):
+            return {label: list(given) for label in self.labels("neumann")}
+        return {label: list(given.get(label, ["0", "0"])) for label in self.labels("neumann")}
 
     def to_dict(self) -> dict:
         """The scene as plain data (for result records)."""

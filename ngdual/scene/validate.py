@@ -33,7 +33,7 @@ from .tables import (
     Solver,
     Units,
 )
-from .values import expression, finite, pair, positive, show, type_problems
+from .values import expression, finite, pair, positive, show, tractions, type_problems
 
 
 def check_level(level, field_name: str = "level", optional: bool = False) -> int | None:
@@ -86,9 +86,12 @@ def validate(scene: Scene) -> None:
         problems.run(_validate_material, scene.material)
     loads = {}
     if ok["loads"]:
-        for key in ("body_force", "traction", "displacement"):
+        for key in ("body_force", "displacement"):
             loads[key] = problems.run(pair, getattr(scene.loads, key), f"loads.{key}",
                                       value=True)
+        loads["traction"] = problems.run(tractions, scene.loads.traction,
+                                         scene.labels("neumann") if ok["boundary"] else None,
+                                         value=True)
         ok["loads"] = all(v is not None for v in loads.values())
     if ok["contact"]:
         ok["contact"] = problems.run(_validate_contact_settings, scene.contact)

@@ -58,6 +58,35 @@ def pair(values, field_name: str) -> list[Expression]:
     return out
 
 
+def tractions(value, neumann: list[str] | None) -> dict[str, list[Expression]]:
+    """``loads.traction`` checked: one pair ``[tx, ty]`` for every side of Gamma_N, or a table
+    keyed by the labels ``neumann`` of Gamma_N (a side not listed is traction-free).
+
+    Returns ``{label: [tx, ty]}`` for every Gamma_N side; with ``neumann`` None (the
+    boundary table is wrong) only the formulas are checked, and the labels given returned.
+    """
+    if not isinstance(value, (dict, list, tuple)):
+        raise SceneError("loads.traction", 'must be a pair [tx, ty] or a table keyed by '
+                                           'Gamma_N label, e.g. {top = ["0", "-1"]}, got '
+                                           f"{show(value)}")
+    if not isinstance(value, dict):
+        both = pair(value, "loads.traction")
+        return {label: both for label in neumann or []}
+    problems = Problems()
+    given = {}
+    for label, formulas in value.items():
+        if neumann is not None and label not in neumann:
+            problems.add("loads.traction", f"{show(label)} is not a side of Gamma_N; the "
+                                           "table is keyed by the labels of boundary.neumann"
+                                           f" ({', '.join(neumann) or 'none'})")
+            continue
+        with problems.check():
+            given[label] = pair(formulas, f"loads.traction.{label}")
+    problems.raise_any()
+    free = [Expression("0"), Expression("0")]
+    return {label: given.get(label, free) for label in (given if neumann is None else neumann)}
+
+
 # What each setting must be; the formulas (loads, contact.gap, friction.bound) are checked
 # by parsing them, the tables of geometry (points, labels, arcs, side_maxh) entry by entry.
 _TYPES = {"str": (str,), "int": (int,), "float": (int, float), "list": (list, tuple),
