@@ -10,7 +10,9 @@ solves one scene, prints the result table and writes ``DIR/result.json``
 runs the adaptive loop and writes ``DIR/history.json`` plus a mesh (.vol, .png with the
 marked triangles shaded) and, with ``--vtk``, a VTK file per step.
 ``ngdual tutorials [--notebooks DIR] [--solutions]`` lists the lecture tutorials or
-writes them as Jupyter notebooks.
+writes them as Jupyter notebooks; ``ngdual tutorials run NAME [--quick] [--out DIR]`` runs
+one as a script and lists the files it wrote. ``ngdual show SCENE [--level N] [--out DIR]``
+draws the geometry, its boundary labels and the initial mesh without solving.
 ``ngdual bench BENCHMARK [--json FILE]`` runs one benchmark of :mod:`ngdual.studies.bench`:
 ``limit-ratio`` (the contact solvers against one linear solve of the same matrix),
 ``levels``, ``estimator-cost``, ``infsup``, ``primal-peer``.
@@ -49,7 +51,7 @@ from .output import (
     EXIT_WARNINGS,
 )
 from .pipeline import EXIT_MEMORY, cmd_adapt, cmd_dofs, cmd_scenes, cmd_solve
-from .studies import cmd_bench, cmd_figures, cmd_tutorials, cmd_verify
+from .studies import cmd_bench, cmd_figures, cmd_show, cmd_tutorials, cmd_verify
 
 
 def parser() -> argparse.ArgumentParser:
@@ -149,15 +151,44 @@ def parser() -> argparse.ArgumentParser:
                          "solution fails a physics check, writing nothing for it "
                          "(history.json keeps the steps before)")
     ad.set_defaults(func=cmd_adapt)
-    tu = sub.add_parser("tutorials", help="list the tutorials or write them as notebooks",
-                        parents=[common])
+    tu = sub.add_parser("tutorials", help="list the tutorials, write them as notebooks or run "
+                                          "one", parents=[common])
     tu.add_argument("--notebooks", metavar="DIR", default=None,
-                    help="write the tutorials as .ipynb notebooks into DIR (the tutorials extra)")
+                    help="write the tutorials as .ipynb notebooks into DIR (with the core "
+                         "install; Jupyter itself comes with the tutorials extra)")
     tu.add_argument("--solutions", action="store_true",
                     help="with --notebooks: also write the exercise solutions to DIR/solutions")
     tu.add_argument("--source", metavar="DIR", default=None,
                     help="tutorials folder (default: tutorials/ of the source checkout)")
-    tu.set_defaults(func=cmd_tutorials)
+    tu.set_defaults(func=cmd_tutorials, action=None)
+    tutorial = tu.add_subparsers(dest="action", metavar="run NAME",
+                                 help="run one tutorial as a script (ngdual tutorials run "
+                                      "--help)")
+    run = tutorial.add_parser("run", help="run one tutorial as a script, headless "
+                                          "(matplotlib's Agg backend), and list the files it "
+                                          "wrote", parents=[common])
+    run.add_argument("name", metavar="NAME",
+                     help="the tutorial: its file name, number or topic, e.g. 07_adaptivity, "
+                          "7 or adaptivity (a solution: 07_adaptivity_solutions)")
+    run.add_argument("--out", default="tutorial-output",
+                     help="output folder; the tutorial writes into DIR/NAME (default: "
+                          "tutorial-output)")
+    run.add_argument("--quick", action="store_true",
+                     help="coarse meshes and short sweeps (NGDUAL_QUICK=1): seconds instead "
+                          "of minutes")
+    run.add_argument("--source", metavar="DIR", default=argparse.SUPPRESS,
+                     help="tutorials folder (default: tutorials/ of the source checkout)")
+    sh = sub.add_parser("show", help="draw a scene's geometry, boundary labels and initial "
+                                     "mesh into DIR/geometry.png, without solving",
+                        parents=[sized])
+    sh.add_argument("scene", help="path to a TOML scene or the name of a shipped scene")
+    sh.add_argument("--level", type=int, default=1,
+                    help="mesh level (default 1, the initial mesh; the scene's level is the "
+                         "one ngdual solve uses)")
+    sh.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="override a scene entry, e.g. --set geometry.maxh=0.5")
+    sh.add_argument("--out", default="out", help="output folder (default: out)")
+    sh.set_defaults(func=cmd_show)
     fg = sub.add_parser("figures", help="regenerate every figure and table of Sections 3.4 "
                                         "and 4.2 (and the work-precision study)",
                         parents=[sized])

@@ -5,7 +5,7 @@ from __future__ import annotations
 import sys
 import warnings
 
-from ..scene import SceneError, check_level, load_scene, shipped_scenes
+from ..scene import SceneError, check_level, load_scene, read_toml, shipped_scenes
 from ..solvers.result import PhysicsWarning
 from .output import (
     EXIT_NOT_CONVERGED,
@@ -89,10 +89,14 @@ def solution_figures(solution, out) -> list:
 
 
 def cmd_scenes(args) -> int:
+    """Each shipped scene: name, geometry, friction law, and its description wrapped below."""
+    import textwrap
+
     for name in shipped_scenes():
-        scene = load_scene(name)
-        print(f"{name:34s} {scene.geometry.kind:12s} friction={scene.friction.law:8s} "
-              f"gap={'foundation line' if scene.contact.foundation else scene.contact.gap_formula}")
+        scene, description = load_scene(name), read_toml(name)[1].get("description", "")
+        print(f"{name:30s} {scene.geometry.kind:12s} friction={scene.friction.law}")
+        print(textwrap.fill(description, width=88, initial_indent="    ",
+                            subsequent_indent="    "))
     return 0
 
 

@@ -1,5 +1,6 @@
-"""``ngdual figures``, ``bench``, ``verify`` and ``tutorials``: the run machinery of
-:mod:`ngdual.studies` and :mod:`ngdual.verification` from the command line."""
+"""``ngdual figures``, ``bench``, ``verify``, ``tutorials`` and ``show``: the run machinery of
+:mod:`ngdual.studies` and :mod:`ngdual.verification`, and the picture of a scene before it is
+solved, from the command line."""
 
 from __future__ import annotations
 
@@ -220,25 +221,67 @@ def cmd_verify(args) -> int:
 
 
 def cmd_tutorials(args) -> int:
-    """List the tutorials; with --notebooks DIR write them (and their solutions) as notebooks."""
+    """List the tutorials; with --notebooks DIR write them (and their solutions) as notebooks;
+    ``run NAME`` runs one as a script, headless, and lists the files it wrote."""
     from ..io import check_output_dir
-    from ..studies.tutorials import list_tutorials, write_notebooks
+    from ..studies.tutorials import find_tutorial, list_tutorials, run_tutorial, write_notebooks
 
+    if args.action == "run":
+        try:
+            item = find_tutorial(args.name, args.source)
+        except LookupError as err:
+            raise SceneError("NAME", str(err)) from None
+        except FileNotFoundError as err:
+            raise SceneError("--source", str(err)) from None
+        out = check_output_dir(args.out, "--out")
+        status, written = run_tutorial(item, out, quick=True if args.quick else None)
+        print(f"\n{item.name} wrote {len(written)} files:")
+        for path in written:
+            print(f"  {path}")
+        if status:
+            print(f"ngdual: tutorial {item.name} failed with exit status {status}",
+                  file=sys.stderr)
+            return 1
+        return 0
     if args.notebooks:
         check_output_dir(args.notebooks, "--notebooks")
     try:
         items = list_tutorials(args.source)
         if args.notebooks:
             written = write_notebooks(args.notebooks, args.source, solutions=args.solutions)
-    except (FileNotFoundError, ImportError) as err:
+    except FileNotFoundError as err:
         print(f"ngdual: error: {err}", file=sys.stderr)
         return EXIT_BAD_INPUT
     if not args.notebooks:
         for item in items:
             print(f"{item.number:2d}  {item.title}  ({item.path})")
+        print("run one with: ngdual tutorials run NAME (e.g. ngdual tutorials run "
+              f"{items[0].name if items else '01'})")
         return 0
     for path in written:
         print(f"wrote {path}")
-    print("execute one with: NGDUAL_QUICK=1 jupyter nbconvert --to notebook --execute "
-          f"{written[0] if written else 'NOTEBOOK'}")
+    print("open them with: jupyter lab " + str(args.notebooks) + "  (or execute one: "
+          "jupyter nbconvert --to notebook --execute "
+          f"{written[0] if written else 'NOTEBOOK'}; pip install \"ngdual[tutorials]\")")
+    return 0
+
+
+def cmd_show(args) -> int:
+    """Draw SCENE's domain, its boundary parts with their labels and the mesh of --level
+    (default 1, the initial mesh; :func:`ngdual.plot.plot_geometry`) into DIR/geometry.png,
+    without solving."""
+    from .. import budget
+    from ..io import check_output_dir
+    from ..mesh import build_mesh
+    from ..plot import plot_geometry, save_figure
+    from ..scene import check_level, load_scene
+
+    level = check_level(args.level, "--level")
+    scene = load_scene(args.scene, args.set)
+    out = check_output_dir(args.out, "--out")
+    budget.check_scene(scene, level, "--level", args.allow_large, mesh_only=True)
+    mesh = build_mesh(scene.geometry, level)
+    fig = plot_geometry(scene, mesh, title=f"{scene.name}: boundary parts and the mesh of "
+                                           f"level {level} ({mesh.ne} triangles)")
+    print(f"wrote {save_figure(fig, out / 'geometry.png')[0]}")
     return 0

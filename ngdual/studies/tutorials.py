@@ -4,9 +4,11 @@ The tutorials are jupytext percent-format scripts (``# %%`` cells) named
 ``NN_topic.py``; their exercise solutions live in ``tutorials/solutions/`` as
 ``NN_topic_solutions.py``. They run top to bottom as plain scripts
 (``python tutorials/01_peers_spaces.py``) and as notebooks written by
-``ngdual tutorials --notebooks DIR``. They compute and draw with the public API
-(``import ngdual as nd``); a :class:`Lesson` is all they take from here: whether to run
-on coarse settings, and where their pictures and numbers go.
+``ngdual tutorials --notebooks DIR`` (:func:`write_notebooks`, with the core install: the
+percent format is read here, the notebooks are plain nbformat-4 JSON), and one runs as a
+script with ``ngdual tutorials run NAME`` (:func:`run_tutorial`). They compute and draw with
+the public API (``import ngdual as nd``); a :class:`Lesson` is all they take from here:
+whether to run on coarse settings, and where their pictures and numbers go.
 
 Environment variables
 ---------------------
@@ -23,12 +25,14 @@ Environment variables
 
 from __future__ import annotations
 
+import json
 import os
 import re
+import subprocess
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..extras import require
 from ..io import write_json
 from .sources import scripts_folder
 
@@ -38,6 +42,7 @@ DEFAULT_OUT = "tutorial-output"
 TRUE_WORDS = ("1", "true", "yes", "on")
 _NAME = re.compile(r"^(\d\d)_[a-z0-9_]+\.py$")
 KERNELSPEC = {"name": "python3", "display_name": "Python 3 (ipykernel)", "language": "python"}
+_CELL = re.compile(r"^# %%(?:\s+\[(\w+)\])?")   # a percent-format cell marker and its type
 
 
 def quick_mode() -> bool:
@@ -76,15 +81,21 @@ class Lesson:
         self.quick = quick_mode()
         self.out = Path(os.environ.get(OUT_ENV, DEFAULT_OUT)) / name
         self.out.mkdir(parents=True, exist_ok=True)
+        self.saved: set[Path] = set()
+
+    def _write(self, fig, name: str) -> Path:
+        from ..plot import save_figure
+
+        path = save_figure(fig, self.out / f"{name}.png", dpi=120)[0]
+        self.saved.add(path)
+        return path
 
     def save(self, fig, name: str) -> Path:
         """Save ``fig`` as ``out/name.png`` (:func:`ngdual.plot.save_figure`, which closes
         it); show the file in a notebook, print its path in a script. Headless runs thus
         keep every picture, and a notebook shows it whatever matplotlib backend is active.
         """
-        from ..plot import save_figure
-
-        path = save_figure(fig, self.out / f"{name}.png", dpi=120)[0]
+        path = self._write(fig, name)
         if in_notebook():
             from IPython.display import Image, display
 
@@ -93,16 +104,37 @@ class Lesson:
             print(f"saved {path}")
         return path
 
-    def draw(self, obj, *args, **kwargs) -> None:
-        """NGSolve's interactive webgui ``Draw`` inside a notebook; nothing in a script,
-        where the saved matplotlib pictures are the ones that always exist."""
+    def draw(self, cf, mesh, name: str, **kwargs) -> Path:
+        """A field to turn and zoom: NGSolve's interactive webgui ``Draw(cf, mesh, name)``
+        in a notebook, the picture ``out/name.png`` in a script.
+
+        The picture is the one this lesson saved as ``name`` (:meth:`save`), else the
+        element means of ``cf`` (its norm if it is a vector) drawn here; a notebook
+        without the webgui (the ``tutorials`` extra) shows that picture instead.
+        """
+        path = self.out / f"{name}.png"
+        if path not in self.saved:
+            import ngsolve as ngs
+
+            from ..plot import plot_element_field
+            from ..post import element_values
+
+            scalar = ngs.Norm(cf) if cf.dim > 1 else cf
+            fig = plot_element_field(*element_values(mesh, scalar), f"{self.name}: {name}",
+                                     name)
+            path = self._write(fig, name)
         if not in_notebook():
-            return
+            print(f"saved {path} (a notebook shows it with NGSolve's interactive Draw)")
+            return path
         try:
             from ngsolve.webgui import Draw
         except ImportError:
-            return
-        Draw(obj, *args, **kwargs)
+            from IPython.display import Image, display
+
+            display(Image(filename=str(path)))
+            return path
+        Draw(cf, mesh, name, **kwargs)
+        return path
 
     def results(self, numbers: dict) -> Path:
         """Write ``numbers`` (and ``quick``) to ``out/results.json``: what the test suite
@@ -152,14 +184,99 @@ def list_tutorials(folder: str | Path | None = None, solutions: bool = False) ->
     return found
 
 
+def find_tutorial(name: str, folder: str | Path | None = None) -> Tutorial:
+    """The tutorial (or solution) called ``name``: its file stem (``07_adaptivity``), its
+    file name, its number (``7``, ``07``) or its topic (``adaptivity``).
+
+    >>> find_tutorial("7").name
+    '07_adaptivity'
+    """
+    items = list_tutorials(folder)
+    if (Path(folder) if folder is not None else tutorials_dir()).joinpath("solutions").is_dir():
+        items += list_tutorials(folder, solutions=True)
+    key = Path(str(name)).name.removesuffix(".py")
+    for item in items:
+        if key in (item.name, item.name[3:]) or key.isdigit() and int(key) == item.number:
+            return item
+    raise LookupError(f"unknown tutorial {key!r}; the tutorials are "
+                      + ", ".join(item.name for item in items if item.path.parent == items[0]
+                                  .path.parent) + " (and their NN_topic_solutions)")
+
+
+def run_tutorial(item: Tutorial, out: str | Path = DEFAULT_OUT,
+                 quick: bool | None = None) -> tuple[int, list[Path]]:
+    """Run one tutorial as a script in a fresh Python, headless (matplotlib's Agg backend),
+    its output below ``out``; its printout goes to this process' terminal.
+
+    ``quick``: coarse settings (None: as ``NGDUAL_QUICK`` says). Returns the script's exit
+    status and the files it wrote (new or rewritten below ``out``), sorted.
+    """
+    out = Path(out)
+    before = _stamps(out)
+    env = dict(os.environ, MPLBACKEND="Agg", **{OUT_ENV: str(out)})
+    if quick is not None:
+        env[QUICK_ENV] = "1" if quick else "0"
+    status = subprocess.run([sys.executable, str(item.path)], env=env).returncode
+    after = _stamps(out)
+    return status, sorted(path for path, stamp in after.items() if before.get(path) != stamp)
+
+
+def _stamps(folder: Path) -> dict[Path, tuple[int, int]]:
+    """Modification time and size of every file below ``folder``."""
+    return {path: (path.stat().st_mtime_ns, path.stat().st_size)
+            for path in folder.rglob("*") if path.is_file()} if folder.is_dir() else {}
+
+
+def percent_cells(text: str) -> list[tuple[str, str]]:
+    """``(cell_type, source)`` of each cell of a jupytext percent-format script.
+
+    A ``# %% [markdown]`` cell is its comment lines without their ``# ``; a ``# %%`` cell
+    is code as written. Blank lines around a cell belong to no cell.
+
+    >>> percent_cells("# %% [markdown]\\n# # Title\\n#\\n# Text.\\n\\n# %%\\nx = 1\\n")
+    [('markdown', '# Title\\n\\nText.'), ('code', 'x = 1')]
+    """
+    cells: list[tuple[str, list[str]]] = []
+    for line in text.splitlines():
+        marker = _CELL.match(line)
+        if marker:
+            cells.append(("markdown" if marker.group(1) in ("markdown", "md") else "code", []))
+        elif cells:
+            cells[-1][1].append(line)
+        elif line.strip():  # lines before the first marker: one code cell
+            cells.append(("code", [line]))
+    out = []
+    for kind, lines in cells:
+        if kind == "markdown":
+            lines = [line[2:] if line.startswith("# ") else line.lstrip("#") for line in lines]
+        source = "\n".join(lines).strip("\n")
+        if source.strip():
+            out.append((kind, source))
+    return out
+
+
+def notebook(path: str | Path) -> dict:
+    """The nbformat-4 notebook of one percent-format script, not executed (plain JSON:
+    ``json.dump`` writes it, Jupyter opens and runs it)."""
+    cells = []
+    for number, (kind, source) in enumerate(percent_cells(Path(path).read_text("utf-8"))):
+        cell = {"cell_type": kind, "id": f"cell-{number}", "metadata": {},
+                "source": source.splitlines(keepends=True)}
+        if kind == "code":
+            cell.update(execution_count=None, outputs=[])
+        cells.append(cell)
+    return {"cells": cells, "nbformat": 4, "nbformat_minor": 5,
+            "metadata": {"kernelspec": dict(KERNELSPEC),
+                         "language_info": {"name": "python"}}}
+
+
 def write_notebooks(dest: str | Path, folder: str | Path | None = None,
                     solutions: bool = False) -> list[Path]:
-    """Convert the tutorials to ``.ipynb`` files in ``dest`` with jupytext.
+    """Write the tutorials as ``.ipynb`` notebooks (:func:`notebook`) into ``dest``.
 
     With ``solutions=True`` the solutions go to ``dest/solutions`` as well.
-    Returns the paths written. Needs the ``tutorials`` extra (jupytext).
+    Returns the paths written. Needs only the core install.
     """
-    jupytext = require("jupytext", "tutorials")
     dest = Path(dest)
     groups = [(dest, list_tutorials(folder))]
     if solutions:
@@ -168,9 +285,8 @@ def write_notebooks(dest: str | Path, folder: str | Path | None = None,
     for target, items in groups:
         target.mkdir(parents=True, exist_ok=True)
         for item in items:
-            notebook = jupytext.read(item.path, fmt="py:percent")
-            notebook.metadata["kernelspec"] = dict(KERNELSPEC)
             path = target / (item.name + ".ipynb")
-            jupytext.write(notebook, path, fmt="ipynb")
+            path.write_text(json.dumps(notebook(item.path), indent=1, ensure_ascii=False)
+                            + "\n", encoding="utf-8")
             written.append(path)
     return written
