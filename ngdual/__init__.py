@@ -44,7 +44,7 @@ _PUBLIC = {
     "Scene": ("ngdual.scene", "Scene"),
     "SceneError": ("ngdual.scene", "SceneError"),
     "solve": ("ngdual.solvers", "solve_scene"),
-    "Solution": ("ngdual.solvers", "Solution"),
+    "Solution": ("ngdual.solution", "Solution"),
     "adapt": ("ngdual.afem", "adapt"),
     "build_mesh": ("ngdual.mesh", "build_mesh"),
     "BoundaryMeshes": ("ngdual.boundary", "BoundaryMeshes"),

@@ -1,9 +1,9 @@
 """Physics checks of a discrete solution: what a user should not believe, one line each.
 
 :func:`physics_checks` runs every check on a solution and returns a
-:class:`~ngdual.solvers.result.CheckWarning` per failed one; :func:`~ngdual.solvers.solve_problem`
+:class:`~ngdual.solution.CheckWarning` per failed one; :func:`~ngdual.solvers.solve_problem`
 stores them in ``Solution.warnings`` and :func:`~ngdual.solvers.solve_scene` (``nd.solve``)
-also issues each as a Python warning (:class:`~ngdual.solvers.result.PhysicsWarning`).
+also issues each as a Python warning (:class:`~ngdual.solution.PhysicsWarning`).
 Each message is one line naming the cause, its size and the remedy. Unlike the solvers,
 the checks read the scene: what meets Gamma_C at its ends and which end values it sets.
 
@@ -79,7 +79,7 @@ from .forms import traction_coefficient
 from .friction import FrictionForms, build_friction_forms
 from .geometry import round_off
 from .scene import Contact, contact_junctions
-from .solvers.result import CheckWarning, Solution
+from .solution import CheckWarning, Solution
 
 TENSION_TOL = 0.05        # tensile hat force, of F_ref
 FORCE_BALANCE_TOL = 0.05  # |int sigma n - sum_i t_i over the hats with a dof|, of F_ref

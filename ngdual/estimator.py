@@ -68,7 +68,7 @@ from .geometry import tangent
 from .mesh import element_diameters
 from .quantities import fields, require_solution
 from .scene import SceneError, SceneTypeError
-from .solvers.result import Solution
+from .solution import Solution
 
 SIGMA_TERMS = ("residual", "asymmetry", "curl", "jump_interior", "jump_dirichlet",
                "jump_neumann", "jump_contact")

@@ -22,7 +22,7 @@ from .geometry import tangent
 from .io import versions
 from .quantities import fields, norms, require_contact
 from .scene import SceneError, SceneTypeError
-from .solvers.result import Solution
+from .solution import Solution
 
 # the sampled traces are evaluated these shares of |e| inside the triangle of their edge,
 # along the edge and across it: NGSolve's point search accepts points within about 1e-8 of

@@ -2,7 +2,7 @@
 
 NGSolve views of every unknown on the fine mesh (:func:`fields`) and the norms that the
 thesis tabulates (:func:`norms`): what the estimator, the adaptive loop and the
-post-processing read from a :class:`ngdual.solvers.result.Solution`. The rotation is
+post-processing read from a :class:`ngdual.solution.Solution`. The rotation is
 ``eta`` (the thesis' eta in Tables 3.2/3.3); the estimator (4.50) is never called eta in a
 record (:mod:`ngdual.afem`).
 """
@@ -16,11 +16,11 @@ import numpy as np
 
 from . import peers
 from .scene import SceneError, SceneTypeError
-from .solvers.result import Solution
+from .solution import Solution
 
 
 def require_solution(value, name: str = "solution") -> Solution:
-    """``value`` if it is a :class:`~ngdual.solvers.result.Solution`; a SceneTypeError
+    """``value`` if it is a :class:`~ngdual.solution.Solution`; a SceneTypeError
     naming the argument ``name`` otherwise (the check of every function of the public API
     that reads a solution)."""
     if not isinstance(value, Solution):

@@ -21,10 +21,10 @@ from ngdual.forms import assemble
 from ngdual.friction import build_friction_forms
 from ngdual.mesh import build_mesh
 from ngdual.scene import load_scene
+from ngdual.solution import ConvergenceError
 from ngdual.solvers import active_set, solve_problem
 from ngdual.solvers.active_set import active_set_solve
 from ngdual.solvers.nested import nested_uzawa
-from ngdual.solvers.result import ConvergenceError
 from ngdual.solvers.semismooth import EPS, SAFETY, condition_number, kkt_residuals
 from ngdual.solvers.settings import ActiveSetSettings, NestedUzawaSettings
 

@@ -273,7 +273,7 @@ def test_uniform_refinement_by_marking_everything_matches_the_levels():
     assert mesh.ne == refine_uniformly(thesis_mesh(1), 1).ne == thesis_mesh(2).ne
 
 
-@pytest.mark.filterwarnings("ignore::ngdual.solvers.result.PhysicsWarning")
+@pytest.mark.filterwarnings("ignore::ngdual.solution.PhysicsWarning")
 def test_the_first_adaptive_step_solves_what_solve_scene_solves_on_its_level():
     """adapt and solve_scene share one SOLVE step (solvers.solve_on_mesh): on the initial
     level they assemble and solve the same problem, to the last bit."""

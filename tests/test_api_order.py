@@ -12,7 +12,7 @@ from ngdual.verification.manufactured import manufactured_case
 from ngdual.verification.manufactured_errors import volume_errors
 
 CONSISTENT = "contact.ends='consistent'"   # the facet multipliers have no thesis ends
-pytestmark = pytest.mark.filterwarnings("ignore::ngdual.solvers.result.PhysicsWarning")
+pytestmark = pytest.mark.filterwarnings("ignore::ngdual.solution.PhysicsWarning")
 
 
 def test_the_order_argument_solves_the_problem_of_the_scenes_order_entry():

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import ngdual as nd
-from ngdual.solvers.result import PhysicsWarning
+from ngdual.solution import PhysicsWarning
 
 FACET_0 = ["discretisation.order=0", "discretisation.multipliers=facet"]
 

@@ -21,12 +21,12 @@ from ngdual.forms import assemble
 from ngdual.friction import build_friction_forms
 from ngdual.mesh import build_mesh
 from ngdual.scene import SceneError, load_scene, shipped_scenes
+from ngdual.solution import ConvergenceError
 from ngdual.solvers import solve_problem, solve_scene
 from ngdual.solvers.active_set import active_set_solve
 from ngdual.solvers.cholesky import SchurCholesky
 from ngdual.solvers.hybrid import HybridSystem
 from ngdual.solvers.qp import solve_qp_friction
-from ngdual.solvers.result import ConvergenceError
 from ngdual.solvers.semismooth import EPS, SAFETY, kkt_residuals, semismooth_newton
 from ngdual.solvers.settings import ActiveSetSettings, Model, UzawaSettings
 from ngdual.solvers.uzawa import uzawa

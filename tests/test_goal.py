@@ -25,8 +25,8 @@ from ngdual.estimator import estimate
 from ngdual.goal import goal_estimate, goal_for, singular_free_ends
 from ngdual.mesh import build_mesh
 from ngdual.scene import SceneError, SceneTypeError, load_scene
+from ngdual.solution import PhysicsWarning
 from ngdual.solvers import solve_on_mesh, solve_scene
-from ngdual.solvers.result import PhysicsWarning
 from ngdual.verification.benchmark import center_coordinate, exact_solution
 from ngdual.verification.overkill import nodes_to_samples, pressure_error, solution_samples
 from ngdual.verification.overkill import pressure_errors as sample_pressure_errors

@@ -12,9 +12,9 @@ from ngdual.forms import assemble
 from ngdual.mesh import build_mesh
 from ngdual.quantities import norms
 from ngdual.scene import load_scene
+from ngdual.solution import ConvergenceError
 from ngdual.solvers import solve_problem, solve_scene
 from ngdual.solvers.qp import solve_qp_friction
-from ngdual.solvers.result import ConvergenceError
 from ngdual.solvers.settings import Model
 
 pytestmark = pytest.mark.slow  # levels 2-4 under Uzawa at tight tolerances

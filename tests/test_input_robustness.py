@@ -283,8 +283,8 @@ def test_an_internal_error_is_one_line_and_debug_shows_the_traceback(workspace, 
 
 
 def test_a_non_finite_solution_is_never_converged():
+    from ngdual.solution import ConvergenceError, Solution
     from ngdual.solvers.dispatch import _check_finite
-    from ngdual.solvers.result import ConvergenceError, Solution
 
     solution = Solution(problem=None, x=np.array([1.0, np.nan]), converged=True,
                         method="linear", history=[1.0, 0.5])

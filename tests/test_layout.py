@@ -1,6 +1,7 @@
 """The layout shows the architecture: data flows one way through the pipeline.
 
-scene -> mesh -> spaces (PEERS, boundary meshes, Gamma_C) -> forms -> solvers -> the fields and
+scene -> mesh -> spaces (PEERS, boundary meshes, Gamma_C) -> forms -> what a solver returns
+(``Solution``) -> solvers -> the fields and
 norms of a solution -> estimator ->
 marking -> adaptive loop -> post-processing -> verification; run machinery (studies, CLI)
 only calls the pipeline. Every import inside ``ngdual/`` (also those inside functions) is
@@ -21,6 +22,7 @@ STAGES = [
     ("mesh", ["mesh", "budget", "io"]),
     ("spaces", ["peers", "boundary", "contact"]),
     ("forms", ["forms", "friction", "quadrature_check"]),
+    ("solution", ["solution"]),
     ("solvers", ["solvers", "checks"]),
     ("quantities", ["quantities"]),
     ("estimator", ["estimator", "goal"]),

@@ -116,7 +116,7 @@ def test_on_straight_sides_the_gap_of_the_facet_multipliers_is_that_of_the_edges
     assert np.array_equal(moved, points) and np.array_equal(normals, gamma_c.normals)
 
 
-@pytest.mark.filterwarnings("ignore::ngdual.solvers.result.PhysicsWarning")
+@pytest.mark.filterwarnings("ignore::ngdual.solution.PhysicsWarning")
 def test_hertz_at_order_2_has_the_pressure_of_hertz_on_the_core_of_the_contact_zone():
     """The P_2 trace -sigma_nn on |x| < a/2 against Hertz's p0 sqrt(1 - x^2 / a^2) for the
     computed force (the block is finite: Hertz's half-plane differs by about 1 %). With the
@@ -131,7 +131,7 @@ def test_hertz_at_order_2_has_the_pressure_of_hertz_on_the_core_of_the_contact_z
     assert core.sum() >= 4 and error < 0.03, error
 
 
-@pytest.mark.filterwarnings("ignore::ngdual.solvers.result.PhysicsWarning")
+@pytest.mark.filterwarnings("ignore::ngdual.solution.PhysicsWarning")
 def test_the_traces_at_order_1_are_read_at_the_control_points_of_the_fine_edges():
     """contact_traces of a facet solution: the pressure at every control point is the moment
     its contact condition signs, over int psi_i (so the moments sum to the contact force),
@@ -154,7 +154,7 @@ def test_the_traces_at_order_1_are_read_at_the_control_points_of_the_fine_edges(
         traces.coarse_in_contact.reshape(-1, 2).any(axis=1))
 
 
-@pytest.mark.filterwarnings("ignore::ngdual.solvers.result.PhysicsWarning")
+@pytest.mark.filterwarnings("ignore::ngdual.solution.PhysicsWarning")
 def test_the_traction_profile_at_order_1_is_the_trace_and_integrates_to_the_contact_force():
     """The analytic curves of ``ngdual solve`` are drawn for the profile's force: at order k
     it is the P_k trace itself, whose integral is int -sigma_n ds exactly at k = 1 (up to its

@@ -26,8 +26,8 @@ from ngdual.checks import (
 from ngdual.cli import main
 from ngdual.cli.output import EXIT_WARNINGS
 from ngdual.scene import load_scene
+from ngdual.solution import PhysicsWarning
 from ngdual.solvers import solve_scene
-from ngdual.solvers.result import PhysicsWarning
 
 CONSISTENT = ("contact.ends='consistent'",)
 FAR_FOUNDATION = ('contact.foundation={point=[0.0, -1e6], normal=[0.0, 1.0]}',)

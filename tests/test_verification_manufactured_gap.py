@@ -15,7 +15,7 @@ import pytest
 from ngdual.verification.manufactured import APPROACH, Y0, frictionless_case
 from ngdual.verification.order import ORDER_SLACK, contact_study
 
-pytestmark = pytest.mark.filterwarnings("ignore::ngdual.solvers.result.PhysicsWarning")
+pytestmark = pytest.mark.filterwarnings("ignore::ngdual.solution.PhysicsWarning")
 
 
 def test_the_quadratic_gap_is_a_p2_function_on_the_contact_zone_and_the_quartic_is_not():

@@ -23,7 +23,7 @@ from ngdual.verification.manufactured import (
 from ngdual.verification.order import contact_study
 from ngdual.verification.piecewise import Piecewise, poly_numpy
 
-pytestmark = pytest.mark.filterwarnings("ignore::ngdual.solvers.result.PhysicsWarning")
+pytestmark = pytest.mark.filterwarnings("ignore::ngdual.solution.PhysicsWarning")
 
 
 def _jumps(f: Piecewise, x0: float, y0: float, up_to: int) -> list[float]:

@@ -13,7 +13,7 @@ from ngdual.cli import main
 from ngdual.verification import report
 from ngdual.verification.order import ORDER_SLACK, expected_order, order_check, set_check
 
-pytestmark = pytest.mark.filterwarnings("ignore::ngdual.solvers.result.PhysicsWarning")
+pytestmark = pytest.mark.filterwarnings("ignore::ngdual.solution.PhysicsWarning")
 
 
 def _orders_run(tmp_path, capsys, orders: list[str]) -> tuple[int, str, dict]:

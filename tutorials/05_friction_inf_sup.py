@@ -41,9 +41,9 @@ import ngdual as nd
 from ngdual.forms import assemble
 from ngdual.friction import build_friction_forms
 from ngdual.mesh import build_mesh
+from ngdual.solution import ConvergenceError
 from ngdual.solvers.nested import nested_uzawa
 from ngdual.solvers.projections import metric_matrix
-from ngdual.solvers.result import ConvergenceError
 from ngdual.solvers.settings import NestedUzawaSettings
 from ngdual.studies.tutorials import Lesson
 

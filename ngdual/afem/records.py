@@ -17,8 +17,8 @@ from ..estimator import Estimate
 from ..quantities import norms
 from ..rates import extrapolated_norms, total_error
 from ..scene import Scene, SceneError, SceneTypeError, check_level, ensure_valid
+from ..solution import Solution
 from ..solvers import solve_scene
-from ..solvers.result import Solution
 
 
 def relative_estimate(record: dict) -> float:

@@ -28,7 +28,7 @@ from ..goal import Goal, Measure
 from ..goal.base import points_text
 from ..mesh import mesh_arrays
 from ..scene import Scene
-from ..solvers.result import Solution
+from ..solution import Solution
 from .refinement import below_resolution
 
 # A tolerance run stops as stalled when its goal's relative estimate has not fallen below

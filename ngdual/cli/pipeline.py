@@ -6,7 +6,7 @@ import sys
 import warnings
 
 from ..scene import SceneError, check_level, load_scene, read_toml, shipped_scenes
-from ..solvers.result import PhysicsWarning
+from ..solution import PhysicsWarning
 from .output import (
     EXIT_NOT_CONVERGED,
     LARGE_MESH,
@@ -29,8 +29,8 @@ EXIT_MEMORY = 5
 def cmd_solve(args) -> int:
     from .. import budget, post
     from ..io import check_output_dir, write_json
+    from ..solution import ConvergenceError
     from ..solvers import solve_scene
-    from ..solvers.result import ConvergenceError
 
     level = check_level(args.level, "--level", optional=True)
     scene = load_scene(args.scene, args.set)
@@ -144,7 +144,7 @@ def _adapt(args) -> int:
     from ..afem import adapt, loop_defaults, reference_norms
     from ..io import check_output_dir, versions, write_json
     from ..mesh import mesh_arrays
-    from ..solvers.result import ConvergenceError
+    from ..solution import ConvergenceError
 
     level = check_level(args.level, "--level", optional=True)
     if args.theta is not None:

@@ -14,7 +14,7 @@ import numpy as np
 from ..checks import thesis_ends_outside_l2
 from ..estimator import Estimate
 from ..scene import Scene
-from ..solvers.result import Solution
+from ..solution import Solution
 
 
 @dataclass(frozen=True)

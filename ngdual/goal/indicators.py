@@ -64,7 +64,7 @@ from ..friction import hat_projection
 from ..mesh import boundary_segments, mesh_arrays
 from ..quantities import fields  # the trace of sigma_h at order k
 from ..scene import SceneError
-from ..solvers.result import Solution
+from ..solution import Solution
 
 __all__ = ["CALIBRATION", "CALIBRATION_ORDER_K", "CALIBRATION_WINDOW_ORDER_K", "TERMS",
            "PressureEstimate", "calibration", "goal_estimate", "in_window"]

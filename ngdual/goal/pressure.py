@@ -19,7 +19,7 @@ from ..checks import displacement_scale, thesis_ends_outside_l2
 from ..estimator import Estimate
 from ..scene import Scene, contact_junctions
 from ..scene.contact import KINK_ANGLE
-from ..solvers.result import Solution
+from ..solution import Solution
 from .base import Goal, Measure, points_text, thesis_ends_reason
 from .indicators import CONTACT_SHARE, goal_estimate, in_window
 

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from ..estimator import Estimate
-from ..solvers.result import Solution
+from ..solution import Solution
 from .base import Goal, Measure
 
 

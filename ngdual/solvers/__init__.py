@@ -9,8 +9,8 @@ them. The settings (:mod:`.settings`) are built once from the scene; no solver r
 scene itself.
 """
 
+from ..solution import ConvergenceError, Solution
 from .dispatch import check_unknowns, solve_on_mesh, solve_problem, solve_scene
-from .result import ConvergenceError, Solution
 from .settings import (
     ActiveSetSettings,
     LinearSettings,

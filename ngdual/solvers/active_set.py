@@ -63,13 +63,13 @@ from scipy.spatial import cKDTree
 
 from ..forms import DiscreteProblem
 from ..friction import FrictionForms, build_friction_forms, tresca_bound
+from ..solution import ConvergenceError, Solution
 from ..tolerances import COULOMB_FIXED_POINT_TOL, friction_vanishes
 from .cholesky import SchurCholesky
 from .hybrid import HybridSystem
 from .linear import blas_threads
 from .nested import friction_residuals
 from .projections import NonnegativeProjection, metric_matrix
-from .result import ConvergenceError, Solution
 from .semismooth import EPS, SAFETY, BoundarySolution, condition_number, semismooth_newton
 from .settings import ActiveSetSettings, Model
 from .uzawa import contact_residuals

@@ -66,10 +66,10 @@ import scipy.linalg as sla
 
 from ..forms import DiscreteProblem
 from ..friction import MomentFriction, build_friction_forms, tresca_moments
+from ..solution import ConvergenceError, Solution
 from ..tolerances import COULOMB_FIXED_POINT_TOL
 from .active_set import ContactStart, _coulomb_bound, coulomb_fixed_point
 from .linear import Factorization
-from .result import ConvergenceError, Solution
 from .scales import TOLERANCE, Scales
 from .semismooth import EPS, SAFETY, BoundarySolution, condition_number, semismooth_newton
 from .settings import ActiveSetSettings

@@ -37,11 +37,11 @@ from ..mesh import build_mesh
 from ..quadrature_check import check_formulas
 from ..scene import Scene, SceneError, SceneTypeError, check_level, ensure_valid, validate
 from ..scene.values import show
+from ..solution import ConvergenceError, PhysicsWarning, Solution
 from .active_set import ContactStart, active_set_solve
 from .hybrid_order import hybrid_active_set
 from .linear import solve_linear
 from .nested import nested_uzawa
-from .result import ConvergenceError, PhysicsWarning, Solution
 from .settings import (
     ActiveSetSettings,
     LinearSettings,
@@ -65,12 +65,12 @@ def solve_scene(scene: Scene, level: int | None = None,
     if it would not fit in memory (``allow_large=True`` tries anyway,
     :mod:`ngdual.budget`); then :func:`solve_on_mesh` solves. Bad input raises
     :class:`ngdual.scene.SceneError` naming the argument or field; a solve that fails
-    raises :class:`ngdual.solvers.result.ConvergenceError`. ``progress(iteration,
+    raises :class:`ngdual.solution.ConvergenceError`. ``progress(iteration,
     increment)`` is called after every iteration of the contact solver, ``status(phase)``
     when a phase begins (meshing, assembling, factorising and solving), e.g. for a
     progress display. Every failed physics check (``solution.warnings``,
     :mod:`ngdual.checks`) is also issued as a Python warning of category
-    :class:`~ngdual.solvers.result.PhysicsWarning`, so a notebook shows it.
+    :class:`~ngdual.solution.PhysicsWarning`, so a notebook shows it.
 
     ``order`` and ``multipliers`` solve with the polynomial order k of PEERS_k and the
     multiplier family in place of the scene's ``[discretisation]`` entries
@@ -212,7 +212,7 @@ def solve_problem(problem: DiscreteProblem, settings: Settings | None = None,
     ``settings`` (:mod:`ngdual.solvers.settings`) defaults to those of the problem's scene,
     :func:`~ngdual.solvers.settings.solver_settings`: the one place where a solve reads
     the scene. A solution with a non-finite value or residual is never returned as a
-    solution: it raises :class:`ngdual.solvers.result.ConvergenceError` with the history.
+    solution: it raises :class:`ngdual.solution.ConvergenceError` with the history.
     ``start`` warm-starts the active-set method (:class:`~.active_set.ContactStart`); the
     Uzawa algorithms of the thesis start from zero and refuse it (ValueError).
     """

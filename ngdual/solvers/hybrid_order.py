@@ -64,6 +64,7 @@ import scipy.sparse as sp
 from .. import peers
 from ..forms import DiscreteProblem
 from ..friction import MomentFriction, tresca_moments
+from ..solution import Solution
 from ..sparse import to_scipy
 from ..tolerances import COULOMB_FIXED_POINT_TOL
 from .active_set import ContactStart
@@ -78,7 +79,6 @@ from .conforming import (
     solve_condensed,
 )
 from .linear import blas_threads
-from .result import Solution
 from .settings import ActiveSetSettings
 
 CONTACT_REFINEMENTS = 2  # corrections of b by the moments on K (hybrid_active_set)

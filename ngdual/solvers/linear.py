@@ -16,9 +16,9 @@ import scipy.sparse as sp
 from threadpoolctl import ThreadpoolController
 
 from ..forms import DiscreteProblem
+from ..solution import Solution
 from ..sparse import to_ngsolve
 from ..tolerances import BLAS_THREADS
-from .result import Solution
 
 
 @functools.cache

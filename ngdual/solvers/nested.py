@@ -39,9 +39,9 @@ import scipy.sparse as sp
 
 from ..forms import DiscreteProblem
 from ..friction import FrictionForms, build_friction_forms, tresca_bound
+from ..solution import ConvergenceError, Solution
 from ..tolerances import CLARABEL_TOLERANCES, DIVERGENCE_FACTOR, friction_vanishes
 from .condensed import CondensedResponse
-from .result import ConvergenceError, Solution
 from .scales import Scales
 from .settings import Model, NestedUzawaSettings
 from .uzawa import ContactLoop

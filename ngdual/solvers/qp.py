@@ -35,8 +35,8 @@ import scipy.sparse.linalg as spla
 
 from ..forms import DiscreteProblem
 from ..friction import MomentFriction, build_friction_forms, tresca_bound, tresca_moments
+from ..solution import ConvergenceError, Solution
 from ..tolerances import CLARABEL_TOLERANCES, CLARABEL_WHOLE_PROBLEM
-from .result import ConvergenceError, Solution
 from .settings import Model
 
 FEASIBILITY_TOL = 1e-10  # the polished active set is accepted up to this relative violation

@@ -66,9 +66,9 @@ import scipy.linalg as sla
 import scipy.linalg.lapack as lapack
 import scipy.optimize as spo
 
+from ..solution import ConvergenceError
 from ..tolerances import friction_vanishes
 from .qp import contact_qp
-from .result import ConvergenceError
 
 EPS = float(np.finfo(float).eps)
 SAFETY = 100.0  # a tolerance is SAFETY times the round-off level it has to accommodate

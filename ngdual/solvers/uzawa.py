@@ -23,11 +23,11 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as sla_sparse
 
 from ..forms import DiscreteProblem
+from ..solution import ConvergenceError, Solution
 from ..tolerances import DIVERGENCE_FACTOR
 from .condensed import CondensedResponse
 from .linear import Factorization
 from .projections import NonnegativeProjection, metric_matrix
-from .result import ConvergenceError, Solution
 from .settings import UzawaSettings
 
 

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..scene import Scene, foundation_line
-from ..solvers.result import Solution
+from ..solution import Solution
 from .analytic import cattaneo_mindlin, flat_punch, hertz, wedge
 from .traction import plane_direction, traction_profile
 

@@ -61,8 +61,8 @@ import numpy as np
 from ..afem import adapt
 from ..mesh import mesh_size
 from ..scene import Scene, load_scene
+from ..solution import Solution
 from ..solvers import solve_scene
-from ..solvers.result import Solution
 from .analytic import cattaneo_mindlin, flat_punch, hertz
 from .traction import pressure_errors, traction_errors, traction_profile
 

@@ -25,7 +25,7 @@ import ngsolve as ngs
 from ..expr import Expression
 from ..quantities import fields
 from ..scene import Geometry, Loads, Material, Scene, validate
-from ..solvers.result import Solution
+from ..solution import Solution
 
 OMEGA = 3 * math.pi / 4  # half the interior angle at the re-entrant corner
 POINTS = [(-1, -1), (0, -1), (0, 0), (1, 0), (1, 1), (-1, 1)]

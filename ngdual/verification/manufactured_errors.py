@@ -16,8 +16,8 @@ from ..mesh import mesh_size
 from ..post import contact_traces, friction_diagnostics
 from ..quantities import fields
 from ..rates import observed_rates
+from ..solution import Solution
 from ..solvers import solve_scene
-from ..solvers.result import Solution
 from .integrate import PiecewiseQuadrature
 from .manufactured import (
     QUANTITIES,

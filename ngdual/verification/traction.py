@@ -42,7 +42,7 @@ from ..friction import hat_projection
 from ..geometry import tangent
 from ..post import contact_traces, force_balance
 from ..scene import Scene, foundation_line
-from ..solvers.result import Solution
+from ..solution import Solution
 from .analytic import CattaneoMindlin
 
 GAUSS_POINTS = 24          # per piece, after the cosine map (smooth integrands)

@@ -11,8 +11,8 @@ import ngdual as nd
 from ngdual import peers, post
 from ngdual.forms import assemble
 from ngdual.mesh import build_mesh
+from ngdual.solution import ConvergenceError
 from ngdual.solvers.nested import nested_uzawa
-from ngdual.solvers.result import ConvergenceError
 from ngdual.solvers.settings import NestedUzawaSettings, UzawaSettings
 from ngdual.solvers.uzawa import uzawa
 from ngdual.studies.tutorials import Lesson

@@ -67,7 +67,7 @@ def run(scene: str, overrides=(), level: int | None = None, steps: int = 8,
     ``allow_large`` as for :func:`ngdual.afem.adapt`."""
     from ...afem import adapt
     from ...scene import load_scene
-    from ...solvers.result import PhysicsWarning
+    from ...solution import PhysicsWarning
 
     study = header("adaptive", scene=scene, overrides=list(overrides), level=level,
                    steps=steps, marking="dorfler", theta=theta)

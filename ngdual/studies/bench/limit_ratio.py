@@ -116,8 +116,8 @@ def _measure(case: str, level: int, solver: str) -> dict:
     from ...mesh import build_mesh
     from ...quantities import norms
     from ...scene import load_scene
+    from ...solution import ConvergenceError
     from ...solvers import solve_problem
-    from ...solvers.result import ConvergenceError
 
     scene = load_scene(CASES[case], _overrides(solver))
     start = time.perf_counter()

@@ -44,8 +44,8 @@ def solve_quietly(scene, level: int):
     """:func:`ngdual.solvers.solve_scene` without printing the physics checks' warnings: a
     benchmark records them (``solution.warnings``) rather than interleaving them with its
     table."""
+    from ...solution import PhysicsWarning
     from ...solvers import solve_scene
-    from ...solvers.result import PhysicsWarning
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PhysicsWarning)

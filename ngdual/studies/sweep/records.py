@@ -8,7 +8,7 @@ killed run never leaves a half-written record.
 
 Statuses: ``"ok"``; ``"not-converged"`` (the solver returned without reaching its
 tolerance, e.g. at ``solver.max_iter``); ``"failed"`` (it raised a
-:class:`~ngdual.solvers.result.ConvergenceError`, whose message is kept) -- all
+:class:`~ngdual.solution.ConvergenceError`, whose message is kept) -- all
 three are final. ``"error"`` (any other exception, with its traceback) is kept
 for inspection but counts as unfinished, so the next run tries again.
 

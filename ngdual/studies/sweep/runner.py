@@ -64,8 +64,8 @@ def run_task(task: Task, folder: str) -> tuple[dict, dict]:
 def warm_up() -> None:
     """Solve a tiny scene with each solver once, so that the first timed task of a worker does
     not pay for imports and NGSolve's first-call set-up."""
+    from ...solution import PhysicsWarning
     from ...solvers import solve_scene
-    from ...solvers.result import PhysicsWarning
 
     with warnings.catch_warnings():  # the thesis ends warn; this solve is thrown away
         warnings.simplefilter("ignore", PhysicsWarning)

@@ -62,8 +62,8 @@ def _status_of(solution) -> str:
 
 
 def _solve_quietly(scene, level: int):
+    from ...solution import PhysicsWarning
     from ...solvers import solve_scene
-    from ...solvers.result import PhysicsWarning
 
     with warnings.catch_warnings():  # recorded under "warnings", not printed by a worker
         warnings.simplefilter("ignore", PhysicsWarning)
@@ -173,7 +173,7 @@ def adapt_task(scene: str, marking: str, theta: float, steps: int, level: int,
     from ...afem import adapt
     from ...estimator import estimate
     from ...mesh import mesh_arrays
-    from ...solvers.result import ConvergenceError
+    from ...solution import ConvergenceError
 
     history, arrays = [], {}
     run = {"scene": scene, "marking": marking, "theta": theta, "steps": steps, "level": level,
@@ -253,7 +253,7 @@ def _loop_times(scene: str, overrides, loop: dict, unknowns: list[int],
     ``max_elements`` triangles; the steps from the first whose unknowns differ from
     ``unknowns`` (another mesh: a tie in the marking broken otherwise) are left out."""
     from ...afem import adapt
-    from ...solvers.result import ConvergenceError
+    from ...solution import ConvergenceError
 
     times = []
 
@@ -434,7 +434,7 @@ def one_thread():
 def execute(task: Task) -> tuple[dict, dict]:
     """Compute ``task`` (no files) on one thread (:func:`one_thread`): its record and
     arrays, failures included; the record's ``threads`` are NGSolve's during the task."""
-    from ...solvers.result import ConvergenceError
+    from ...solution import ConvergenceError
 
     started = time.time()
     start = time.perf_counter()

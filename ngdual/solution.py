@@ -6,8 +6,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..forms import DiscreteProblem
-from ..friction import FrictionForms
+from .forms import DiscreteProblem
+from .friction import FrictionForms
 
 
 class PhysicsWarning(UserWarning):
