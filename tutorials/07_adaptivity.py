@@ -1,6 +1,9 @@
 # %% [markdown]
 # # Tutorial 7: Adaptive refinement
 #
+# **Run time** on a 2-core laptop: about 30 s; about 8 s with `NGDUAL_QUICK=1`
+# (`ngdual tutorials run 07 --quick`).
+#
 # **Problem.** Solutions of contact problems are not smooth: $\sigma$ is singular at
 # corners where boundary conditions change, and at the ends of the contact zone. Uniform
 # refinement then converges slowly. The model case: an L-shaped domain with a re-entrant

@@ -16,7 +16,8 @@ The schema (all tables optional except ``geometry``, whose ``kind`` must be give
     [geometry]   kind = "thesis-3.46" | "polygon", level, points, labels, maxh, arcs
     [boundary]   dirichlet = [labels], neumann = [labels], contact = [labels]
     [material]   E, nu                                   (plane strain)
-    [loads]      body_force = [fx, fy], traction = [tx, ty], displacement = [ux, uy]
+    [loads]      body_force = [fx, fy], displacement = [ux, uy], traction = [tx, ty]
+                 (every Gamma_N side) | {label = [tx, ty], ...} (per side, the others free)
     [contact]    gap | foundation = {point, normal}, htilde_factor (h~/h),
                  hhat_factor (h^/h~: 1 or 2), ends = "consistent" | "thesis"
     [friction]   law = "none" | "tresca" | "coulomb", mu, bound (Tresca F),
