@@ -1,7 +1,7 @@
 """Fig. 3.19: tangential displacement lambda_t^h on Gamma_C (lambda_t = -u_t), both problems.
 
 With friction, the h~ nodes in contact are marked stick (green) or slip (red) as in
-:func:`ngdual.post.friction_diagnostics`. The thesis: a sticking zone around x_1 in (-0.5, 0.5).
+:func:`ngdual.trace.friction_diagnostics`. The thesis: a sticking zone around x_1 in (-0.5, 0.5).
 """
 
 import numpy as np

@@ -54,7 +54,7 @@ _PUBLIC = {
     "refine_with_boundary": ("ngdual.afem", "refine_with_boundary"),
     "fields": ("ngdual.quantities", "fields"),
     "norms": ("ngdual.quantities", "norms"),
-    "contact_traces": ("ngdual.post", "contact_traces"),
+    "contact_traces": ("ngdual.trace", "contact_traces"),
     "force_balance": ("ngdual.post", "force_balance"),
     "result_record": ("ngdual.post", "result_record"),
     "plot_contact_traces": ("ngdual.plot", "plot_contact_traces"),

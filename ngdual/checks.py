@@ -335,7 +335,7 @@ def _friction_bound(solution: Solution, forms: FrictionForms, balance: ForceBala
                     ) -> CheckWarning | None:
     """|t_{t,i}| = |d_Ct(mu_i, sigma)| against int F mu_i at every h~ node: the bound the
     discrete problem imposes (F is the h^ mean of mu_f |p_h|, so |t_t| / |t_n| may exceed
-    mu_f at the last node of a contact zone, :class:`ngdual.post.FrictionDiagnostics`)."""
+    mu_f at the last node of a contact zone, :class:`ngdual.trace.FrictionDiagnostics`)."""
     if solution.friction_bound is None:
         return None
     pb = solution.problem

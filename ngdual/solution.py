@@ -53,7 +53,8 @@ class Solution:
     those the solution was computed with (:mod:`ngdual.solvers.settings`). ``warnings``
     lists the physics checks the solution fails (:class:`CheckWarning`,
     :func:`ngdual.checks.physics_checks`; filled by
-    :func:`~ngdual.solvers.solve_problem`), empty for a solution to believe.
+    :func:`~ngdual.solvers.solve_problem`), empty for a solution to believe. ``trace`` is
+    its contact trace once computed (:func:`ngdual.trace.contact_traces`: one per solution).
     """
 
     problem: DiscreteProblem
@@ -70,6 +71,7 @@ class Solution:
     friction_forms: FrictionForms | None = None
     settings: object | None = None
     warnings: list[CheckWarning] = field(default_factory=list)
+    trace: object | None = field(default=None, repr=False, compare=False)
 
     def part(self, *names: str) -> np.ndarray:
         return self.x[self.problem.index(*names)]

@@ -12,7 +12,7 @@ from functools import cache
 import numpy as np
 import pytest
 
-from ngdual import post
+from ngdual import post, trace
 from ngdual.afem import adapt
 from ngdual.forms import assemble
 from ngdual.mesh import build_mesh
@@ -116,7 +116,7 @@ def test_kink_splits_the_multipliers():
 
 def test_cattaneo_mindlin_has_stick_inside_slip_nearly_incompressible():
     sol = solved("cattaneo-mindlin", 3)
-    diag = post.friction_diagnostics(sol)
+    diag = trace.friction_diagnostics(sol)
     x = diag.node_xy[:, 0]
     stick = x[diag.node_status == "stick"]
     slip = x[diag.node_status == "slip"]

@@ -15,10 +15,11 @@ import pytest
 
 from ngdual.forms import assemble
 from ngdual.mesh import build_mesh
-from ngdual.post import contact_traces, force_balance
+from ngdual.post import force_balance
 from ngdual.quantities import norms
 from ngdual.scene import load_scene, scene_from_dict
 from ngdual.solvers import solve_problem, solve_scene
+from ngdual.trace import contact_traces
 
 ZERO_LOADS = ['loads.body_force=["0", "0"]', 'loads.traction=["0", "0"]',
               'loads.displacement=["0", "0"]']

@@ -7,7 +7,7 @@ import functools
 import numpy as np
 import pytest
 
-from ngdual import post
+from ngdual import post, trace
 from ngdual.forms import assemble
 from ngdual.friction import build_friction_forms
 from ngdual.mesh import build_mesh
@@ -130,7 +130,7 @@ def test_projection_by_nnls_equals_the_cvxpy_qp():
 
 def test_stick_slip_diagnostics_are_consistent(solved):
     _, sol = solved
-    diag = post.friction_diagnostics(sol)
+    diag = trace.friction_diagnostics(sol)
     assert set(diag.edge_status) <= {"free", "stick", "slip"}
     assert np.all(np.abs(diag.nu[diag.edge_status == "slip"]) >= 1 - 1e-6)
     assert np.all(np.abs(diag.nu[diag.edge_status == "stick"]) < 1)

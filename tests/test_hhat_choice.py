@@ -18,9 +18,9 @@ import numpy as np
 import pytest
 
 from ngdual.friction import build_friction_forms
-from ngdual.post import friction_diagnostics
 from ngdual.scene import load_scene
 from ngdual.solvers import solve_scene
+from ngdual.trace import friction_diagnostics
 
 pytestmark = pytest.mark.slow  # Figs. 3.26-3.28: nested Uzawa on levels 3 and 4
 

@@ -24,7 +24,7 @@ STAGES = [
     ("forms", ["forms", "friction", "quadrature_check"]),
     ("solution", ["solution"]),
     ("solvers", ["solvers", "checks"]),
-    ("quantities", ["quantities"]),
+    ("quantities", ["quantities", "trace"]),
     ("estimator", ["estimator", "goal"]),
     ("marking", ["marking"]),
     ("afem", ["afem"]),

@@ -18,9 +18,9 @@ from ngdual.boundary.facet import bernstein_values
 from ngdual.contact import curve_normal
 from ngdual.forms import Spaces
 from ngdual.mesh import build_mesh
-from ngdual.post import contact_traces
 from ngdual.scene import SceneError, gap_at, load_scene
 from ngdual.solvers import solve_scene
+from ngdual.trace import contact_traces
 from ngdual.verification.analytic import hertz
 from ngdual.verification.traction import traction_profile
 

@@ -21,8 +21,8 @@ import pytest
 from matplotlib.figure import Figure
 
 from ngdual import plot
-from ngdual.post import ContactTraces
 from ngdual.scene import Units
+from ngdual.trace import ContactTraces
 
 # a 4 x 2 grid of the rectangle [0, 4] x [0, 1], 16 triangles
 X, Y = np.meshgrid(np.linspace(0, 4, 5), np.linspace(0, 1, 3))

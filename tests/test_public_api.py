@@ -26,12 +26,12 @@ def test_every_public_name_resolves_and_has_a_docstring():
 
 
 def test_public_names_are_the_pipeline_functions():
-    from ngdual import afem, boundary, estimator, marking, mesh, post, quantities, scene, solvers
+    from ngdual import afem, boundary, estimator, marking, mesh, quantities, scene, solvers, trace
 
     assert nd.solve is solvers.solve_scene
     assert nd.load_scene is scene.load_scene and nd.Scene is scene.Scene
     assert nd.adapt is afem.adapt and nd.estimate is estimator.estimate
-    assert nd.mark is marking.mark and nd.contact_traces is post.contact_traces
+    assert nd.mark is marking.mark and nd.contact_traces is trace.contact_traces
     assert nd.norms is quantities.norms and nd.fields is quantities.fields
     # the steps of the adaptive loop, to write it by hand (tutorial 07)
     assert nd.solve_on_mesh is solvers.solve_on_mesh and nd.build_mesh is mesh.build_mesh

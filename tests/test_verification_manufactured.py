@@ -41,8 +41,8 @@ import numpy as np
 import pytest
 
 from ngdual.expr import Expression
-from ngdual.post import contact_traces, friction_diagnostics
 from ngdual.solvers import solve_scene
+from ngdual.trace import contact_traces, friction_diagnostics
 from ngdual.verification import (
     Piecewise,
     discrete_sets,

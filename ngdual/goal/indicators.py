@@ -58,13 +58,12 @@ import ngsolve as ngs  # the pressure of order k, a trace of sigma_h
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ..checks import friction_forms_of
 from ..estimator import BoundaryEdges, Estimate
-from ..friction import hat_projection
 from ..mesh import boundary_segments, mesh_arrays
 from ..quantities import fields  # the trace of sigma_h at order k
 from ..scene import SceneError
 from ..solution import Solution
+from ..trace import contact_traces
 
 __all__ = ["CALIBRATION", "CALIBRATION_ORDER_K", "CALIBRATION_WINDOW_ORDER_K", "TERMS",
            "PressureEstimate", "calibration", "goal_estimate", "in_window"]
@@ -194,14 +193,16 @@ def goal_estimate(solution: Solution, estimated: Estimate,
         p_mean, residual, p_squared = _trace_pressure(pressure, solution, edges, on_gamma_c)
         jumps = _vertex_jumps(pressure, mesh, gamma_c)
     else:
-        # sigma_n^h per fine edge (constant for RT_0, order 0), from the fine-edge operators
-        sigma_n = friction_forms_of(solution).T_n @ solution.x
-        # p_h = -(hat projection of sigma_n^h), as means over the fine edges
+        # sigma_n^h per fine edge and p_h at the h~ nodes, with the fixed ends, from the
+        # solution's contact trace; p_h as means over the fine edges
+        traces = contact_traces(solution)
+        sigma_n = traces.sigma_n
         p_mean = np.zeros(len(length))
-        for hats in (spaces.prolongations["lam_n"], spaces.end_hats["lam_n"]):
+        for hats, nodal in ((spaces.prolongations["lam_n"], traces.pressure),
+                            (spaces.end_hats["lam_n"], traces.end_pressure)):
             means = gamma_c.hat_means(hats)
             if means.shape[1]:
-                p_mean += means @ -hat_projection(means, length, sigma_n)
+                p_mean += means @ nodal
         residual, p_squared = length * (sigma_n + p_mean)**2, length * p_mean**2
         jumps = np.zeros(len(length))   # p_h is continuous along a chain
     # the edges under a fixed end's hat, where lambda_n is data, not an unknown of (3.62)

@@ -119,7 +119,7 @@ def plot_contact_traces(traces, title: str = "", units=None, clip: float | None 
                         exact=None) -> Figure:
     """The contact pressure p_h and shear q_h along Gamma_C, and lambda_n - g, lambda_t.
 
-    Top: p_h and q_h per h~ node (:class:`ngdual.post.ContactTraces`: what the contact
+    Top: p_h and q_h per h~ node (:class:`ngdual.trace.ContactTraces`: what the contact
     conditions of (3.62) control), the main curves; the values at fixed ends of Gamma_C
     (no contact condition there) marked apart; the fine-edge -sigma_n, sigma_t thin and
     light behind them; ``exact`` (e.g. :func:`ngdual.verification.benchmark.benchmark_traces`:
@@ -131,8 +131,8 @@ def plot_contact_traces(traces, title: str = "", units=None, clip: float | None 
     of Gamma_C and p_h, q_h vanish outside it, the top panels show the zone (and say so).
     ``units``: the scene's ``units``.
     """
-    from ..post import ContactTraces
     from ..scene import SceneTypeError
+    from ..trace import ContactTraces
 
     if not isinstance(traces, ContactTraces):
         raise SceneTypeError("traces", "must be the ContactTraces of nd.contact_traces("

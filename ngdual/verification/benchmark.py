@@ -5,7 +5,7 @@
 discrete solution carries: P = int p_h and Q = int q_h along the foundation
 (:func:`ngdual.verification.traction.traction_profile`, the h~ hat projections the contact
 conditions of (3.62) see). :func:`benchmark_traces` samples the exact pressure and shear
-along the fine edges of Gamma_C in the conventions of :class:`ngdual.post.ContactTraces`
+along the fine edges of Gamma_C in the conventions of :class:`ngdual.trace.ContactTraces`
 (pressure positive in compression, shear along t = (n_2, -n_1) of (3.24)), for
 :func:`ngdual.plot.plot_contact_traces`.
 """

@@ -11,13 +11,12 @@ import ngsolve as ngs
 import numpy as np
 
 from ..expr import Expression
-from ..friction import hat_projection
 from ..mesh import mesh_size
-from ..post import contact_traces, friction_diagnostics
 from ..quantities import fields
 from ..rates import observed_rates
 from ..solution import Solution
 from ..solvers import solve_scene
+from ..trace import contact_traces, friction_diagnostics
 from .integrate import PiecewiseQuadrature
 from .manufactured import (
     QUANTITIES,
@@ -140,10 +139,10 @@ def discrete_sets(solution: Solution) -> dict:
     """The discrete contact and stick sets as unions of intervals of x.
 
     Contact: the h~ edges on which lambda_n^h vanishes identically (both nodes in contact,
-    :func:`ngdual.post.contact_traces`; the ends of Gamma_C, where lambda_n^h is fixed to
+    :func:`ngdual.trace.contact_traces`; the ends of Gamma_C, where lambda_n^h is fixed to
     zero, count as in contact). Stick: the h^ edges where the discrete friction variable
     sticks, |nu| < 1 with F > 0 (``edge_status == "stick"`` in
-    :func:`ngdual.post.friction_diagnostics`; there (Q_F lambda_t^h) = 0), within the
+    :func:`ngdual.trace.friction_diagnostics`; there (Q_F lambda_t^h) = 0), within the
     contact set. (The node status of ``friction_diagnostics`` calls a node stick only if
     every h^ edge under its hat sticks, so its stick nodes span up to one h~ edge less at
     each end of a stick zone.)
@@ -315,17 +314,18 @@ def contact_profile(case: ManufacturedCase, solution: Solution) -> dict:
 def contact_pressure(solution: Solution) -> dict:
     """The contact pressure p_h and the raw fine-edge sigma_n^h along Gamma_C.
 
-    p_h = sum_i (t_i / m_i) mu_i over the h~ hats (:func:`ngdual.friction.hat_projection`):
+    p_h = sum_i (t_i / m_i) mu_i over the h~ hats, the pressure of the solution's contact
+    trace (:func:`ngdual.trace.contact_traces`, signed here as sigma_n):
     the discrete contact forces per unit length, zero where the body separates. Returns the
     fine edge end points ``x0``, ``x1`` (x of the start and end vertex), ``p0``, ``p1``
     (p_h there: p_h is linear on every fine edge), ``sigma_n`` (the fine-edge value of
-    :func:`ngdual.post.contact_traces`), and per interior h~ node ``node_x``,
+    :func:`ngdual.trace.contact_traces`), and per interior h~ node ``node_x``,
     ``node_pressure`` (t_i / m_i) and ``node_lam_n``.
     """
     pb = solution.problem
     gamma_c, prolong = pb.spaces.gamma_c, pb.spaces.prolongations["lam_n"]
-    sigma_n = contact_traces(solution).sigma_n
-    nodal = hat_projection(gamma_c.hat_means(prolong), gamma_c.lengths, sigma_n)
+    traces = contact_traces(solution)
+    sigma_n, nodal = traces.sigma_n, -traces.pressure
     fine = prolong @ nodal
     points = np.array([v.point for v in pb.fes.mesh.vertices])
     dof_x = np.concatenate([chain.path_points[pb.spaces.contact.dof_positions(c)][:, 0]

@@ -40,9 +40,10 @@ from scipy.optimize import brentq
 
 from ..friction import hat_projection
 from ..geometry import tangent
-from ..post import contact_traces, force_balance
+from ..post import force_balance
 from ..scene import Scene, foundation_line
 from ..solution import Solution
+from ..trace import contact_traces
 from .analytic import CattaneoMindlin
 
 GAUSS_POINTS = 24          # per piece, after the cosine map (smooth integrands)
@@ -145,8 +146,7 @@ def traction_profile(solution: Solution) -> TractionProfile:
     end_hats = gamma_c.hat_means(pb.spaces.end_hats["lam_n"])           # fixed-end hats
     length = gamma_c.lengths
     along = np.sign(gamma_c.tangents @ plane_direction(solution.problem.scene))
-    sigma_n = np.concatenate([hat_projection(h, length, traces.sigma_n)
-                              for h in (hats, end_hats)])
+    sigma_n = -np.concatenate([traces.pressure, traces.end_pressure])
     sigma_t = np.concatenate([hat_projection(h, length, along * traces.sigma_t)
                               for h in (hats, end_hats)])
     contact = np.concatenate([traces.coarse_in_contact, np.zeros(end_hats.shape[1], bool)])
@@ -177,7 +177,7 @@ def _facet_profile(solution: Solution, traces) -> TractionProfile:
     nothing orthogonal to project away; the coarse ones of degree k + 1 control moments on
     h~ and leave no profile at the h~ nodes (their unknowns are Bernstein coefficients),
     so they are measured by the same traces. Linear between the samples of
-    :func:`ngdual.post.contact_traces` (4k + 2 per fine edge, end points included: exact at
+    :func:`ngdual.trace.contact_traces` (4k + 2 per fine edge, end points included: exact at
     k <= 1); every edge is a piece of its own (the traces are discontinuous)."""
     pb = solution.problem
     gamma_c = pb.spaces.gamma_c

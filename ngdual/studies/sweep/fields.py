@@ -11,13 +11,13 @@ def field_arrays(solution) -> dict[str, np.ndarray]:
     Element values at the centroids of the fine mesh (``points``, ``triangles``):
     ``von_mises`` (plane strain, Section 3.4), ``u1``, ``u2``, ``eta``. On
     Gamma_N at the fine vertices: ``phi_x``, ``phi1``, ``phi2``. On Gamma_C
-    (:func:`ngdual.post.contact_traces`): per fine edge ``edge_x``,
+    (:func:`ngdual.trace.contact_traces`): per fine edge ``edge_x``,
     ``sigma_n``, ``sigma_t``, ``edge_active``; per fine vertex ``node_x``,
     ``lam_n``, ``lam_t``, ``gap``; per h~ node ``coarse_x``, ``in_contact`` and the
     pressure and shear traction the contact conditions see, ``hat_x`` (coordinate along the
     foundation), ``hat_pressure``, ``hat_shear``
     (:func:`ngdual.verification.traction.traction_profile`).
-    With friction (:func:`ngdual.post.friction_diagnostics`): per h~ node
+    With friction (:func:`ngdual.trace.friction_diagnostics`): per h~ node
     ``hat_ratio`` (|int sigma_t mu_i| / |int sigma_n mu_i|), ``bound_ratio``
     (|int sigma_t mu_i| / int F mu_i, at most 1 by (3.62): the discrete Coulomb
     condition) and ``node_status`` (0 separation, 1 stick, 2 slip); per h^ edge
@@ -26,7 +26,7 @@ def field_arrays(solution) -> dict[str, np.ndarray]:
     """
     import ngsolve as ngs
 
-    from ... import post, quantities
+    from ... import post, quantities, trace
 
     pb = solution.problem
     mesh = pb.fes.mesh
@@ -45,7 +45,7 @@ def field_arrays(solution) -> dict[str, np.ndarray]:
         values = np.asarray(f.phi(mesh(xy[:, 0], xy[:, 1], VOL_or_BND=ngs.BND)))
         out.update(phi_x=xy[:, 0], phi1=values[:, 0], phi2=values[:, 1])
     if pb.spaces.contact is not None:
-        tr = post.contact_traces(solution)
+        tr = trace.contact_traces(solution)
         out.update(edge_x=tr.edge_xy[:, 0], edge_length=tr.edge_length, sigma_n=tr.sigma_n,
                    sigma_t=tr.sigma_t, edge_active=tr.edge_active, node_x=tr.node_xy[:, 0],
                    lam_n=tr.lam_n, lam_t=tr.lam_t, gap=tr.gap, coarse_x=tr.coarse_xy[:, 0],
@@ -57,7 +57,7 @@ def field_arrays(solution) -> dict[str, np.ndarray]:
     if solution.nu is not None:
         from ...friction import build_friction_forms
 
-        diag = post.friction_diagnostics(solution)
+        diag = trace.friction_diagnostics(solution)
         forms = solution.friction_forms or build_friction_forms(pb)
         bound = forms.q_matrix(solution.friction_bound).T @ np.ones(len(solution.nu))
         out["bound_ratio"] = np.where(bound > 0, np.abs(diag.t_t) / np.where(bound > 0, bound,
