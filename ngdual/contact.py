@@ -77,9 +77,10 @@ def curve_normal(scene: Scene, mesh: ngs.Mesh) -> ngs.CoefficientFunction:
     """The outward unit normal of the boundary curve of Gamma_C on its fine edges, as an
     NGSolve coefficient: on an arc the radial direction at every point of a chord (the
     arc's normal on the same ray, :meth:`ContactBoundary.on_curve`), on a straight side the
-    edge normal. The facet multipliers pair with sigma in it (:func:`ngdual.forms._forms`),
-    so that lambda_n = g - u.n and the frictionless t.sigma n = 0 hold for the arc's normal
-    and tangent, not for a chord's, which differ from them by up to |e| / (2 R)."""
+    edge normal. The facet multipliers pair with sigma in it
+    (:func:`ngdual.forms.couplings.coupling_forms`), so that lambda_n = g - u.n and the
+    frictionless t.sigma n = 0 hold for the arc's normal and tangent, not for a chord's,
+    which differ from them by up to |e| / (2 R)."""
     n = ngs.specialcf.normal(2)
     arcs = _contact_arcs(scene)
     if not arcs:

@@ -8,7 +8,7 @@ import contextlib
 import numpy as np
 import pytest
 
-from ngdual import forms
+from ngdual import forms, peers
 from ngdual.mesh import build_mesh
 from ngdual.scene import load_scene
 from ngdual.solvers.hybrid import HybridSystem
@@ -36,7 +36,7 @@ def test_differentiated_integrands_give_the_matrices_of_3_62_to_the_bit(name, mo
         return problem.K, problem.rhs, problem.broken.matrix, hybrid.H, hybrid.r
 
     differentiated = assembled()
-    monkeypatch.setattr(forms, "differentiated_integrands", contextlib.nullcontext)
+    monkeypatch.setattr(forms.peers_block, "differentiated_integrands", contextlib.nullcontext)
     default = assembled()
     _assert_same_bits(matrices(*differentiated), matrices(*default))
 
@@ -46,10 +46,10 @@ def test_differentiated_integrands_give_the_peers_block_of_order_1_to_the_bit(mo
                                           "discretisation.multipliers=facet"])
     spaces = forms.Spaces.build(scene, build_mesh(scene.geometry, 1))
     lame = scene.material.lame
-    size = sum(spaces.components[name].ndof for name in forms.peers.PEERS)
+    size = sum(spaces.components[name].ndof for name in peers.PEERS)
     differentiated = forms.broken_peers(spaces, lame)
     conforming = forms.conforming_peers(spaces, lame, size)
-    monkeypatch.setattr(forms, "differentiated_integrands", contextlib.nullcontext)
+    monkeypatch.setattr(forms.peers_block, "differentiated_integrands", contextlib.nullcontext)
     default = forms.broken_peers(spaces, lame)
     _assert_same_bits((differentiated.matrix, conforming),
                       (default.matrix, forms.conforming_peers(spaces, lame, size)))

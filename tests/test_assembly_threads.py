@@ -23,7 +23,7 @@ def test_parallel_and_serial_assembly_agree_bit_for_bit(monkeypatch):
     mesh = build_mesh(scene.geometry, 5)
     assert mesh.ne >= forms.PARALLEL_ELEMENTS
     parallel = assembled(scene, mesh)
-    monkeypatch.setattr(forms, "parallel_tasks", lambda mesh: contextlib.nullcontext())
+    monkeypatch.setattr(forms.peers_block, "parallel_tasks", lambda mesh: contextlib.nullcontext())
     serial = assembled(scene, mesh)
     for p, s in zip(parallel, serial):
         if hasattr(p, "tocsr"):

@@ -6,7 +6,7 @@ import pytest
 
 from ngdual.afem import refine_towards, refine_with_boundary
 from ngdual.boundary import BoundaryMeshes, CoarseMesh, boundary_chains, end_rule
-from ngdual.forms import _trace_space
+from ngdual.forms.spaces import _trace_space
 from ngdual.geometry import round_off
 from ngdual.mesh import build_mesh, mesh_arrays, polygon_mesh, thesis_mesh
 from ngdual.scene import load_scene

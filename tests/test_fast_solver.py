@@ -259,7 +259,7 @@ def test_broken_rt_map_holds_on_a_mesh_graded_over_ten_orders_of_magnitude():
     import ngsolve as ngs
     from netgen.geom2d import unit_square
 
-    from ngdual.forms import _edge_of_broken
+    from ngdual.forms.peers_block import _edge_of_broken
 
     mesh = ngs.Mesh(unit_square.GenerateMesh(maxh=0.5))
     for _ in range(36):

@@ -148,7 +148,7 @@ class CoarseOrderMesh(WithoutP1, CoarseMesh):
         """(space.ndof, n_unknowns): coarse Bernstein coefficients -> host coefficients of
         ``space`` (:func:`~ngdual.boundary.facet.host_space` of degree p); with ``ends=True``
         (space.ndof, n_ends), the functions of the fixed end coefficients, which lift the end
-        values (:func:`ngdual.forms._end_lift`)."""
+        values (:func:`ngdual.forms.couplings.end_lift`)."""
         n = self.n_coefficients
         R = self.restriction()
         R = R[:, n:] if ends else R[:, :n]
