@@ -1,4 +1,4 @@
-"""Boundary multipliers of order k (ngdual.verification.multipliers, issue 27 item 2).
+"""Boundary multipliers of order k (ngdual.verification.multipliers).
 
 * Two independent paths agree: the thesis' coarse P1 multipliers on h~ = 2h, built here from
   Legendre polynomials on the fine edges and paired through a SurfaceL2 host, give the
@@ -30,6 +30,7 @@ from ngdual.scene import SceneError, load_scene
 from ngdual.studies.bench.infsup import infsup
 from ngdual.verification import multipliers as m
 from ngdual.verification.infsup import dense_singular_values, gram_matrix
+from ngdual.verification.order import unit_square
 
 DOCS = Path(__file__).resolve().parents[1] / "docs" / "theory" / "order.md"
 CHOSEN = (("coarse", 2), ("facet", 1))
@@ -47,7 +48,7 @@ def documented(family: str, multipliers: str, ratio: int, k: int) -> list[tuple[
 
 
 def model(multipliers: str, ratio: int, k: int, levels, family: str = "peers") -> list[dict]:
-    return [m.constants(m.unit_square(level), m.model_parts(), multipliers, k, ratio, family)
+    return [m.constants(unit_square(level), m.model_parts(), multipliers, k, ratio, family)
             for level in levels]
 
 
@@ -84,7 +85,7 @@ def test_the_facet_multipliers_of_the_contact_solver_have_the_constants_of_the_f
 
 
 def test_the_coarse_p1_basis_has_the_mass_and_stiffness_of_the_coarse_p1_space():
-    mesh = m.unit_square(2)
+    mesh = unit_square(2)
     coarse = CoarseMesh.from_fine(mesh, ["bottom"], 2)
     stresses = m.Stresses.of(mesh, "peers", 0)
     pairing = m.pair(m.coarse_basis(coarse, 0), m.model_parts()[0], stresses.fes,
@@ -96,7 +97,7 @@ def test_the_coarse_p1_basis_has_the_mass_and_stiffness_of_the_coarse_p1_space()
 
 def test_the_facet_space_has_the_dimension_of_the_normal_traces_of_rt_k_on_the_part():
     for k in (0, 1):
-        mesh = m.unit_square(1)
+        mesh = unit_square(1)
         basis = m.multiplier_basis(mesh, m.model_parts()[0], "facet", k, ratio=1)
         stresses = m.Stresses.of(mesh, "peers", k)
         B = m.pair(basis, m.model_parts()[0], stresses.fes, stresses.names, k).B
@@ -134,9 +135,9 @@ def test_continuous_multipliers_on_the_fine_mesh_lose_stability_like_h(k):
 
 def test_facet_multipliers_on_a_coarse_mesh_are_refused():
     with pytest.raises(SceneError):
-        m.multiplier_basis(m.unit_square(1), m.model_parts()[0], "facet", 0, ratio=2)
+        m.multiplier_basis(unit_square(1), m.model_parts()[0], "facet", 0, ratio=2)
     with pytest.raises(SceneError):
-        m.multiplier_basis(m.unit_square(1), m.model_parts()[0], "mortar", 0)
+        m.multiplier_basis(unit_square(1), m.model_parts()[0], "mortar", 0)
 
 
 @pytest.mark.slow
