@@ -22,7 +22,7 @@ from ngdual.friction import build_friction_forms
 from ngdual.mesh import build_mesh
 from ngdual.scene import load_scene
 from ngdual.solution import ConvergenceError
-from ngdual.solvers import active_set, solve_problem
+from ngdual.solvers import active_set, coulomb, solve_problem
 from ngdual.solvers.active_set import active_set_solve
 from ngdual.solvers.nested import nested_uzawa
 from ngdual.solvers.semismooth import EPS, SAFETY, condition_number, kkt_residuals
@@ -138,7 +138,9 @@ def test_damped_newton_ends_the_cycle_without_the_qp(monkeypatch):
         sol = newton(G, b, n_c, Q, start, **kwargs)
         calls.append((G, b, Q, sol))
         return sol
+    # the frictionless start and the Coulomb fixed point's Tresca solves
     monkeypatch.setattr(active_set, "semismooth_newton", recorded)
+    monkeypatch.setattr(coulomb, "semismooth_newton", recorded)
     sol = active_set_solve(pb, ActiveSetSettings.from_scene(pb.scene))
     assert_round_off(sol)
     assert max(c[3].iterations for c in calls) > 8  # the damped phase was needed

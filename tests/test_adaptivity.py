@@ -286,12 +286,12 @@ def test_the_first_adaptive_step_solves_what_solve_scene_solves_on_its_level():
 @pytest.mark.parametrize("name", ["hertz-cylinder", "cattaneo-mindlin"])
 def test_a_warm_started_contact_iteration_finds_the_cold_started_solution(name):
     """The active set started from the coarser mesh's contact multipliers
-    (solvers.active_set.ContactStart) solves the same discrete problem: the unknowns agree
+    (solvers.start.ContactStart) solves the same discrete problem: the unknowns agree
     to round-off with the solve from z = 0, in fewer semismooth Newton steps (Hertz: one)."""
     from ngdual.afem import refine_with_boundary
     from ngdual.mesh import build_mesh
     from ngdual.solvers import solve_on_mesh
-    from ngdual.solvers.active_set import ContactStart
+    from ngdual.solvers.start import ContactStart
 
     scene = load_scene(name)
     mesh = build_mesh(scene.geometry, 1)

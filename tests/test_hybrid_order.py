@@ -16,7 +16,8 @@ from ngdual.forms import assemble, broken_peers, conforming_peers
 from ngdual.mesh import build_mesh
 from ngdual.scene import load_scene
 from ngdual.solvers import solve_scene
-from ngdual.solvers.conforming import TOLERANCE, conforming_active_set
+from ngdual.solvers.conforming import conforming_active_set
+from ngdual.solvers.convergence import TOLERANCE
 from ngdual.solvers.hybrid_order import OrderHybridSystem, _element_schur, hybrid_active_set
 from ngdual.solvers.linear import solve_linear
 from ngdual.solvers.settings import solver_settings

@@ -20,7 +20,7 @@ from ngdual.forms import assemble
 from ngdual.friction import tresca_moments
 from ngdual.mesh import build_mesh
 from ngdual.scene import load_scene
-from ngdual.solvers import conforming, solve_problem
+from ngdual.solvers import conforming, convergence, solve_problem
 from ngdual.solvers.qp import solve_qp, solve_qp_friction
 from ngdual.solvers.semismooth import semismooth_newton
 from ngdual.solvers.settings import Model, solver_settings
@@ -87,14 +87,14 @@ def test_the_coulomb_check_at_order_k_takes_the_bound_as_the_solver_defines_it()
     solution = solve_problem(problem)
     t_n = (problem.apply(solution.x) - problem.rhs)[problem.lam_n]
     F = 0.5 * np.maximum(-t_n, 0.0)
-    assert conforming.residuals(problem, solution.x, "coulomb", 0.5, F)["coulomb_bound"] < 1e-9
+    assert convergence.residuals(problem, solution.x, "coulomb", 0.5, F)["coulomb_bound"] < 1e-9
     separated = np.flatnonzero(np.abs(t_n) < 1e-12 * np.max(np.abs(t_n)))
     assert len(separated)
     F[separated] = 0.0
     for share, fails in ((1e-7, False), (1e-5, True)):
         rhs = problem.rhs.copy()
         problem.rhs[problem.lam_n[separated[0]]] += share * np.max(np.abs(t_n))
-        found = conforming.residuals(problem, solution.x, "coulomb", 0.5, F)
+        found = convergence.residuals(problem, solution.x, "coulomb", 0.5, F)
         problem.rhs[:] = rhs
         assert (found["coulomb_bound"] > 1e-9) == fails, (share, found["coulomb_bound"])
 

@@ -8,7 +8,7 @@ the stress by e and a force per unit thickness by e c, and the contact and stick
 scaled discrete solution, so the contact force, the multipliers and the verdict
 "converged" must follow on every shipped scene, whatever the order k and the multiplier
 family (the convergence test measures every residual against the problem's scales:
-:mod:`ngdual.solvers.scales`). Scaling the friction bound alone changes the answer but not
+:mod:`ngdual.solvers.convergence`). Scaling the friction bound alone changes the answer but not
 the verdict: bounds from 1e-6 to 1e6 times the scene's pressure and mu_f from 1e-6 to 10
 solve.
 """

@@ -23,8 +23,8 @@ from ..mesh import build_mesh
 from ..scene import Scene
 from ..solution import Solution
 from ..solvers import solve_on_mesh
-from ..solvers.active_set import ContactStart
 from ..solvers.dispatch import with_discretisation
+from ..solvers.start import ContactStart
 from .arguments import check_adapt_arguments
 from .records import relative_estimate, step_record
 from .refinement import refine_with_boundary

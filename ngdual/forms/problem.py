@@ -85,7 +85,7 @@ class DiscreteProblem:
     def units(self) -> tuple[float, float]:
         """(E*, L): the plane-strain modulus E / (1 - nu^2) and the body's length scale
         (:func:`ngdual.geometry.length_scale`), the units in which a solver judges its
-        residuals (:class:`ngdual.solvers.scales.Scales`)."""
+        residuals (:class:`ngdual.solvers.convergence.Scales`)."""
         material = self.scene.material
         return (material.E / (1.0 - material.nu ** 2),
                 length_scale(self.scene.geometry.curves()))

@@ -54,29 +54,27 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
-from scipy.spatial import cKDTree
 
 from ..forms import DiscreteProblem
-from ..friction import FrictionForms, build_friction_forms, tresca_bound
+from ..friction import build_friction_forms, tresca_bound
 from ..solution import ConvergenceError, Solution
-from ..tolerances import COULOMB_FIXED_POINT_TOL, friction_vanishes
+from ..tolerances import COULOMB_FIXED_POINT_TOL
 from .cholesky import SchurCholesky
+from .coulomb import coulomb_bound, coulomb_fixed_point
 from .hybrid import HybridSystem
 from .linear import blas_threads
 from .nested import friction_residuals
 from .projections import NonnegativeProjection, metric_matrix
 from .semismooth import EPS, SAFETY, BoundarySolution, condition_number, semismooth_newton
 from .settings import ActiveSetSettings, Model
+from .start import ContactStart
 from .uzawa import contact_residuals
 
-RELAXATION_MIN = 1.0 / 64  # smallest relaxation of the Coulomb fixed point
 PROBE_SEED = 20110501      # the random signs of the round-off estimate (reproducible)
-CANDIDATE_EDGES = 4        # a warm start's edges searched per point, by midpoint distance
 INFORMATIVE = ("qp_fallback", "roundoff_level")  # reported, not checked
 
 
@@ -139,50 +137,6 @@ def _roundoff_probe(problem: DiscreteProblem, hybrid: HybridSystem, chol: SchurC
             if scale > 0:
                 level = max(level, float(np.max(np.abs(C.T @ d_sigma), initial=0.0) / scale))
     return level
-
-
-@dataclass(frozen=True)
-class ContactStart:
-    """The contact multipliers of a solution on another (coarser) mesh of the same Gamma_C,
-    to start the contact iteration from (the adaptive loop's warm start).
-
-    ``segments`` (n, 2, 2) are the fine Gamma_C edges of that mesh, ``lam_n`` and ``lam_t``
-    (n, 2) the multipliers at their ends: P1 on h~, so linear on every fine edge.
-    """
-
-    segments: np.ndarray
-    lam_n: np.ndarray
-    lam_t: np.ndarray
-
-    @classmethod
-    def of(cls, solution: Solution) -> ContactStart:
-        """The multipliers lambda_n, lambda_t of ``solution`` on its fine Gamma_C edges."""
-        pb = solution.problem
-        gamma_c = pb.spaces.gamma_c
-        fine = pb.to_fine(solution.x)
-        segments = np.concatenate([np.stack([chain.path_points[:-1], chain.path_points[1:]], 1)
-                                   for chain in gamma_c.coarse.chains])
-        values = {}
-        for name in ("lam_n", "lam_t"):
-            rng = pb.fes.Range(pb.names.index(name))
-            values[name] = fine[rng.start:rng.stop][gamma_c.edge_dofs]
-        return cls(segments, values["lam_n"], values["lam_t"])
-
-    def at(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """lambda_n, lambda_t at ``points`` of Gamma_C, linear along the nearest edge (a
-        refined mesh's vertices on a curved Gamma_C lie off the coarser mesh's chords)."""
-        a, b = self.segments[:, 0], self.segments[:, 1]
-        # the edge holding a point is among the few whose midpoints are nearest
-        _, near = cKDTree(0.5 * (a + b)).query(points, k=min(CANDIDATE_EDGES, len(a)))
-        near = near.reshape(len(points), -1)
-        d = (b - a)[near]
-        t = np.clip(np.einsum("qck,qck->qc", points[:, None, :] - a[near], d)
-                    / np.einsum("qck,qck->qc", d, d), 0.0, 1.0)
-        foot = a[near] + t[..., None] * d
-        best = np.argmin(np.linalg.norm(points[:, None, :] - foot, axis=2), axis=1)
-        rows = np.arange(len(points))
-        edge, w = near[rows, best], t[rows, best]
-        return tuple((1 - w) * v[edge, 0] + w * v[edge, 1] for v in (self.lam_n, self.lam_t))
 
 
 def _first_state(problem: DiscreteProblem, start: ContactStart | None, n_c: int,
@@ -313,7 +267,7 @@ def _active_set_solve(problem: DiscreteProblem, settings: ActiveSetSettings, tol
         residuals.update(friction_residuals(forms, problem, x, nu, bound,
                                             boundary.traction_scale))
     if law == "coulomb":
-        bound_x = _coulomb_bound(forms, forms.T_n @ x, mu_f, noise)
+        bound_x = coulomb_bound(forms, forms.T_n @ x, mu_f, noise)
         residuals["coulomb_bound"] = float(np.max(np.abs(bound_x - bound), initial=0.0) / (
             max(np.max(bound_x, initial=0.0), mu_f * boundary.stress_scale) or 1.0))
     _check(residuals, level, lambda: _roundoff_probe(
@@ -356,92 +310,6 @@ class BoundaryProblem:
         """sigma_n = t_f,n / |e| on the fine Gamma_C edges for the state's multipliers."""
         z = np.concatenate([state.lam_n, state.lam_t])
         return (self.a_f - self.B_f @ z)[:len(self.lengths)] / self.lengths
-
-
-def coulomb_fixed_point(boundary: BoundaryProblem, forms: FrictionForms, mu_f: float,
-                         tol: float, max_iter: int, progress, noise: float,
-                         first: BoundarySolution | None = None,
-                         on_sets: Callable[[BoundarySolution], np.ndarray | None] | None = None):
-    """Remark 3.45 on Gamma_C: F^0 from the frictionless solution, then Phi(F) = mu_f |sigma_n|
-    of (3.123) for the Tresca solution with bound F, warm-started, until F = Phi(F). The
-    frictionless solve starts from ``first`` (None: z = 0).
-
-    Stops when the fixed-point residual ||Phi(F) - F|| / ||Phi(F)|| is <= ``tol``, or when it
-    has stagnated (no longer halves) below SAFETY eps kappa_1(G), the round-off of F;
-    the returned F is then Phi(F) with its own Tresca solution.
-
-    Relaxation: the step is F <- F + omega (Phi(F) - F), omega = 1 (the plain fixed point of
-    the thesis) until the residual fails to decrease (the iteration oscillates, e.g. for
-    large mu_f), then halved each time it does so, down to ``RELAXATION_MIN``. A fixed point
-    of the relaxed map is a fixed point of Phi: the solution is the same, and where the plain
-    iteration contracts (all shipped scenes), so are the iterates. Where F is zero follows
-    :func:`ngdual.tolerances.friction_vanishes` with the round-off ``noise`` of a vanishing
-    normal stress.
-
-    ``on_sets(state)``, where given, is the normal stress of the Coulomb problem itself on
-    the contact, stick and slip sets of a Tresca solution ``state`` (None if it has none):
-    on fixed sets Phi is affine, and its fixed point is one linear solve away. Each new set
-    of a Tresca solution is tried once in place of a relaxed step; if the sets are the
-    solution's, the next Tresca solve reproduces F to round-off and the iteration stops by
-    the same criterion, otherwise it goes on from there (:func:`ngdual.solvers.conforming.
-    coulomb_on_sets`; the plain iteration takes 12-16 steps on Example 3.46 at order k,
-    levels 1-4, this one 2-7).
-    """
-    G, b, n_c = boundary.G, boundary.b, boundary.n_c
-    floor = SAFETY * boundary.roundoff  # = kkt_tolerance(G)
-    state = semismooth_newton(G, b, n_c, start=first, tol=floor)
-    inner = state.iterations
-    bound = _coulomb_bound(forms, boundary.normal_stress(state), mu_f, noise)
-    history: list[float] = []
-    omega, change = 1.0, np.inf
-    # the sets whose Coulomb problem was solved, and whether the last step was such a solve
-    tried, jumped = set(), False
-    for outer in range(1, max_iter + 1):
-        state = semismooth_newton(G, b, n_c, forms.q_matrix(bound).toarray(), start=state,
-                                  tol=floor)
-        inner += state.iterations
-        mapped = _coulomb_bound(forms, boundary.normal_stress(state), mu_f, noise)
-        change = float(np.linalg.norm(mapped - bound) / (np.linalg.norm(mapped) or 1.0))
-        history.append(change)
-        if progress:
-            progress(outer, change)
-        previous = history[-2] if len(history) > 1 else np.inf
-        if change <= tol or (change <= floor and change > 0.5 * previous):
-            # the last F: its own Tresca solution, so that F, nu and z belong together
-            bound = mapped
-            state = semismooth_newton(G, b, n_c, forms.q_matrix(bound).toarray(), start=state,
-                                      tol=floor)
-            inner += state.iterations
-            return state, bound, history, {"outer": outer, "inner": int(inner)}
-        if change >= previous and not jumped:
-            omega = max(0.5 * omega, RELAXATION_MIN)
-        jumped = False
-        if on_sets is not None:
-            key = (state.contact.tobytes(), state.stick.tobytes(), np.sign(state.nu).tobytes())
-            if key not in tried:
-                tried.add(key)
-                stress = on_sets(state)
-                jumped = stress is not None
-        bound = (_coulomb_bound(forms, stress, mu_f, noise) if jumped
-                 else bound + omega * (mapped - bound))
-    raise ConvergenceError(f"the Coulomb fixed point (3.123) did not converge in "
-                           f"solver.max_iter = {max_iter} steps: its relative change of F = "
-                           f"{change:.1e} > {tol:.1e} (relaxation omega = {omega:g}); try a "
-                           "smaller friction.mu", history)
-
-
-def _coulomb_bound(forms: FrictionForms, sigma_n: np.ndarray, mu_f: float,
-                   noise: float) -> np.ndarray:
-    """F of (3.123) (``FrictionForms.coulomb_bound_of``), zero where it vanishes.
-
-    On a separated part of Gamma_C the normal stress entering F vanishes up to rounding
-    errors of the stress scale; a bound made of rounding errors would turn the friction
-    conditions there into conditions on noise, so F is zero where
-    :func:`ngdual.tolerances.friction_vanishes` says so, with the round-off level ``noise``.
-    """
-    bound = forms.coulomb_bound_of(sigma_n, mu_f)
-    bound[friction_vanishes(bound, noise)] = 0.0
-    return bound
 
 
 def _contact_conditions(problem: DiscreteProblem, x: np.ndarray, metric: str, modulus: float,

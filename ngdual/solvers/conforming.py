@@ -30,7 +30,7 @@ lambda_J; G symmetric positive definite), so on J the problem is that of
 z = (lambda_n, lambda_t) on J (without friction lambda_t is free everywhere, t_t = 0: its
 block is the identity), and the damped semismooth Newton method with its QP fallback
 solves it; for Coulomb friction the fixed point F = mu_f (-t_n) of Remark 3.45 runs around
-it (:func:`ngdual.solvers.active_set.coulomb_fixed_point`). Off J the multipliers are free
+it (:func:`ngdual.solvers.coulomb.coulomb_fixed_point`). Off J the multipliers are free
 and their moments vanish, which satisfies the conditions exactly where lambda_n >= 0 (and,
 where a Tresca bound F_i > 0 holds, lambda_t,i = 0: stick). J starts with the coefficients
 the free solution pushes through the obstacle by at least ``DEEPEST`` of its deepest
@@ -68,11 +68,12 @@ from ..forms import DiscreteProblem
 from ..friction import MomentFriction, build_friction_forms, tresca_moments
 from ..solution import ConvergenceError, Solution
 from ..tolerances import COULOMB_FIXED_POINT_TOL
-from .active_set import ContactStart, _coulomb_bound, coulomb_fixed_point
+from .convergence import TOLERANCE, moments, residuals
+from .coulomb import coulomb_fixed_point
 from .linear import Factorization
-from .scales import TOLERANCE, Scales
 from .semismooth import EPS, SAFETY, BoundarySolution, condition_number, semismooth_newton
 from .settings import ActiveSetSettings
+from .start import ContactStart
 
 REGULAR = 1e-8     # the free solve of a regular K leaves relative residuals below this
 CONTACT_START = 1e-8  # a warm start's lambda_n in contact: below this of its largest value
@@ -266,7 +267,7 @@ def coulomb_on_sets(cond: Condensed, mu_f: float, state: BoundarySolution
                                              t_t,i = 0 where F_i = 0),
 
     the Newton step of the Coulomb law itself (Hueber, Stadler and Wohlmuth) on the sets the
-    fixed point of Remark 3.45 has found; :func:`ngdual.solvers.active_set.coulomb_fixed_point`
+    fixed point of Remark 3.45 has found; :func:`ngdual.solvers.coulomb.coulomb_fixed_point`
     checks it as it checks its own steps."""
     n = cond.n_c
     G, b = cond.G, cond.b
@@ -397,57 +398,3 @@ def _on_every_coefficient(problem: DiscreteProblem, law: str, mu_f: float, bound
     x[L] = z
     return x, state, F, {"iterations": {**its, "candidate_rounds": 0}, "history": history,
                          "unknowns": n_c, "solves": len(L) + 1}, fact.seconds
-
-
-def moments(problem: DiscreteProblem, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """t_n, t_t = C^T sigma - r on every coefficient (the lambda rows of K x - rhs)."""
-    residual = problem.apply(x) - problem.rhs
-    return residual[problem.lam_n], residual[problem.index("lam_t")]
-
-
-def residuals(problem: DiscreteProblem, x: np.ndarray, law: str, mu_f: float,
-              F: np.ndarray | None) -> dict:
-    """Relative residuals of (3.103) on ``problem.K`` and, with the bound F on the
-    coefficients, of the friction law, each against the scales of the problem
-    (:class:`~ngdual.solvers.scales.Scales`: the displacement scale D and the size of each
-    equation, never the residual's own quantity):
-
-    * ``stationarity``, ``equality``: the backward errors of the stress rows and of the
-      multiplier rows (equilibrium, symmetry, phi, and lambda_t: their rows carry Q_F^T nu
-      = t_t with friction);
-    * ``lambda_n_negative`` = max(-lambda_n) / D; ``sigma_n_positive`` = max t_n,i / T_i
-      and ``complementarity`` = max |lambda_n,i t_n,i| / (D T_i), T_i the size of the
-      moment row i;
-    * with F: ``friction_bound`` = max (|t_t,i| - F_i)^+ / (T_i + F_i); ``slip`` = max
-      |F_i |lambda_t,i| - lambda_t,i t_t,i| / (D (T_i + F_i)) (stick where |t_t,i| < F_i,
-      slip along t_t,i); for Coulomb ``coulomb_bound`` = max |F_i - mu_f (-t_n,i)| /
-      (mu_f T_i), zero where that vanishes (a moment at 1e-6 of the largest, as the
-      fixed point sets it: :func:`ngdual.tolerances.friction_vanishes`).
-    """
-    scales = Scales.of(problem, x)
-    i_lam, i_lam_t = problem.lam_n, problem.index("lam_t")
-    residual = problem.apply(x) - problem.rhs
-    t_n, t_t = residual[i_lam], residual[i_lam_t]
-    rows = problem.mult
-    if F is not None:  # the lambda_t rows carry Q_F^T nu = t_t: no equation of their own
-        rows = np.setdiff1d(rows, i_lam_t)
-    D = scales.displacement
-    lam_n, lam_t = x[i_lam], x[i_lam_t]
-    found = {
-        "stationarity": scales.relative(residual[problem.sigma], problem.sigma),
-        "equality": scales.relative(residual[rows], rows),
-        "lambda_n_negative": float(max(0.0, -lam_n.min(initial=0.0))) / (D or 1.0),
-        "sigma_n_positive": scales.per_row(np.maximum(t_n, 0.0), i_lam),
-        "complementarity": scales.per_row(lam_n * t_n, i_lam) / (D or 1.0),
-    }
-    if F is not None:
-        bounded = Scales(D, scales.stress, scales.rows[i_lam_t] + F)
-        every = np.arange(len(F))
-        found["friction_bound"] = bounded.per_row(np.maximum(np.abs(t_t) - F, 0.0), every)
-        found["slip"] = bounded.per_row(F * np.abs(lam_t) - lam_t * t_t, every) / (D or 1.0)
-    if law == "coulomb":
-        # F of the moments on K as the solver defines it: zero where it vanishes (at most
-        # 1e-6 of its largest value, tolerances.friction_vanishes), as the F it returns
-        mapped = _coulomb_bound(MomentFriction(), t_n, mu_f, 0.0)
-        found["coulomb_bound"] = scales.per_row(mapped - F, i_lam) / mu_f
-    return found

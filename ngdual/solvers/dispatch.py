@@ -38,7 +38,7 @@ from ..quadrature_check import check_formulas
 from ..scene import Scene, SceneError, SceneTypeError, check_level, ensure_valid, validate
 from ..scene.values import show
 from ..solution import ConvergenceError, PhysicsWarning, Solution
-from .active_set import ContactStart, active_set_solve
+from .active_set import active_set_solve
 from .hybrid_order import hybrid_active_set
 from .linear import solve_linear
 from .nested import nested_uzawa
@@ -50,6 +50,7 @@ from .settings import (
     UzawaSettings,
     solver_settings,
 )
+from .start import ContactStart
 from .uzawa import uzawa
 
 
@@ -213,7 +214,7 @@ def solve_problem(problem: DiscreteProblem, settings: Settings | None = None,
     :func:`~ngdual.solvers.settings.solver_settings`: the one place where a solve reads
     the scene. A solution with a non-finite value or residual is never returned as a
     solution: it raises :class:`ngdual.solution.ConvergenceError` with the history.
-    ``start`` warm-starts the active-set method (:class:`~.active_set.ContactStart`); the
+    ``start`` warm-starts the active-set method (:class:`~.start.ContactStart`); the
     Uzawa algorithms of the thesis start from zero and refuse it (ValueError).
     """
     if settings is None:

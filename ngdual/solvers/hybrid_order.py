@@ -67,19 +67,12 @@ from ..friction import MomentFriction, tresca_moments
 from ..solution import Solution
 from ..sparse import to_scipy
 from ..tolerances import COULOMB_FIXED_POINT_TOL
-from .active_set import ContactStart
 from .cholesky import SchurCholesky
-from .conforming import (
-    TOLERANCE,
-    Condensed,
-    checked_solution,
-    conforming_active_set,
-    moments,
-    residuals,
-    solve_condensed,
-)
+from .conforming import Condensed, checked_solution, conforming_active_set, solve_condensed
+from .convergence import TOLERANCE, moments, residuals
 from .linear import blas_threads
 from .settings import ActiveSetSettings
+from .start import ContactStart
 
 CONTACT_REFINEMENTS = 2  # corrections of b by the moments on K (hybrid_active_set)
 SCHUR_CHUNK = 2048  # triangles per batch of _element_schur (PEERS_2: 48 MB of blocks)
@@ -341,7 +334,7 @@ def hybrid_active_set(problem: DiscreteProblem, settings: ActiveSetSettings,
     ------
     ConvergenceError
         If the contact problem is not solved, the Coulomb fixed point does not converge, or
-        the residuals of (3.62) exceed :data:`ngdual.solvers.conforming.TOLERANCE`.
+        the residuals of (3.62) exceed :data:`ngdual.solvers.convergence.TOLERANCE`.
     """
     model = settings.model
     law = model.law

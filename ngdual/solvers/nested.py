@@ -42,7 +42,7 @@ from ..friction import FrictionForms, build_friction_forms, tresca_bound
 from ..solution import ConvergenceError, Solution
 from ..tolerances import CLARABEL_TOLERANCES, DIVERGENCE_FACTOR, friction_vanishes
 from .condensed import CondensedResponse
-from .scales import Scales
+from .convergence import Scales
 from .settings import Model, NestedUzawaSettings
 from .uzawa import ContactLoop
 
@@ -74,7 +74,7 @@ def sign_residual(Q: sp.spmatrix, nu: np.ndarray, lam_t: np.ndarray,
 
     Zero iff nu_j = sign q_j wherever q_j != 0; relative to the friction work j =
     max(int F |lambda_t| ds, int F ds times the problem's ``displacement`` scale D
-    (:class:`~ngdual.solvers.scales.Scales`)), so that stick (q = 0) counts as exact and
+    (:class:`~ngdual.solvers.convergence.Scales`)), so that stick (q = 0) counts as exact and
     the round-off of a vanishing lambda_t (no load) is not measured against itself.
     """
     q = Q @ lam_t

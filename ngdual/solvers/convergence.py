@@ -1,4 +1,5 @@
-"""The scales against which a discrete solution of (3.62) is judged converged.
+"""The convergence test of a discrete solution of (3.62): its residuals against the scales
+of the problem.
 
 A residual is small only relative to something. Measured against its own quantity it
 counts round-off as a violation of size one wherever that quantity vanishes: with nothing
@@ -32,7 +33,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..forms import DiscreteProblem
+from ..friction import MomentFriction
 from ..peers import STRESS
+from .coulomb import coulomb_bound
 
 TOLERANCE = 1e-9   # relative residuals of (3.62) accepted as round-off
 DISPLACEMENTS = ("u1", "u2", "phi1", "phi2", "lam_n", "lam_t")
@@ -86,3 +89,57 @@ class Scales:
         with np.errstate(divide="ignore", invalid="ignore"):
             ratio = np.where(size > 0, np.abs(values) / size, 0.0)
         return float(np.max(ratio, initial=0.0))
+
+
+def moments(problem: DiscreteProblem, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """t_n, t_t = C^T sigma - r on every coefficient (the lambda rows of K x - rhs)."""
+    residual = problem.apply(x) - problem.rhs
+    return residual[problem.lam_n], residual[problem.index("lam_t")]
+
+
+def residuals(problem: DiscreteProblem, x: np.ndarray, law: str, mu_f: float,
+              F: np.ndarray | None) -> dict:
+    """Relative residuals of (3.103) on ``problem.K`` and, with the bound F on the
+    coefficients, of the friction law, each against the scales of the problem
+    (:class:`~ngdual.solvers.convergence.Scales`: the displacement scale D and the size of each
+    equation, never the residual's own quantity):
+
+    * ``stationarity``, ``equality``: the backward errors of the stress rows and of the
+      multiplier rows (equilibrium, symmetry, phi, and lambda_t: their rows carry Q_F^T nu
+      = t_t with friction);
+    * ``lambda_n_negative`` = max(-lambda_n) / D; ``sigma_n_positive`` = max t_n,i / T_i
+      and ``complementarity`` = max |lambda_n,i t_n,i| / (D T_i), T_i the size of the
+      moment row i;
+    * with F: ``friction_bound`` = max (|t_t,i| - F_i)^+ / (T_i + F_i); ``slip`` = max
+      |F_i |lambda_t,i| - lambda_t,i t_t,i| / (D (T_i + F_i)) (stick where |t_t,i| < F_i,
+      slip along t_t,i); for Coulomb ``coulomb_bound`` = max |F_i - mu_f (-t_n,i)| /
+      (mu_f T_i), zero where that vanishes (a moment at 1e-6 of the largest, as the
+      fixed point sets it: :func:`ngdual.tolerances.friction_vanishes`).
+    """
+    scales = Scales.of(problem, x)
+    i_lam, i_lam_t = problem.lam_n, problem.index("lam_t")
+    residual = problem.apply(x) - problem.rhs
+    t_n, t_t = residual[i_lam], residual[i_lam_t]
+    rows = problem.mult
+    if F is not None:  # the lambda_t rows carry Q_F^T nu = t_t: no equation of their own
+        rows = np.setdiff1d(rows, i_lam_t)
+    D = scales.displacement
+    lam_n, lam_t = x[i_lam], x[i_lam_t]
+    found = {
+        "stationarity": scales.relative(residual[problem.sigma], problem.sigma),
+        "equality": scales.relative(residual[rows], rows),
+        "lambda_n_negative": float(max(0.0, -lam_n.min(initial=0.0))) / (D or 1.0),
+        "sigma_n_positive": scales.per_row(np.maximum(t_n, 0.0), i_lam),
+        "complementarity": scales.per_row(lam_n * t_n, i_lam) / (D or 1.0),
+    }
+    if F is not None:
+        bounded = Scales(D, scales.stress, scales.rows[i_lam_t] + F)
+        every = np.arange(len(F))
+        found["friction_bound"] = bounded.per_row(np.maximum(np.abs(t_t) - F, 0.0), every)
+        found["slip"] = bounded.per_row(F * np.abs(lam_t) - lam_t * t_t, every) / (D or 1.0)
+    if law == "coulomb":
+        # F of the moments on K as the solver defines it: zero where it vanishes (at most
+        # 1e-6 of its largest value, tolerances.friction_vanishes), as the F it returns
+        mapped = coulomb_bound(MomentFriction(), t_n, mu_f, 0.0)
+        found["coulomb_bound"] = scales.per_row(mapped - F, i_lam) / mu_f
+    return found
