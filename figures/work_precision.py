@@ -56,21 +56,21 @@ punch edges) and the relative error of sigma in the compliance norm (int A tau :
 Time: uniform and peer -- the wall time of one solve (mesh, assembly, solve; not the
 estimator); adaptive -- to that mesh's solution: the SOLVE-ESTIMATE-MARK-REFINE of every
 step before and its SOLVE (the estimate on the mesh, which decides whether to go on, is left
-out as uniform's is; ngdual.studies.sweep.work.adapt_task).
+out as uniform's is; ngdual.studies.sweep.adaptive_tasks.adapt_task).
 From the default K on, every time is the median of three runs (an adaptive step's: the
 median of its step's times, summed over the steps), runs beyond the first only while they
-take under 5 s (``ngdual.studies.sweep.work.REPEAT_BELOW_S``): one run's time of a fraction
+take under 5 s (``ngdual.studies.sweep.timing.REPEAT_BELOW_S``): one run's time of a fraction
 of a second varies by about 10 % with the load, enough to decide a verdict. A task's runs
 follow each other, so one slow period of the machine (10-25 % on a shared VM, invisible to
 the guest) can fall on all runs of one method: a verdict whose two times lie within
 CLOSE (1.3x) of each other is timed again after the sweep, the uniform solve and the
 adaptive run to its step in turn, seven runs of each after one not counted
-(ngdual.studies.sweep.work.paired_task), and decided by their medians (the table's
+(ngdual.studies.sweep.adaptive_tasks.paired_task), and decided by their medians (the table's
 "adaptive first" gives them). A verdict whose fastest adaptive run reaches the target with
 its first solve, the very solve of the fastest uniform level (same order, multipliers and
 unknowns), is a tie by construction: "tie: the same solve", no win, not timed again
 (same_solve). Every task
-runs NGSolve and BLAS on one thread (``ngdual.studies.sweep.work.one_thread``): one task per
+runs NGSolve and BLAS on one thread (``ngdual.studies.sweep.timing.one_thread``): one task per
 core, the same for every method.
 The table gives the least time to reach 5 %, 2 % and 1 % per method and measure, the
 verdicts adaptive against uniform (at order 0, and the fastest of each at any order), the
@@ -92,7 +92,7 @@ from ngdual.studies.figures.plan import (
     order_method,
 )
 from ngdual.studies.figures.tasks import paired_timing, truth_tasks
-from ngdual.studies.sweep.work import REPEAT_BELOW_S
+from ngdual.studies.sweep.timing import REPEAT_BELOW_S
 
 THESIS = "Work-precision (beyond the thesis)"
 STUDIES = ("truth",)

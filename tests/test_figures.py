@@ -452,7 +452,7 @@ def test_the_three_cornered_hat_recovers_three_orthogonal_errors_and_refuses_oth
     """Three solutions of one truth whose errors live on disjoint parts (orthogonal): the
     pairwise distances give each error exactly; distances no orthogonal errors can have
     (one longer than the other two together in squares) give no estimate."""
-    from ngdual.studies.figures.truth import three_cornered_hat
+    from ngdual.studies.figures.hats import three_cornered_hat
 
     truth = np.sin(np.linspace(0, 3, 30))
     errors = [np.zeros(30) for _ in range(3)]
@@ -473,7 +473,7 @@ def test_a_hat_that_a_corners_richardson_estimate_refutes_is_no_own_error(monkey
     error, and is no reference. With orthogonal errors (a's 0.5 w') the same corners give
     the hat, exact, as its error. The pressure's hat is bounded by every run with a
     Richardson estimate, corner or not."""
-    from ngdual.studies.figures import truth
+    from ngdual.studies.figures import hats
     from ngdual.verification import overkill
 
     v, w, w2 = np.eye(3)
@@ -482,7 +482,7 @@ def test_a_hat_that_a_corners_richardson_estimate_refutes_is_no_own_error(monkey
     def dist(x, y):
         return float(np.linalg.norm(x["e"] - y["e"]))
 
-    monkeypatch.setattr(truth, "pressure_distance", lambda x, y, window=None: dist(x, y))
+    monkeypatch.setattr(hats, "pressure_distance", lambda x, y, window=None: dist(x, y))
     monkeypatch.setattr(overkill, "true_errors", lambda x, y, lam, mu, window=None: {
         "sigma_energy": dist(x, y), "sigma_energy_norm": 1.0})
 
@@ -499,7 +499,7 @@ def test_a_hat_that_a_corners_richardson_estimate_refutes_is_no_own_error(monkey
     uniform = ({}, samples("uniform"))
     for name, truth_a in (("a", 2.0), ("a2", 0.5)):
         checks = [check(name, None), check("b", None), check("c", 0.5)]
-        truth._hat_checks(checks, runs_of([name, "b", "c"]), uniform, 1.0, 1.0, None)
+        hats.hat_checks(checks, runs_of([name, "b", "c"]), uniform, 1.0, 1.0, None)
         entry = checks[0]["pressure"]
         assert sorted(entry["corners"]) == ["b", "c"]
         if name == "a":
@@ -519,7 +519,7 @@ def test_a_hat_that_a_corners_richardson_estimate_refutes_is_no_own_error(monkey
     solutions.update(d=5 * v)
     for own_d, bound in ((5.0, 0.0), (1.25, 0.5), (0.75, 1.5)):
         checks = [check("a", None), check("b", None), check("c", None), check("d", own_d)]
-        truth._hat_checks(checks, runs_of(["a", "b", "c", "d"]), uniform, 1.0, 1.0, None)
+        hats.hat_checks(checks, runs_of(["a", "b", "c", "d"]), uniform, 1.0, 1.0, None)
         entry = checks[0]["pressure"]
         assert sorted(entry["corners"]) == ["b", "c"] and entry["hat"] == pytest.approx(1.0)
         assert entry["hat_bound"] == pytest.approx(bound) and entry["hat_bound"] <= 2.0
@@ -543,12 +543,12 @@ def test_a_task_runs_on_one_thread_and_leaves_the_threads_as_they_were():
     """execute() runs NGSolve's task manager (and BLAS) on one thread: one task per core,
     so that a large mesh's parallel assembly does not take a second core the other
     methods' timings do not get; the setting is restored afterwards."""
-    from ngdual.studies.sweep import work
+    from ngdual.studies.sweep import timing
 
-    before = work._ngsolve_threads()
+    before = timing._ngsolve_threads()
     record, _ = execute(Task("dofs", {"scene": "thesis-3.46-coulomb", "level": 1}))
     assert record["status"] == "ok" and record["threads"] == 1
-    assert work._ngsolve_threads() == before
+    assert timing._ngsolve_threads() == before
 
 
 def _worker_environment() -> dict:
@@ -575,15 +575,15 @@ def test_a_true_error_task_times_the_median_of_its_runs(monkeypatch):
     """With ``repeat`` the wall time of a solve, a peer solve and an adaptive run is the
     median of its runs (an adaptive run's: its steps' median times summed); runs beyond
     the first only below REPEAT_BELOW_S, and a plan below the default K times once."""
-    from ngdual.studies.sweep import work
+    from ngdual.studies.sweep import adaptive_tasks, solve_tasks, timing
 
-    solve, _ = work.solve_task("thesis-3.46-frictionless", 1, repeat=3)
+    solve, _ = solve_tasks.solve_task("thesis-3.46-frictionless", 1, repeat=3)
     assert len(solve["time_runs_s"]) == 3
     assert solve["time_s"] == pytest.approx(np.median(solve["time_runs_s"]))
     assert solve["time_runs_s"][0] == solve["timings_s"]["total"]
-    peer, _ = work.peer_task("hertz-cylinder", 1, 1, repeat=2)
+    peer, _ = solve_tasks.peer_task("hertz-cylinder", 1, 1, repeat=2)
     assert len(peer["time_runs_s"]) == 2 and peer["time_s"] == np.median(peer["time_runs_s"])
-    run, _ = work.adapt_task("thesis-3.46-frictionless", "dorfler", 0.8, 3, 1, repeat=3)
+    run, _ = adaptive_tasks.adapt_task("thesis-3.46-frictionless", "dorfler", 0.8, 3, 1, repeat=3)
     cumulative = [r["cumulative_s"] for r in run["history"]]
     assert len(cumulative) == 3 and np.all(np.diff(cumulative) > 0)
     for r in run["history"]:   # the same meshes in every run: three times per step
@@ -595,15 +595,18 @@ def test_a_true_error_task_times_the_median_of_its_runs(monkeypatch):
     assert cumulative == pytest.approx(np.cumsum(steps), rel=1e-12)
     # a rerun that keeps no step (its first mesh differs) leaves the first run's times
     with monkeypatch.context() as m:
-        m.setattr(work, "_loop_times", lambda *args: [])
-        alone, _ = work.adapt_task("thesis-3.46-frictionless", "dorfler", 0.8, 2, 1, repeat=3)
+        m.setattr(adaptive_tasks, "_loop_times", lambda *args: [])
+        alone, _ = adaptive_tasks.adapt_task("thesis-3.46-frictionless", "dorfler", 0.8, 2, 1,
+                                             repeat=3)
     assert alone["status"] == "ok"
     assert [r["cumulative_s"] for r in alone["history"]] == pytest.approx(
         [r["cumulative_runs_s"][0] for r in alone["history"]], rel=1e-12)
-    monkeypatch.setattr(work, "REPEAT_BELOW_S", 0.0)
-    once, _ = work.adapt_task("thesis-3.46-frictionless", "dorfler", 0.8, 2, 1, repeat=3)
+    monkeypatch.setattr(timing, "REPEAT_BELOW_S", 0.0)
+    monkeypatch.setattr(adaptive_tasks, "REPEAT_BELOW_S", 0.0)
+    once, _ = adaptive_tasks.adapt_task("thesis-3.46-frictionless", "dorfler", 0.8, 2, 1, repeat=3)
     assert [len(r["cumulative_runs_s"]) for r in once["history"]] == [1, 1]
-    assert len(work.solve_task("thesis-3.46-frictionless", 1, repeat=3)[0]["time_runs_s"]) == 1
+    solve, _ = solve_tasks.solve_task("thesis-3.46-frictionless", 1, repeat=3)
+    assert len(solve["time_runs_s"]) == 1
     assert Plan(3).timing_repeats == 1 and Plan(5).timing_repeats == Plan(7).timing_repeats == 3
 
 
@@ -612,33 +615,33 @@ def test_a_paired_timing_runs_uniform_and_adaptive_in_turn(monkeypatch):
     (uniform first in the odd rounds, adaptive first in the even ones), the adaptive run
     only to the step asked for, and its medians are those of its runs; a run on other
     meshes is not counted, and none counted is a failed record."""
-    from ngdual.studies.sweep import work
+    from ngdual.studies.sweep import adaptive_tasks
 
     uniform = {"scene": "thesis-3.46-frictionless", "level": 1, "overrides": []}
     adaptive = {"scene": "thesis-3.46-frictionless", "overrides": [], "marking": "dorfler",
                 "theta": 0.8, "steps": 5, "level": 1, "goal": "stress", "tol": None,
                 "window": None}
-    run, _ = work.adapt_task("thesis-3.46-frictionless", "dorfler", 0.8, 5, 1)
+    run, _ = adaptive_tasks.adapt_task("thesis-3.46-frictionless", "dorfler", 0.8, 5, 1)
     unknowns = [r["dofs"]["total"] for r in run["history"]][:2]
-    record, arrays = work.paired_task(uniform, adaptive, unknowns, rounds=3)
+    record, arrays = adaptive_tasks.paired_task(uniform, adaptive, unknowns, rounds=3)
     assert record["status"] == "ok" and arrays == {}
     assert len(record["uniform_runs_s"]) == len(record["adaptive_runs_s"]) == 3
     assert record["uniform_s"] == np.median(record["uniform_runs_s"])
     assert record["adaptive_s"] == np.median(record["adaptive_runs_s"])
     calls = []
-    monkeypatch.setattr(work, "_solve_quietly", lambda sc, level: calls.append("u") or type(
-        "S", (), {"timings": {"total": 1.0}})())
+    monkeypatch.setattr(adaptive_tasks, "solve_quietly", lambda sc, level: calls.append(
+        "u") or type("S", (), {"timings": {"total": 1.0}})())
 
     def loop_times(scene, overrides, loop, steps, max_elements):
         calls.append("a")
         assert loop["steps"] == 5 and steps == unknowns and max_elements is None
         return [0.1, 0.2]
-    monkeypatch.setattr(work, "_loop_times", loop_times)
-    record, _ = work.paired_task(uniform, adaptive, unknowns, rounds=4)
+    monkeypatch.setattr(adaptive_tasks, "_loop_times", loop_times)
+    record, _ = adaptive_tasks.paired_task(uniform, adaptive, unknowns, rounds=4)
     assert "".join(calls) == "ua" + "uaauuaau"
     assert record["adaptive_runs_s"] == [0.2] * 4 and record["uniform_s"] == 1.0
-    monkeypatch.setattr(work, "_loop_times", lambda *args: [0.1])   # the meshes differ
-    record, _ = work.paired_task(uniform, adaptive, unknowns, rounds=2)
+    monkeypatch.setattr(adaptive_tasks, "_loop_times", lambda *args: [0.1])   # the meshes differ
+    record, _ = adaptive_tasks.paired_task(uniform, adaptive, unknowns, rounds=2)
     assert record["status"] == "failed" and "step's mesh" in record["message"]
 
 
@@ -649,7 +652,7 @@ def test_close_verdicts_are_decided_by_their_paired_timing():
     decide "adaptive first" (a failed pairing leaves the table's verdict), and the README's
     cell gives them."""
     from ngdual.studies.figures.run import load_script
-    from ngdual.studies.sweep.work import REPEAT_BELOW_S
+    from ngdual.studies.sweep.timing import REPEAT_BELOW_S
 
     wp = load_script(Path(__file__).parents[1] / "figures" / "work_precision.py")
 

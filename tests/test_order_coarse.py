@@ -149,7 +149,7 @@ def test_the_coarse_family_is_measured_by_its_traces_which_converge():
     """At order k the pressure samples of the coarse family are the traces -sigma_nn^h
     (4k + 2 per fine edge; its unknowns are Bernstein coefficients on h~, not nodal
     values), and they approach a finer facet solution of Example 3.46 level by level."""
-    from ngdual.studies.figures.truth import pressure_distance
+    from ngdual.studies.figures.hats import pressure_distance
     from ngdual.verification.overkill import solution_samples
 
     def samples(level, family):

@@ -82,18 +82,18 @@ STRAIN_TERMS = ("curl", "jump_interior", "jump_dirichlet", "jump_neumann")
 CALIBRATION = 0.1
 # The far field of a window (the dipole weight, :func:`_dipole_weight`) at order k >= 1,
 # calibrated where it is the estimate: on the flat punch's core (the edge terms vanish
-# there) it read 2.46 (k = 1) and 2.41 (k = 2) times the true error at 0.1 (geometric means
-# over the resolved steps of the work-precision study at commit bd02125), so 0.1 / 2.4 = 0.04.
+# there) it reads 2.46 (k = 1) and 2.41 (k = 2) times the true error at 0.1 (geometric means
+# over the resolved steps of the work-precision study), so 0.1 / 2.4 = 0.04.
 # Not derived: the far field of the punch edges' singular elements reaches the core less than
 # the weight of order k says (docs/theory/estimator.md, "The far field's constant").
 CALIBRATION_WINDOW_ORDER_K = 0.04
 # The edge terms at order k with the facet multipliers, by the same recipe: the constant
 # that makes the geometric mean of the effectivity 1 over a tolerance run on hertz-cylinder
-# at order k from level 1, the far field at 0.1 (recomputed from the stored terms of the
-# study at commit cbf539c, theta = 0.9, docs/theory/estimator.md): k = 2 0.114 (nine
-# steps), rounded to 0.11; k = 1 0.165 (twelve steps), and 0.15, from eight theta = 0.8
-# steps with the far field at 0.15, is kept: 10 %, within the spread of one run's
-# effectivity. Orders above 2 take k = 2's.
+# at order k from level 1, the far field at 0.1 (from the terms of the tolerance study with
+# theta = 0.9, docs/theory/estimator.md): k = 2 0.114 (nine steps), rounded to 0.11; k = 1
+# 0.165 (twelve steps), within 10 % of 0.15, the constant of eight theta = 0.8 steps with
+# the far field at 0.15, and so within the spread of one run's effectivity: 0.15. Orders
+# above 2 take k = 2's.
 CALIBRATION_ORDER_K = {1: 0.15, 2: 0.11}
 # The weight of the vertex jumps of the order-k pressure against the other terms, measured
 # (docs/theory/estimator.md, "The jumps of the pressure of order k"): at k = 1 the pressure

@@ -117,7 +117,7 @@ class Plan:
     @property
     def timing_repeats(self) -> int:
         """Timed runs of a true-error task (the median is its wall time,
-        :data:`ngdual.studies.sweep.work.REPEAT_BELOW_S`): :data:`TIMING_REPEATS` from the
+        :data:`ngdual.studies.sweep.timing.REPEAT_BELOW_S`): :data:`TIMING_REPEATS` from the
         default K on; a smoke run below it times once."""
         return TIMING_REPEATS if self.max_level >= DEFAULT_MAX_LEVEL else 1
 
@@ -188,9 +188,9 @@ TRUTH_PROBLEMS = {
     # the punch pressure ~ (a - |x|)^(-1/2) is not in L2: its error on the core |x| < a/2
     # (as ngdual.verification.analytic); sigma (~ r^(-1/2)) is in L2 everywhere, but its
     # references converge slowest: at the tolerance 0.001 of the other problems the best,
-    # the stress goal of order 1 (307 936 unknowns), was Richardson-accurate to 0.60 %
-    # (0.785 per step), which does not resolve 1 % (the study at 1925802); its steps solved
-    # again by PEERS_2 converge at 0.89 per step. A third of the tolerance and twice the
+    # the stress goal of order 1 (307 936 unknowns), is Richardson-accurate to 0.60 %
+    # (0.785 per step), which does not resolve 1 %; its steps solved again by PEERS_2
+    # converge at 0.89 per step. A third of the tolerance and twice the
     # budget of order k take it about four steps further
     "flat-punch": TruthProblem("flat-punch", (), 2, "flat punch", 206, 0.125,
                                reference_tol=0.0003, order_budget=2),

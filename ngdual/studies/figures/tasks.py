@@ -9,7 +9,8 @@ for, so the tables and the figures share it.
 from __future__ import annotations
 
 from ..sweep import Task
-from ..sweep.work import LOOP_KEYS, PAIRED_ROUNDS
+from ..sweep.adaptive_tasks import LOOP_KEYS
+from ..sweep.timing import PAIRED_ROUNDS
 from ..variants import UZAWA, setting
 from .plan import (
     ADAPT_STEPS,
@@ -161,7 +162,7 @@ def peer_solve(plan: Plan, problem: str, level: int, order: int) -> Task:
 def paired_timing(plan: Plan, uniform: Task, adaptive: Task, unknowns: list[int]) -> Task:
     """The uniform solve ``uniform`` and the adaptive run ``adaptive`` to the solution of
     its step of ``unknowns[-1]`` unknowns (``unknowns``: its steps' up to that one), timed
-    in turn (:func:`ngdual.studies.sweep.work.paired_task`): PAIRED_ROUNDS runs of each
+    in turn (:func:`ngdual.studies.sweep.adaptive_tasks.paired_task`): PAIRED_ROUNDS runs of each
     where the plan times its tasks more than once, else one."""
     u, a = uniform.params, adaptive.params
     return Task("paired", {"uniform": {k: u[k] for k in ("scene", "level", "overrides")},

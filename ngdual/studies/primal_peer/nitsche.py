@@ -288,7 +288,7 @@ def solve_primal(mesh: ngs.Mesh, *, E: float, nu: float, dirichlet, neumann=(), 
                              "sqrt(max(0, w)) as ifpos(w, sqrt(ifpos(w, w, 1)), 0)")
         t1 = time.perf_counter()
         # one BLAS thread: NGSolve's threaded OpenBLAS spin-waits on shared cores (the same
-        # UMFPACK factorisation took 0.57 s with one thread and 1.6-3 s without the limit)
+        # UMFPACK factorisation takes 0.57 s with one thread and 1.6-3 s without the limit)
         with threadpool_limits(limits=BLAS_THREADS):
             inv = a.mat.Inverse(free, inverse="umfpack")
             du = (inv * res).Evaluate()

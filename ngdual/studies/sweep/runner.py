@@ -18,7 +18,8 @@ from pathlib import Path
 from ...extras import require
 from ..variants import VARIANTS
 from .records import Task, load_record, record_path, remove_stale_temporaries, write_record
-from .work import execute, load_scene_with
+from .solve_tasks import load_scene_with
+from .work import execute
 
 WORKER_ENV = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1",
               "MPLBACKEND": "Agg"}
@@ -32,9 +33,9 @@ UNSET_IN_WORKERS = ("MALLOC_TRIM_THRESHOLD_",)
 # dask's statistical profiler wakes every 10 ms in a worker, takes the GIL and walks the
 # stack of the running task: code that spends its time in many short Python calls pays for
 # it, code in long C calls hardly does. The adaptive run of order 2 on Example 3.46 to
-# 11 264 unknowns took 0.44-0.50 s in a worker against 0.39-0.41 s with the profiler off
-# or in a plain process, while the uniform PEERS_1 solve of level 4 took the same time
-# (0.39-0.46 s) either way: the profiler biased the study's wall times against the
+# 11 264 unknowns takes 0.44-0.50 s in a worker against 0.39-0.41 s with the profiler off
+# or in a plain process, while the uniform PEERS_1 solve of level 4 takes the same time
+# (0.39-0.46 s) either way: the profiler would bias the study's wall times against the
 # adaptive loop. Its samples are not used here.
 WORKER_CONFIG = {"distributed.worker.profile.enabled": False}
 
@@ -43,9 +44,10 @@ WORKER_CONFIG = {"distributed.worker.profile.enabled": False}
 def _environment_kept():
     """This process's environment as it was on entry, on exit. dask's nanny writes its
     pre-spawn environment (OMP_NUM_THREADS=1, OPENBLAS_NUM_THREADS=1, MKL_NUM_THREADS=1,
-    PYTHONHASHSEED) into the parent's os.environ before it spawns a worker: afterwards the
-    parent's variables no longer said how many threads its own BLAS runs on (a test that
-    compares the two failed after a sweep had started a cluster in the same process)."""
+    PYTHONHASHSEED) into the parent's os.environ before it spawns a worker: without the
+    restore the parent's variables would no longer say how many threads its own BLAS runs
+    on, and a process that compares the two would find them differ once a sweep has
+    started a cluster in it."""
     saved = dict(os.environ)
     try:
         yield
