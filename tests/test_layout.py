@@ -28,7 +28,7 @@ STAGES = [
     ("estimator", ["estimator", "goal"]),
     ("marking", ["marking"]),
     ("afem", ["afem"]),
-    ("post", ["post", "plot"]),
+    ("post", ["post", "summary", "plot"]),
     ("verification", ["verification"]),
     ("run machinery", ["studies", "cli", "__main__"]),
 ]

@@ -72,14 +72,93 @@ def level_flags(levels, flag: str) -> list[int]:
     return [check_level(level, flag) for level in levels]
 
 
+# rows of the summary: key, what it is, its symbol in the benchmark's formulas, its kind
+SUMMARY_ROWS = [("half_width", "contact half-width", "a", "length"),
+                ("peak_pressure", "peak pressure", "p0", "stress"),
+                ("normal_force", "normal force", "P", "force"),
+                ("tangential_force", "tangential force", "Q", "force"),
+                ("peak_shear", "peak shear |q_h|", "", "stress"),
+                ("stick_half_width", "stick half-width", "c", "length")]
+THESIS_HEADING = "norms and residuals of (3.62)"
+FRICTION_ONLY = ("stick_nodes", "slip_nodes", "stick_edges", "slip_edges", "max_traction_ratio")
+
+
+def _g(value: float) -> str:
+    """Four significant digits: what a summary of a discretisation can claim."""
+    return f"{value:.4g}"
+
+
+def _unit(summary: dict, kind: str) -> str:
+    units = summary["units"]
+    length, stress = units["length"], units["stress"]
+    unit = {"length": length, "stress": stress,
+            "force": f"{stress}*{length}" if stress and length else None}[kind]
+    return f" [{unit}]" if unit else ""
+
+
+def _direction(vector: list[float]) -> str:
+    axes = {(1.0, 0.0): "+x_1", (-1.0, 0.0): "-x_1", (0.0, 1.0): "+x_2", (0.0, -1.0): "-x_2"}
+    rounded = tuple(round(v, 12) + 0.0 for v in vector)
+    return axes.get(rounded, f"({vector[0]:.3g}, {vector[1]:.3g})")
+
+
+def _zones(runs: list[list[float]]) -> str:
+    return ", ".join(f"[{_g(a)}, {_g(b)}]" for a, b in runs) or "none"
+
+
+def summary_table(summary: dict) -> str:
+    """The summary of :func:`ngdual.summary.solution_summary` as a student reads it: the
+    method, then one row per quantity with the analytic value of the scene's benchmark
+    beside it and the relative difference; stick and slip zones only where friction acts."""
+    m = summary["method"]
+    lines = [f"{m['scene']}, level {m['level']}: PEERS order {m['order']}, {m['multipliers']} "
+             f"multipliers, {m['solver']}" + ("" if m["converged"] else " (NOT converged)")]
+    if not summary["contact"]:
+        return "\n".join(lines + ["no contact boundary: no contact quantities"])
+    bench = summary.get("benchmark")
+    n, t = (_direction(summary["directions"][k]) for k in ("normal", "tangent"))
+    lines.append(f"{'':32s}{'computed':>11s}" + (f"{bench['name']:>18s}{'difference':>12s}"
+                                                   if bench else ""))
+    for key, name, symbol, kind in SUMMARY_ROWS:
+        if summary.get(key) is None:
+            continue
+        label = f"{name} {symbol}".strip() + _unit(summary, kind)
+        row = f"{label:32s}{_g(summary[key]):>11s}"
+        if bench and key in bench["values"]:
+            row += f"{_g(bench['values'][key]):>18s}"
+            if key in bench["difference"]:
+                row += f"{bench['difference'][key] * 100:>+10.3g} %"
+        lines.append(row + {"half_width": f"   (node spacing {_g(summary['resolution'] or 0)})",
+                            "normal_force": f"   (along {n}, on the body)",
+                            "tangential_force": f"   (along {t})",
+                            "peak_pressure": "" if summary["peak_at"] is None else
+                            f"   (at {_g(summary['peak_at'])})"}.get(key, ""))
+    lines.append(f"{'contact zone':32s}{_zones(summary['contact_zones'])}")
+    if summary.get("friction"):
+        lines.append(f"{'stick zone':32s}{_zones(summary['stick'])}")
+        lines.append(f"{'slip zones':32s}{_zones(summary['slip'])}")
+    if bench:
+        forces = "forces P and Q" if "peak_shear" in bench["values"] else "force P"
+        lines.append(f"{bench['name']}: the analytic solution for the computed {forces}; "
+                     f"positions along {t}")
+    else:
+        lines.append(f"positions along {t}")
+    return "\n".join(lines)
+
+
 def result_table(record: dict) -> str:
-    lines = [f"scene {record['scene']}  level {record['level']}  method {record['method']}  "
+    """The record of ``ngdual solve`` under the heading THESIS_HEADING: DOFs, the norms of
+    Tables 3.2/3.3, the contact record (stick and slip counts only with friction), the
+    iterations and residuals of (3.62), the timings."""
+    lines = [f"-- {THESIS_HEADING} --",
+             f"scene {record['scene']}  level {record['level']}  method {record['method']}  "
              f"converged {record['converged']}"]
     lines.append("dofs      " + "  ".join(f"{k}={v}" for k, v in record["dofs"].items()))
     lines.append("norms     " + "  ".join(f"{k}={v:.6e}" for k, v in record["norms"].items()
                                           if v is not None))
-    lines.append("contact   " + "  ".join(f"{k}={v:.6g}" if isinstance(v, float) else f"{k}={v}"
-                                          for k, v in record["contact"].items()))
+    friction = "stick_edges" in record["contact"]
+    lines.append("contact   " + "  ".join(f"{k}={_value(v)}" for k, v in record["contact"].items()
+                                          if friction or k not in FRICTION_ONLY))
     lines.append("iterations " + "  ".join(f"{k}={v}" for k, v in record["iterations"].items()))
     if record["residuals"]:
         lines.append("residuals " + "  ".join(f"{k}={v:.2e}"
@@ -87,6 +166,14 @@ def result_table(record: dict) -> str:
     lines.append("time [s]  " + "  ".join(f"{k}={v:.3f}"
                                           for k, v in record["timings_s"].items()))
     return "\n".join(lines)
+
+
+def _value(value) -> str:
+    if isinstance(value, float):
+        return _g(value)
+    if isinstance(value, list):
+        return "[" + ", ".join(_value(v) for v in value) + "]"
+    return str(value)
 
 
 def progress_bar(desc: str = "Uzawa"):

@@ -18,6 +18,7 @@ from .output import (
     progress_bar,
     result_table,
     strict_failure,
+    summary_table,
     warning_lines,
 )
 
@@ -31,6 +32,8 @@ def cmd_solve(args) -> int:
     from ..io import check_output_dir, write_json
     from ..solution import ConvergenceError
     from ..solvers import solve_scene
+    from ..summary import solution_summary
+    from ..verification.benchmark import NAMES, benchmark_traces
 
     level = check_level(args.level, "--level", optional=True)
     scene = load_scene(args.scene, args.set)
@@ -50,7 +53,11 @@ def cmd_solve(args) -> int:
         return not_converged(err)
     status("post-processing")
     record = post.result_record(solution)
+    bench = benchmark_traces(solution) if solution.problem.spaces.contact is not None else None
+    record["summary"] = solution_summary(solution, *(bench.solution, NAMES[scene.benchmark.kind])
+                                         if bench else ())
     status.done()
+    print(summary_table(record["summary"]))
     print(result_table(record))
     if record["warnings"]:
         print(warning_lines(record["warnings"]))
