@@ -22,7 +22,8 @@ loop SOLVE, ESTIMATE, MARK, REFINE) and its steps, to write the loop by hand:
 :func:`contact_traces`, :func:`force_balance`, :func:`result_record`. Plotting (each returns
 a matplotlib figure): :func:`plot_geometry` (the domain, its boundary parts and the mesh),
 :func:`plot_contact_traces`, :func:`plot_element_field`, :func:`plot_von_mises`,
-:func:`plot_mesh`; saving one is the caller's choice, :func:`save_figure`.
+:func:`plot_mesh`, :func:`plot_deformed` (the body moved by u_h, magnified); saving one is the
+caller's choice, :func:`save_figure`.
 
 The names are loaded lazily (PEP 562): ``import ngdual`` imports neither NGSolve nor
 matplotlib, so that the command line starts fast; the first use of a name imports its
@@ -62,6 +63,7 @@ _PUBLIC = {
     "plot_geometry": ("ngdual.plot", "plot_geometry"),
     "plot_mesh": ("ngdual.plot", "plot_mesh"),
     "plot_von_mises": ("ngdual.plot", "plot_von_mises"),
+    "plot_deformed": ("ngdual.plot", "plot_deformed"),
     "save_figure": ("ngdual.plot", "save_figure"),
 }
 

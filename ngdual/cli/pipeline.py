@@ -73,26 +73,52 @@ def cmd_solve(args) -> int:
     return 0 if solution.converged else EXIT_NOT_CONVERGED
 
 
-def solution_figures(solution, out) -> list:
-    """von_mises.png (colour scale clipped: the corners are singular) and, with contact,
+def solution_figures(solution, out, prefix: str = "", where: str | None = None) -> list:
+    """von_mises.png (colour scale clipped: the corners are singular), deformed.png (the
+    body moved by u_h, the magnification in its title) and, with contact,
     contact_traces.png (p_h, q_h against the analytic solution of the scene's
-    ``[benchmark]``, if it names one), labelled in the scene's units."""
+    ``[benchmark]``, if it names one), labelled in the scene's units; the file names start
+    with ``prefix``, the titles say ``where`` the mesh comes from (default: its level)."""
     from .. import plot, post
     from ..quantities import fields
     from ..verification.benchmark import benchmark_traces
 
-    scene, level = solution.problem.scene, solution.problem.level
+    scene = solution.problem.scene
+    where = where or f"level {solution.problem.level}"
     fig = plot.plot_von_mises(solution.problem.fes.mesh, fields(solution).sigma,
                               scene.material.nu,
-                              f"Plane-strain von Mises stress, {scene.name}, level {level}",
+                              f"Plane-strain von Mises stress, {scene.name}, {where}",
                               units=scene.units)
-    written = plot.save_figure(fig, out / "von_mises.png")
+    written = plot.save_figure(fig, out / f"{prefix}von_mises.png")
+    fig = plot.plot_deformed(solution)
+    fig.axes[0].set_title(fig.axes[0].get_title().replace(f"level {solution.problem.level}",
+                                                          where))
+    written += plot.save_figure(fig, out / f"{prefix}deformed.png")
     if solution.problem.spaces.contact is not None:
         fig = plot.plot_contact_traces(post.contact_traces(solution),
-                                       f"Gamma_C traces, {scene.name}, level {level}",
+                                       f"Gamma_C traces, {scene.name}, {where}",
                                        units=scene.units, exact=benchmark_traces(solution))
-        written += plot.save_figure(fig, out / "contact_traces.png")
+        written += plot.save_figure(fig, out / f"{prefix}contact_traces.png")
     return written
+
+
+def adapt_figures(run: dict, solution, out) -> list:
+    """convergence.png (the goal's relative estimate against unknowns and wall time, the
+    --tol line; :func:`ngdual.plot.plot_convergence`) and the pictures of the last step's
+    solution, final_*.png: its mesh, von Mises stress, deformed body and contact traces."""
+    from .. import plot
+    from ..mesh import mesh_arrays
+
+    scene, mesh = solution.problem.scene, solution.problem.fes.mesh
+    written = plot.save_figure(plot.plot_convergence(
+        run["history"], run["tol"], f"{scene.name}: {run['marking']} marking, goal "
+                                    f"{run['goal']}"), out / "convergence.png")
+    points, triangles = mesh_arrays(mesh)
+    written += plot.save_figure(plot.plot_mesh(
+        points, triangles, f"{scene.name}, final mesh (step {run['history'][-1]['step']}): "
+                           f"{mesh.ne} triangles", units=scene.units), out / "final_mesh.png")
+    return written + solution_figures(solution, out, "final_", f"final mesh ({mesh.ne} "
+                                                                "triangles)")
 
 
 def cmd_scenes(args) -> int:
@@ -188,13 +214,19 @@ def _adapt(args) -> int:
         except ConvergenceError as err:
             return not_converged(err)
 
+    final = {}
+    print(f"estimate (stress, absolute): ||eta_tot|| of (4.50); {args.goal} (relative): the "
+          f"goal's estimate over the size of what it measures" + (", compared with --tol"
+                                                                 if args.tol else ""))
+
     def on_step(record, solution, estimated, marked):
         effectivity = record.get("effectivity")
+        final["solution"] = solution
         line = (f"step {record['step']:3d}  dofs {record['dofs']['total']:8d}  "
-                f"estimator {record['estimator']:.4e}"
+                f"estimate (stress, absolute) {record['estimator']:.4e}"
                 + (f"  e_tot {record['e_tot']:.4e}  effectivity {effectivity:.3f}"
                    if effectivity else "")
-                + f"  {record['goal']} {record['relative_estimate']:.3e}"
+                + f"  {record['goal']} (relative) {record['relative_estimate']:.3e}"
                 + f"  marked {record['marked']}  {record['elapsed_s']:.1f} s"
                 + (f"  (stopped by {record['stopped_by']})" if "stopped_by" in record
                    else ""))
@@ -243,6 +275,8 @@ def _adapt(args) -> int:
     write_json(run, out / "history.json")
     print(f"wrote {out / 'history.json'} and {len(run['history'])} meshes (.vol, .png"
           + (", solution_stepNN.vtu)" if args.vtk else ")"))
+    if run["history"]:
+        print("wrote " + ", ".join(str(p) for p in adapt_figures(run, final["solution"], out)))
     last = run["history"][-1]
     if last["stopped_by"] == "memory":
         print(f"ngdual: stopped by memory: {last['stop_message']}", file=sys.stderr)

@@ -7,7 +7,8 @@ caller's choice, :func:`save_figure`. Importing this package leaves matplotlib's
 alone: a notebook keeps its inline backend, a headless run gets Agg by matplotlib's own
 fallback.
 
-One module per kind of picture: :mod:`.fields` (element fields, von Mises), :mod:`.meshes`
+One module per kind of picture: :mod:`.fields` (element fields, von Mises), :mod:`.deformed`
+(the deformed body), :mod:`.meshes`
 (the triangulation, the boundary parts, the domain of Example 3.46), :mod:`.traces` (the
 traces on Gamma_C), :mod:`.curves` (line plots and iteration-count grids), :mod:`.scales`
 (axis labels in the scene's units, clipped colour scales) and :mod:`.save` (files and the
@@ -25,7 +26,8 @@ colour bar says so.
 'Figure'
 """
 
-from .curves import plot_curves, plot_heatmaps
+from .curves import plot_convergence, plot_curves, plot_heatmaps
+from .deformed import magnification, plot_deformed
 from .fields import plot_element_field, plot_field_pair, plot_von_mises
 from .meshes import plot_domain, plot_geometry, plot_mesh
 from .save import figure_texts, save_figure
@@ -35,6 +37,7 @@ from .traces import TRACE_CLIP, corner_note, plot_contact_traces, trace_range
 # in the order of the API page: the pictures of a solution, saving, the thesis' figures, the
 # helpers of figure scripts that draw their own panels
 __all__ = ["plot_geometry", "plot_mesh", "plot_element_field", "plot_von_mises",
-           "plot_contact_traces", "save_figure", "figure_texts", "plot_field_pair", "plot_curves",
+           "plot_contact_traces", "plot_deformed", "plot_convergence", "save_figure",
+           "figure_texts", "plot_field_pair", "plot_curves", "magnification",
            "plot_heatmaps", "plot_domain", "unit_label", "clipped_scale", "trace_range",
            "corner_note", "CORNER_CLIP", "TRACE_CLIP"]

@@ -1,6 +1,6 @@
 """Line plots and iteration-count grids of the figures of Sections 3.4 and 4.2: panels of
-curves (:func:`plot_curves`) and heat maps over a parameter grid (:func:`plot_heatmaps`,
-Fig. 3.23)."""
+curves (:func:`plot_curves`), heat maps over a parameter grid (:func:`plot_heatmaps`,
+Fig. 3.23) and the convergence of an adaptive run (:func:`plot_convergence`)."""
 
 from __future__ import annotations
 
@@ -85,3 +85,42 @@ def plot_heatmaps(x: np.ndarray, y: np.ndarray, grids: list[np.ndarray], titles:
         fig.colorbar(art, ax=ax, label=clabel)
     fig.suptitle(suptitle)
     return fig
+
+
+def plot_convergence(history: list[dict], tol: float | None = None, title: str = "") -> Figure:
+    """The goal's relative estimate of every step of an adaptive run against the unknowns
+    and against the wall time, with the tolerance line ``tol``.
+
+    ``history``: the records of :func:`ngdual.afem.adapt` (``dofs["total"]``,
+    ``relative_estimate``, ``goal``, ``elapsed_s``); where they carry the total error
+    ``e_tot`` of (3.124) (reference norms given) and the goal is the stress, also e_tot
+    relative to the same size
+    (``goal_estimate`` / ``relative_estimate``), the true error the estimate is measured
+    against.
+
+    >>> fig = plot_convergence([{"dofs": {"total": 100}, "relative_estimate": 0.1,
+    ...                          "goal_estimate": 1.0, "goal": "stress", "elapsed_s": 0.5},
+    ...                         {"dofs": {"total": 400}, "relative_estimate": 0.05,
+    ...                          "goal_estimate": 0.5, "goal": "stress", "elapsed_s": 1.5}],
+    ...                        tol=0.06)
+    >>> [ax.get_xlabel() for ax in fig.axes]
+    ['unknowns (all fields)', 'wall time since the start [s]']
+    """
+    goal = history[0]["goal"] if history else "stress"
+    curves = [{"y": [r["relative_estimate"] for r in history], "marker": "o",
+               "label": f"{goal} estimate / size of the solution"}]
+    if history and goal == "stress" and all(r.get("e_tot") is not None
+                                            and r["relative_estimate"] > 0 for r in history):
+        curves.append({"y": [r["e_tot"] * r["relative_estimate"] / r["goal_estimate"]
+                             for r in history], "marker": "s", "ls": "--",
+                       "label": "true error e_tot (3.124) / the same size"})
+    panels = []
+    for key, xlabel in ((lambda r: r["dofs"]["total"], "unknowns (all fields)"),
+                        (lambda r: r["elapsed_s"], "wall time since the start [s]")):
+        x = [key(r) for r in history]
+        panels.append({"title": f"against {xlabel.split(' (')[0].split(' since')[0]}",
+                       "xlabel": xlabel, "ylabel": f"relative {goal} error", "loglog": True,
+                       "curves": [{"x": x, **c} for c in curves],
+                       "hlines": [(tol, f"tolerance {tol:g}", {"color": "tab:red", "ls": ":"})]
+                       if tol is not None else []})
+    return plot_curves(panels, title or "Convergence of the adaptive run")
