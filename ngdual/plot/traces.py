@@ -115,12 +115,26 @@ def _window(traces, x_nodes: np.ndarray, main: list[np.ndarray]) -> tuple[float,
     return lo, hi
 
 
+def _shear_label(exact) -> str:
+    """The exact solution's legend with its tangential force Q along t, the direction the
+    shear is drawn in: the exact shear has the sign of Q everywhere, so the sign of its
+    samples along t is the sign of Q along t."""
+    name = exact.label.split(", Q =")[0]
+    force = getattr(exact.solution, "Q", None)
+    if force is None:
+        return name
+    along_t = np.sign(np.sum(exact.shear)) * abs(force)
+    return f"{name}, Q = {along_t:.4g} along $t$"
+
+
 def plot_contact_traces(traces, title: str = "", units=None, clip: float | None = TRACE_CLIP,
                         exact=None) -> Figure:
     """The contact pressure p_h and shear q_h along Gamma_C, and lambda_n - g, lambda_t.
 
     Top: p_h and q_h per h~ node (:class:`ngdual.trace.ContactTraces`: what the contact
-    conditions of (3.62) control), the main curves; the values at fixed ends of Gamma_C
+    conditions of (3.62) control), the main curves, q_h and the exact shear along
+    t = (n_2, -n_1) of (3.24), n the outward normal (on a bottom side t points to -x_1), the
+    exact tangential force Q in the legend along t too; the values at fixed ends of Gamma_C
     (no contact condition there) marked apart; the fine-edge -sigma_n, sigma_t thin and
     light behind them; ``exact`` (e.g. :func:`ngdual.verification.benchmark.benchmark_traces`:
     ``x``, ``pressure``, ``shear`` or None, ``label``) dashed. Bottom: lambda_n - g and
@@ -156,11 +170,14 @@ def plot_contact_traces(traces, title: str = "", units=None, clip: float | None 
             shown.setdefault(label, patch)
         ax.grid(alpha=0.3)
     exact_pressure = exact_shear = None
+    exact_labels = {}
     if exact is not None:
         exact_order = np.argsort(exact.x, kind="stable")
         exact_pressure = (exact.x[exact_order], exact.pressure[exact_order])
+        exact_labels = {"pressure": exact.label.split(", Q =")[0], "shear": exact.label}
         if exact.shear is not None:
             exact_shear = (exact.x[exact_order], exact.shear[exact_order])
+            exact_labels["shear"] = _shear_label(exact)
     friction = "with friction" if traces.friction else "frictionless: (3.62) makes it zero"
     node = NODE_LABELS.get(traces.node_kind, traces.node_kind)
     panels = [
@@ -170,7 +187,8 @@ def plot_contact_traces(traces, title: str = "", units=None, clip: float | None 
          "Contact pressure: what (3.62) controls"),
         (axes[0, 1], shear, traces.end_shear, traces.sigma_t, exact_shear,
          rf"$q_h$ ({node})", r"$\sigma_t^h$ (fine edge)",
-         unit_label(r"shear $q_h$ along $t$", stress), "C1", f"Shear traction ({friction})"),
+         unit_label(r"shear $q_h$ along $t = (n_2, -n_1)$", stress), "C1",
+         f"Shear traction ({friction}); $n$ the outward normal"),
     ]
     sampled = None if traces.trace_xy is None else \
         (traces.trace_xy[..., 0], -traces.trace_sigma_n, traces.trace_sigma_t)
@@ -188,7 +206,8 @@ def plot_contact_traces(traces, title: str = "", units=None, clip: float | None 
                     lw=0.6, color="0.6", label=fine_label)
             fine, fine_x = values.ravel(), sampled[0].ravel()
         if exact_curve is not None:
-            ax.plot(*exact_curve, "k--", lw=1.0, label=exact.label)
+            ax.plot(*exact_curve, "k--", lw=1.0,
+                    label=exact_labels["pressure" if ax is axes[0, 0] else "shear"])
         ax.plot(x_nodes[order], main[order], "-", color=colour, lw=1.6)
         ax.plot(x_dof, main[:len(x_dof)], "o", color=colour, ms=3.5, label=label)
         if len(x_end):
