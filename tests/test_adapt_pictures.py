@@ -34,3 +34,13 @@ def test_the_convergence_plot_has_the_tolerance_line_and_both_axes():
     assert all("tolerance 0.002" in names for names in labels)
     assert all(any("true error" in name for name in names) for names in labels)
     assert fig.axes[1].get_lines()[0].get_xdata().tolist() == [0.1, 0.4, 1.6]
+
+
+def test_a_step_without_a_finite_estimate_is_left_out_and_said():
+    from ngdual.plot import figure_texts, plot_convergence
+
+    history = [{"dofs": {"total": 100}, "relative_estimate": float("inf"),
+                "goal_estimate": 1.0, "goal": "pressure", "elapsed_s": 0.5}]
+    fig = plot_convergence(history)
+    assert "without a finite estimate" in fig.axes[0].texts[0].get_text()
+    assert figure_texts(fig)["axes"][0]["xlabel"] == "unknowns (all fields)"

@@ -96,7 +96,7 @@ def plot_convergence(history: list[dict], tol: float | None = None, title: str =
     ``e_tot`` of (3.124) (reference norms given) and the goal is the stress, also e_tot
     relative to the same size
     (``goal_estimate`` / ``relative_estimate``), the true error the estimate is measured
-    against.
+    against. Steps without a finite estimate are left out, and the panels say so.
 
     >>> fig = plot_convergence([{"dofs": {"total": 100}, "relative_estimate": 0.1,
     ...                          "goal_estimate": 1.0, "goal": "stress", "elapsed_s": 0.5},
@@ -107,6 +107,11 @@ def plot_convergence(history: list[dict], tol: float | None = None, title: str =
     ['unknowns (all fields)', 'wall time since the start [s]']
     """
     goal = history[0]["goal"] if history else "stress"
+    # a goal with nothing to measure (no contact in its window) has an infinite estimate
+    shown = [r for r in history if 0 < r["relative_estimate"] < float("inf")]
+    note = "" if len(shown) == len(history) else \
+        f"{len(history) - len(shown)} step(s) without a finite estimate left out"
+    history = shown
     curves = [{"y": [r["relative_estimate"] for r in history], "marker": "o",
                "label": f"{goal} estimate / size of the solution"}]
     if history and goal == "stress" and all(r.get("e_tot") is not None
@@ -119,7 +124,8 @@ def plot_convergence(history: list[dict], tol: float | None = None, title: str =
                         (lambda r: r["elapsed_s"], "wall time since the start [s]")):
         x = [key(r) for r in history]
         panels.append({"title": f"against {xlabel.split(' (')[0].split(' since')[0]}",
-                       "xlabel": xlabel, "ylabel": f"relative {goal} error", "loglog": True,
+                       "xlabel": xlabel, "ylabel": f"relative {goal} error",
+                       "loglog": bool(history), "note": note,
                        "curves": [{"x": x, **c} for c in curves],
                        "hlines": [(tol, f"tolerance {tol:g}", {"color": "tab:red", "ls": ":"})]
                        if tol is not None else []})
