@@ -89,8 +89,10 @@ def test_the_solve_figures_carry_the_declared_units(tmp_path, monkeypatch):
     monkeypatch.setattr(plot, "save_figure", record)
     assert main(["solve", "thesis-3.46-frictionless", "--level", "1", "--out", str(tmp_path),
                  "--set", "units.length=mm", "--set", "units.stress=MPa"]) == 0
-    von_mises, traces = texts
+    von_mises, deformed, traces = texts
     assert von_mises["axes"][0]["xlabel"] == "$x_1$ [mm]"
+    assert deformed["axes"][0]["xlabel"] == "$x_1$ [mm]"
+    assert deformed["axes"][1]["label"] == r"displacement $|u_h|$ [mm]"
     bar = von_mises["axes"][1]["label"]
     assert bar.startswith(r"von Mises stress $\sigma_0$ [MPa]") and "percentile" in bar
     assert traces["axes"][0]["ylabel"] == r"pressure $p_h = -\sigma_n$ [MPa]"
