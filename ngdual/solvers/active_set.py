@@ -40,7 +40,7 @@ Tolerances. Every residual is relative to the size of its terms, and every toler
   nu = 0.25 and 0.4999, levels 2-5 and graded 2^12 towards a point; cattaneo-mindlin,
   levels 1-6 and 14 adaptive steps). It grows like eps (lambda + 2 mu) / mu diam / h_min:
   on level 6 1e-13 to 7e-13 for nu = 0.25 and 4e-10 for nu = 0.4999, 4e-8 after 14 adaptive
-  steps of cattaneo-mindlin, which the former fixed tolerance 1e-9 took for a failure.
+  steps of cattaneo-mindlin, which a fixed tolerance of 1e-9 would take for a failure.
 
 The Coulomb bound is zero where :func:`ngdual.tolerances.friction_vanishes` says so: at most
 1e-6 of its largest value, or below the round-off of a vanishing normal stress,

@@ -44,9 +44,10 @@ times. Failing all that (or after ``max_iter`` steps) the problem is solved as t
 it is (:func:`ngdual.solvers.qp.contact_qp`), and the same iteration restarts from the
 QP's solution (one or two steps to round-off). Measured on 500 random problems (200 of them
 with Tresca bounds varying by 1e3 between edges, a third of those with duplicated rows of Q_F,
-as for h^ = h~): the QP was needed for 5 of the 433 without duplicated rows (full steps and QP
-only: 27 of the 300 easy ones alone); on a Cattaneo-Mindlin block the damped steps end a
-cycle that took 25 steps and the QP in 17.
+as for h^ = h~): the QP is needed for 5 of the 433 without duplicated rows (with full steps
+and the QP alone, 27 of the 300 easy ones need it); on a Cattaneo-Mindlin block the damped
+steps end in 17 steps without the QP a cycle that full steps leave only after 25 steps and
+the QP.
 
 Tolerance: the conditions are residuals relative to the size of their terms; a backward
 stable solve of a Newton system attains about eps times the condition number of G
