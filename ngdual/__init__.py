@@ -25,6 +25,19 @@ a matplotlib figure): :func:`plot_geometry` (the domain, its boundary parts and 
 :func:`plot_mesh`, :func:`plot_deformed` (the body moved by u_h, magnified); saving one is the
 caller's choice, :func:`save_figure`.
 
+Taking the method apart (the tutorials): :func:`assemble` (the block system of eq. 3.62 on
+a mesh), :func:`friction_forms` (the operators of friction on the fine edges of Gamma_C),
+:func:`mesh_arrays` (the points and triangles the plots take), :class:`Expression` (a scene
+formula in ``x``, ``y`` as a NumPy or NGSolve function), :class:`Lesson` (a tutorial's
+coarse-or-full setting and where its pictures go), :mod:`rates` (the observed order in
+h_N = N^(-1/2)), :mod:`post` (element values, von Mises stress, the contact summary), and
+three subpackages with their modules: :mod:`scene` (the tables of a scene: ``nd.scene.Geometry``,
+``nd.scene.Material``, ``nd.scene.Loads``, ``nd.scene.Contact``), :mod:`solvers` (the
+algorithms one by one: ``nd.solvers.uzawa`` for Algorithm 3.38, ``nd.solvers.nested`` for
+Algorithm 3.41, ``nd.solvers.qp`` the same problems as convex QPs, their settings
+``nd.solvers.UzawaSettings``) and :mod:`verification` (exact solutions and checks:
+``nd.verification.infsup``, ``nd.verification.corner``, ``nd.verification.overkill``).
+
 The names are loaded lazily (PEP 562): ``import ngdual`` imports neither NGSolve nor
 matplotlib, so that the command line starts fast; the first use of a name imports its
 module. Every name here needs only the core dependencies (``install_requires``); a study
@@ -34,6 +47,7 @@ that needs an extra names it (:func:`ngdual.extras.require`).
 from __future__ import annotations
 
 import importlib
+import pkgutil
 
 __version__ = "0.1.0"
 
@@ -65,18 +79,36 @@ _PUBLIC = {
     "plot_von_mises": ("ngdual.plot", "plot_von_mises"),
     "plot_deformed": ("ngdual.plot", "plot_deformed"),
     "save_figure": ("ngdual.plot", "save_figure"),
+    "assemble": ("ngdual.forms", "assemble"),
+    "Expression": ("ngdual.expr", "Expression"),
+    "Lesson": ("ngdual.studies.tutorials", "Lesson"),
+    "friction_forms": ("ngdual.friction", "build_friction_forms"),
+    "mesh_arrays": ("ngdual.mesh", "mesh_arrays"),
+    # modules, a subpackage with its modules: the scene's tables, the thesis' algorithms
+    # one by one, exact solutions and checks, convergence rates
+    "scene": ("ngdual.scene", None),
+    "solvers": ("ngdual.solvers", None),
+    "verification": ("ngdual.verification", None),
+    "rates": ("ngdual.rates", None),
+    "post": ("ngdual.post", None),
 }
 
 __all__ = ["__version__", *_PUBLIC]
 
 
 def __getattr__(name: str):
-    """Import the module of a public name (or a submodule, ``nd.post``) on first use."""
+    """Import the module of a public name (or a submodule, ``nd.post``) on first use; a
+    public subpackage (``nd.solvers``) comes with its modules (``nd.solvers.uzawa``)."""
     if name.startswith("__"):
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
     if name in _PUBLIC:
         module, attribute = _PUBLIC[name]
-        value = getattr(importlib.import_module(module), attribute)
+        value = importlib.import_module(module)
+        if attribute is None:
+            for info in pkgutil.iter_modules(getattr(value, "__path__", [])):
+                importlib.import_module(f"{module}.{info.name}")
+        else:
+            value = getattr(value, attribute)
         globals()[name] = value  # later look-ups do not come back here
         return value
     try:

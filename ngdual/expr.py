@@ -193,6 +193,14 @@ class Expression:
     ----------
     text : str
         The formula; a plain number is fine too.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import ngdual as nd
+    >>> gap = nd.Expression("0.01 + 0.002*x**2")
+    >>> gap.numpy(np.array([0.0, 2.0]), np.zeros(2))          # NumPy; .coefficient(): NGSolve
+    array([0.01 , 0.018])
     """
 
     text: str

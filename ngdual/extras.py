@@ -8,7 +8,8 @@ needs it through :func:`require`, so that a missing one names the extra to insta
 
 * ``studies``: dask.distributed, the parallel runner of ``ngdual sweep``;
 * ``metis``: pymetis, the nested-dissection ordering of the active-set factorisation;
-* ``tutorials``: jupytext and Jupyter, the tutorials as notebooks;
+* ``tutorials``: Jupyter (nbconvert, ipykernel, the webgui widgets), to run the notebooks
+  that ``ngdual tutorials --notebooks`` writes with the core install;
 * ``docs``, ``test``: the documentation site and the test suite.
 """
 

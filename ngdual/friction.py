@@ -258,7 +258,27 @@ def tresca_moments(problem: DiscreteProblem) -> np.ndarray:
 
 def build_friction_forms(problem: DiscreteProblem) -> FrictionForms:
     """Fine-edge traces and hat means on Gamma_C (:class:`ngdual.contact.ContactBoundary`);
-    :class:`FacetFrictionForms` with the facet multipliers."""
+    :class:`FacetFrictionForms` with the facet multipliers.
+
+    Parameters
+    ----------
+    problem : DiscreteProblem
+        An assembled problem with friction (:func:`ngdual.forms.assemble`).
+
+    Returns
+    -------
+    FrictionForms
+        sigma_n and sigma_t on the fine edges of Gamma_C, the matrix Q_F of (3.95)
+        (``q_matrix``), the Coulomb bound per h^ edge (``coulomb_bound_of``).
+
+    Examples
+    --------
+    >>> import ngdual as nd
+    >>> scene = nd.load_scene("thesis-3.46-tresca")
+    >>> forms = nd.friction_forms(nd.assemble(scene, nd.build_mesh(scene.geometry, 1)))
+    >>> len(forms.lengths) > forms.n_nu > 0        # fine edges of Gamma_C, h^ edges of nu
+    True
+    """
     gamma_c = problem.spaces.gamma_c
     int_n, int_t = _edge_functionals(problem)
     scale = sp.diags(1.0 / gamma_c.lengths)

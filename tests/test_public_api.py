@@ -15,7 +15,7 @@ import ngdual as nd
 
 
 def test_every_public_name_resolves_and_has_a_docstring():
-    assert len(nd.__all__) == len(set(nd.__all__)) and 10 <= len(nd.__all__) <= 30
+    assert len(nd.__all__) == len(set(nd.__all__)) and 10 <= len(nd.__all__) <= 40
     for name in nd.__all__:
         value = getattr(nd, name)
         if name == "__version__":
@@ -37,6 +37,27 @@ def test_public_names_are_the_pipeline_functions():
     assert nd.solve_on_mesh is solvers.solve_on_mesh and nd.build_mesh is mesh.build_mesh
     assert nd.refine_with_boundary is afem.refine_with_boundary
     assert nd.BoundaryMeshes is boundary.BoundaryMeshes
+
+
+def test_the_names_the_tutorials_take_the_method_apart_with():
+    from ngdual import expr, forms, friction, mesh, rates, scene, solvers, verification
+    from ngdual.studies import tutorials
+
+    assert nd.assemble is forms.assemble and nd.Expression is expr.Expression
+    assert nd.Lesson is tutorials.Lesson and nd.rates is rates
+    assert nd.friction_forms is friction.build_friction_forms and nd.mesh_arrays is mesh.mesh_arrays
+    assert nd.scene is scene and nd.solvers is solvers and nd.verification is verification
+    # a public subpackage comes with its modules: Algorithm 3.38, the QPs, Williams' corner
+    assert nd.solvers.uzawa.uzawa and nd.solvers.qp.solve_qp and nd.solvers.nested.nested_uzawa
+    assert nd.verification.corner.l_shape_scene and nd.verification.infsup.gram_matrix
+
+
+def test_a_public_subpackage_brings_its_modules_in_a_fresh_process():
+    code = ("import ngdual as nd; "
+            "print(nd.verification.overkill.__name__, nd.solvers.projections.__name__)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True).stdout
+    assert out.split() == ["ngdual.verification.overkill", "ngdual.solvers.projections"]
 
 
 def test_dir_lists_the_public_names_and_unknown_names_raise():

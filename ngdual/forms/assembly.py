@@ -20,7 +20,31 @@ from .spaces import Spaces
 
 def assemble(scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes | None = None
              ) -> DiscreteProblem:
-    """Assemble the block system of (3.62) for ``scene`` on ``mesh`` (``coarse``: see Spaces)."""
+    """Assemble the block system of (3.62) for ``scene`` on ``mesh`` (``coarse``: see Spaces).
+
+    Parameters
+    ----------
+    scene : Scene
+        The validated scene (:func:`ngdual.scene.load_scene`).
+    mesh : ngsolve.Mesh
+        Its mesh, e.g. :func:`ngdual.mesh.build_mesh` of ``scene.geometry``.
+    coarse : BoundaryMeshes, optional
+        The coarse boundary meshes h~, h^; by default built for ``mesh``.
+
+    Returns
+    -------
+    DiscreteProblem
+        The matrix and right-hand side, with the index sets ``sigma``, ``mult``, ``lam_n``
+        of the unknown groups and ``block(rows, cols)`` to cut out A, B, C_n.
+
+    Examples
+    --------
+    >>> import ngdual as nd
+    >>> scene = nd.load_scene("thesis-3.46-frictionless")
+    >>> problem = nd.assemble(scene, nd.build_mesh(scene.geometry, 1))
+    >>> problem.spaces.dofs()["X"], len(problem.sigma)            # Table 3.1, level 1
+    (180, 180)
+    """
     start = time.perf_counter()
     spaces = Spaces.build(scene, mesh, coarse)
     names = list(spaces.components)
