@@ -299,12 +299,17 @@ def test_every_tutorial_has_a_check_and_solutions():
 
 @pytest.mark.parametrize("tutorial", TUTORIALS, ids=lambda t: t.name)
 def test_tutorial_opens_with_header_and_ends_with_exercises(tutorial):
-    """STYLE.md: problem, discretisation, learning goals, references; 2-3 exercises at the end."""
+    """STYLE.md: the idea in words first, then problem, discretisation, learning goals,
+    references; 2-3 exercises at the end."""
     text = tutorial.path.read_text(encoding="utf-8")
     header = text.split("# %%\n", 1)[0]
-    for words in ("**Problem.**", "**Discretisation.**", "**What you will learn.**",
-                  "**References.**"):
+    for words in ("**The idea in words.**", "**Problem.**", "**Discretisation.**",
+                  "**What you will learn.**", "**References.**"):
         assert words in header, words
+    # the mathematics in words before its first equation number, e.g. (3.62)
+    words = header.index("**The idea in words.**")
+    assert words < header.index("**Problem.**"), tutorial.name
+    assert not re.search(r"\(\d\.\d+\)", header[:words]), tutorial.name
     assert "Leibniz Universität Hannover, 2011" in header        # the thesis, cited in full
     first_code = text.split("# %%\n", 2)[1]
     assert f'Lesson("{tutorial.name}")' in first_code            # parameters come first

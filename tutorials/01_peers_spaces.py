@@ -4,6 +4,17 @@
 # **Run time** on a 2-core laptop: about 4 s; about 4 s with `NGDUAL_QUICK=1`
 # (`ngdual tutorials run 01 --quick`).
 #
+# **The idea in words.** In a stress-based method the unknown we solve for is the stress
+# itself (the forces per area inside the body), not the displacement. The stress must
+# balance the loads (its divergence is the body force), be symmetric (no net torque on a
+# small square) and be related to the strain by Hooke's law. The displacement and the
+# rotation $\eta$ enter as Lagrange multipliers of the first two requirements. Such a
+# "mixed" method is stable only if the stress space is rich enough to answer every
+# displacement and rotation it is tested with; the number that measures this is the
+# inf-sup constant $\beta_h$. This tutorial counts the unknowns of the PEERS spaces and
+# computes $\beta_h$ on a sequence of meshes: bounded away from zero with PEERS, zero
+# without its bubble functions.
+#
 # **Problem.** Plane-strain linear elasticity on a polygon $\Omega$, written for the
 # *stress* $\sigma$ as the primary unknown (thesis Ch. 3.1, Hellinger-Reissner form with
 # weakly imposed symmetry): find $\sigma$, the displacement $u$ and the rotation
@@ -51,21 +62,16 @@
 # %% [markdown]
 # ## Parameters
 # Quick mode (`NGDUAL_QUICK=1`) keeps every computation to a few seconds. This
-# tutorial looks *inside* the discretisation (spaces, matrices), so besides the public
-# API (`import ngdual as nd`) it imports the modules that build them.
+# tutorial looks *inside* the discretisation (spaces, matrices): `nd.assemble` builds the
+# matrices of a scene on a mesh, `nd.verification.infsup` the norms of the inf-sup test.
 
 # %%
 import matplotlib.pyplot as plt
 import numpy as np
 
 import ngdual as nd
-from ngdual import peers
-from ngdual.forms import assemble
-from ngdual.mesh import build_mesh
-from ngdual.studies.tutorials import Lesson
-from ngdual.verification.infsup import gram_matrix, smallest_singular_values
 
-lesson = Lesson("01_peers_spaces")                       # figures and results.json go here
+lesson = nd.Lesson("01_peers_spaces")                       # figures and results.json go here
 QUICK = lesson.quick
 DOF_LEVELS = [1, 2, 3] if QUICK else [1, 2, 3, 4, 5]     # Table 3.1 rows to reproduce
 INF_SUP_LEVELS = [1, 2] if QUICK else [1, 2, 3, 4]       # meshes for the eigenvalue problem
@@ -90,17 +96,18 @@ lesson.save(nd.plot_geometry(thesis, level=1), "geometry")
 #   bubble per triangle, so $\dim X_h = 2(E + T)$;
 # * $\dim M_h = 2T$ (a constant vector per triangle) and $\dim S_h = V$.
 #
-# The structured mesh of Example 3.46 (`thesis_mesh`) reproduces Table 3.1 of the thesis:
+# The structured mesh of Example 3.46 (`nd.build_mesh` of its geometry) reproduces
+# Table 3.1 of the thesis:
 # 180, 64, 27 on level 1, and each uniform refinement multiplies $T$ by four.
 
 # %%
 dof_rows = []
 for level in DOF_LEVELS:
-    mesh = build_mesh(thesis.geometry, level)
-    spaces = peers.peers_spaces(mesh)
-    X = sum(spaces[name].ndof for name in peers.STRESS)
-    M = spaces["u1"].ndof + spaces["u2"].ndof
-    S = spaces["eta"].ndof
+    mesh = nd.build_mesh(thesis.geometry, level)
+    problem = nd.assemble(thesis, mesh)          # its index sets count the dofs per space
+    X = len(problem.sigma)                       # r1, r2 (RT0 rows) and b1, b2 (bubbles)
+    M = len(problem.index("u1", "u2"))
+    S = len(problem.index("eta"))
     assert (X, M, S) == (2 * (mesh.nedge + mesh.ne), 2 * mesh.ne, mesh.nv)
     dof_rows.append({"level": level, "X": X, "M": M, "S": S})
     print(f"level {level}:  dim X_h = {X:7d}   dim M_h = {M:7d}   dim S_h = {S:6d}")
@@ -131,7 +138,7 @@ for level in DOF_LEVELS:
 #
 # We take Example 3.46 with Dirichlet conditions on all four sides (no boundary
 # multipliers) and read $B$ off the assembled system: its block $K[\sigma, (u, \eta)]$ is
-# exactly $b + s$. `gram_matrix` (`ngdual.verification.infsup`) assembles $X$ and $Y$;
+# exactly $b + s$. `nd.verification.infsup.gram_matrix` assembles $X$ and $Y$;
 # `smallest_singular_values` finds the smallest eigenvalues by shift-invert Lanczos
 # (`eigsh`), solving with the saddle-point matrix
 # $\begin{pmatrix} X & B \\ B^\top & \sigma_0 Y \end{pmatrix}$ so that $X^{-1}$ never
@@ -144,14 +151,16 @@ clamped = nd.load_scene("thesis-3.46-frictionless",
 lesson.save(nd.plot_geometry(clamped, level=1, title="Example 3.46 clamped on all sides"),
             "geometry_clamped")
 
+infsup = nd.verification.infsup
 inf_sup_rows = []
 for level in INF_SUP_LEVELS:
-    problem = assemble(clamped, build_mesh(clamped.geometry, level))
-    G = gram_matrix(problem)
+    problem = nd.assemble(clamped, nd.build_mesh(clamped.geometry, level))
+    G = infsup.gram_matrix(problem)
     stress, rt0, mult = problem.sigma, problem.index("r1", "r2"), problem.mult
     Y = G[mult][:, mult]
-    peers_beta = smallest_singular_values(G[stress][:, stress], problem.block(stress, mult), Y)
-    bare_beta = smallest_singular_values(G[rt0][:, rt0], problem.block(rt0, mult), Y)
+    peers_beta = infsup.smallest_singular_values(G[stress][:, stress],
+                                                 problem.block(stress, mult), Y)
+    bare_beta = infsup.smallest_singular_values(G[rt0][:, rt0], problem.block(rt0, mult), Y)
     h = np.sqrt(2.0) * 2.0 ** (1 - level)
     inf_sup_rows.append({"level": level, "h": h, "peers": peers_beta.tolist(),
                          "rt0_only": bare_beta.tolist()})

@@ -4,6 +4,14 @@
 # **Run time** on a 2-core laptop: about 6 s; about 5 s with `NGDUAL_QUICK=1`
 # (`ngdual tutorials run 02 --quick`).
 #
+# **The idea in words.** In a nearly incompressible material (rubber, $\nu$ close to ½)
+# the volume hardly changes, whatever the load. A displacement method with linear elements
+# has too few displacements that keep the volume of every triangle, so it stiffens
+# artificially: it "locks", and the computed displacement is far too small. A stress-based
+# method does not ask the displacement to keep any volume; its error stays the same as
+# $\nu \to \frac12$. The pictures compare the errors of both methods over $\nu$ and the
+# stresses they compute.
+#
 # **Problem.** Plane-strain elasticity on the unit square, clamped ($u = 0$) on the whole
 # boundary, with a body force $f$ manufactured from the divergence-free displacement
 # $u = \operatorname{Curl}\psi$, $\psi = x^2(1 - x)^2 y^2(1 - y)^2$. Since
@@ -40,11 +48,8 @@ import ngsolve as ngs
 import numpy as np
 
 import ngdual as nd
-from ngdual.expr import Expression
-from ngdual.scene import Geometry, Loads, Material
-from ngdual.studies.tutorials import Lesson
 
-lesson = Lesson("02_locking")                            # figures and results.json go here
+lesson = nd.Lesson("02_locking")                            # figures and results.json go here
 QUICK = lesson.quick
 LOCKING_LEVELS = [1, 2] if QUICK else [1, 2, 3, 4]       # refinements of the square mesh
 NUS = [0.3, 0.45, 0.49, 0.499, 0.4999]                   # Poisson ratios of the sweep
@@ -102,7 +107,7 @@ SIDES = ["bottom", "right", "top", "left"]
 
 
 def cf(formula: str) -> ngs.CoefficientFunction:
-    return Expression(formula).coefficient()
+    return nd.Expression(formula).coefficient()
 
 
 u_exact = ngs.CF(tuple(cf(c) for c in EXACT_U))
@@ -112,11 +117,12 @@ sigma_exact = ngs.CF(tuple(cf(c) for row in EXACT_SIGMA for c in row), dims=(2, 
 def square_scene(nu: float) -> nd.Scene:
     """The unit square, clamped everywhere, with E chosen so that μ stays fixed."""
     scene = nd.Scene(name=f"square-nu{nu}",
-                     geometry=Geometry(kind="polygon", points=[[0, 0], [1, 0], [1, 1], [0, 1]],
-                                       labels=SIDES, maxh=MAXH),
+                     geometry=nd.scene.Geometry(kind="polygon",
+                                                points=[[0, 0], [1, 0], [1, 1], [0, 1]],
+                                                labels=SIDES, maxh=MAXH),
                      boundary={"dirichlet": SIDES},
-                     material=Material(E=2 * mu * (1 + nu), nu=nu),
-                     loads=Loads(body_force=BODY_FORCE))
+                     material=nd.scene.Material(E=2 * mu * (1 + nu), nu=nu),
+                     loads=nd.scene.Loads(body_force=BODY_FORCE))
     nd.validate(scene)
     return scene
 
@@ -132,7 +138,7 @@ def relative_l2(error, exact, mesh) -> float:
     return float(norm(error) / norm(exact))
 
 
-def solve_p1(mesh, material: Material):
+def solve_p1(mesh, material: nd.scene.Material):
     """Primal P1 displacement method; returns (u_h, σ_h = C ε(u_h))."""
     lam, shear_modulus = material.lame
     space = ngs.VectorH1(mesh, order=1, dirichlet="|".join(SIDES))
@@ -184,7 +190,7 @@ for key, value in ratios.items():
     print(f"error(nu = {last['nu']}) / error(nu = {first['nu']}) for {key:11s}: {value:8.2f}")
 
 fig, ax = plt.subplots(figsize=(6, 4))
-lam_over_mu = [Material(2 * mu * (1 + nu), nu).lame[0] / mu for nu in NUS]
+lam_over_mu = [nd.scene.Material(2 * mu * (1 + nu), nu).lame[0] / mu for nu in NUS]
 for key, style, label in (("peers_sigma", "o-", "PEERS σ"), ("peers_u", "o--", "PEERS u"),
                           ("p1_sigma", "s-", "P1 σ"), ("p1_u", "s--", "P1 u")):
     ax.loglog(lam_over_mu, [row[key] for row in sweep], style, label=label)

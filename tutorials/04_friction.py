@@ -4,6 +4,15 @@
 # **Run time** on a 2-core laptop: about 11 s; about 9 s with `NGDUAL_QUICK=1`
 # (`ngdual tutorials run 04 --quick`).
 #
+# **The idea in words.** Friction resists sliding along the contact boundary: a point
+# sticks as long as the tangential traction stays below a bound, and slides (slips) once
+# it reaches it, then opposite to its motion. With Tresca friction the bound is given;
+# with Coulomb friction it is the friction coefficient times the contact pressure, which
+# is itself unknown. The nested Uzawa algorithm handles this with two loops: an inner loop
+# for the contact (as in Tutorial 3) and an outer loop that updates the direction and the
+# bound of the friction force, until both settle. The pictures show the contact traces
+# with their stick and slip zones and how the loops converge.
+#
 # **Problem.** Example 3.46 of the thesis *with* friction: the block $[-4,4]\times[-1,1]$,
 # clamped at its ends, pressed by a parabolic traction on top onto a rigid foundation
 # at distance $g$ below $\Gamma_C$. On the contact part the body may stick or slip. With a
@@ -50,17 +59,15 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import ngdual as nd
-from ngdual import peers
-from ngdual.forms import assemble
-from ngdual.friction import build_friction_forms
-from ngdual.mesh import build_mesh
-from ngdual.solvers.nested import nested_uzawa
-from ngdual.solvers.qp import solve_qp_friction
-from ngdual.solvers.settings import Model, NestedUzawaSettings
-from ngdual.studies.tutorials import Lesson
 
-lesson = Lesson("04_friction")                   # figures and results.json go here
+nested_uzawa = nd.solvers.nested.nested_uzawa             # Algorithm 3.41
+NestedUzawaSettings = nd.solvers.NestedUzawaSettings      # its two step lengths, loop order
+Model = nd.solvers.Model                                  # the law and moduli the QPs need
+solve_qp_friction = nd.solvers.qp.solve_qp_friction       # friction as a sequence of QPs
+
+lesson = nd.Lesson("04_friction")                   # figures and results.json go here
 QUICK = lesson.quick
+STRESS = ("r1", "r2", "b1", "b2")   # the stress unknowns: two RT0 rows, two Curl bubbles
 LEVEL = 3 if QUICK else 4                        # mesh level of Example 3.46
 LOOP_ORDERS = ["friction-outer", "contact-outer"]  # Algorithm 3.41 and Remark 3.43
 EPS1, EPS2 = 1e-10, 1e-9                         # tight tolerances, to compare with the QP
@@ -106,9 +113,9 @@ lesson.save(nd.plot_contact_traces(nd.contact_traces(default), f"Coulomb, mu_f =
 # reaches about $-500$ under the load).
 
 # %%
-problem_t = assemble(tresca, build_mesh(tresca.geometry, LEVEL))
-problem_c = assemble(coulomb, build_mesh(coulomb.geometry, LEVEL))
-forms = build_friction_forms(problem_t)
+problem_t = nd.assemble(tresca, nd.build_mesh(tresca.geometry, LEVEL))
+problem_c = nd.assemble(coulomb, nd.build_mesh(coulomb.geometry, LEVEL))
+forms = nd.friction_forms(problem_t)
 print(f"dofs (Table 3.1, L = nu on the h^ mesh): {problem_t.spaces.dofs()}")
 print(f"fine edges on Gamma_C: {len(forms.lengths)}, h^ edges (nu): {forms.n_nu}, "
       f"Q_F: {forms.q_matrix(np.ones(len(forms.lengths))).shape} (N_A x N_C)")
@@ -167,7 +174,7 @@ print(f"the two loop orders differ by {loop_order_difference['tresca']:.1e} (rel
 coulomb_runs = run_both_orders(problem_c, coulomb)
 loop_order_difference["coulomb"] = relative(*(coulomb_runs[o].x for o in LOOP_ORDERS))
 coulomb_solution = coulomb_runs["friction-outer"]
-forms_c = build_friction_forms(problem_c)
+forms_c = nd.friction_forms(problem_c)
 F_again = forms_c.coulomb_bound_of(forms_c.T_n @ coulomb_solution.x, mu_f)
 fixed_point_residual = float(np.max(np.abs(F_again - coulomb_solution.friction_bound))
                              / np.max(coulomb_solution.friction_bound))
@@ -188,10 +195,10 @@ print(f"max |F(sigma_n) - F| / max F = {fixed_point_residual:.1e}")
 # %%
 def compare(nested, other) -> dict:
     """Relative differences of sigma, lambda_t, lambda_n and nu (where F matters)."""
-    fr = build_friction_forms(other.problem)
+    fr = nd.friction_forms(other.problem)
     lam_scale = max(np.linalg.norm(other.part("lam_n")), np.linalg.norm(other.part("lam_t")))
     F_hat = fr.per_hat_edge(other.friction_bound)
-    return {"sigma": relative(nested.part(*peers.STRESS), other.part(*peers.STRESS)),
+    return {"sigma": relative(nested.part(*STRESS), other.part(*STRESS)),
             "lam_t": relative(nested.part("lam_t"), other.part("lam_t")),
             "lam_n": float(np.linalg.norm(nested.part("lam_n") - other.part("lam_n")) / lam_scale),
             "nu": float(np.max(np.abs(nested.nu - other.nu)[F_hat > 1e-3 * F_hat.max()]))}
@@ -240,7 +247,7 @@ lesson.save(fig, "outer_histories")
 def discrete_conditions(solution) -> dict:
     """The sign, complementarity and friction conditions of (3.62), relative to their scale."""
     pb = solution.problem
-    fr = build_friction_forms(pb)
+    fr = nd.friction_forms(pb)
     sigma = solution.x[pb.sigma]
     t_n = pb.block(pb.sigma, pb.lam_n).T @ sigma                 # int sigma_n mu_i
     t_t = pb.block(pb.sigma, pb.index("lam_t")).T @ sigma        # int sigma_t mu_i

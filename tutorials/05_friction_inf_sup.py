@@ -4,6 +4,14 @@
 # **Run time** on a 2-core laptop: about 8 s; about 7 s with `NGDUAL_QUICK=1`
 # (`ngdual tutorials run 05 --quick`).
 #
+# **The idea in words.** The friction force is represented by a multiplier that lives on a
+# mesh of the contact boundary. If that mesh is as fine as the one of the contact
+# multiplier, some patterns of the friction multiplier (a checkerboard of alternating
+# signs) are invisible to every stress: the discrete problem is not stable and the
+# algorithm struggles. Taking the friction mesh twice as coarse removes those patterns.
+# This tutorial computes the stability constant for both choices and shows the kernel and
+# its effect on the iteration counts.
+#
 # **Problem.** Example 3.46 with Coulomb friction and *no* initial gap, $g \equiv 0$: the
 # whole of $\Gamma_C$ touches the foundation, so the friction zone
 # $A_C = \operatorname{supp}\mathcal{F}$ reaches the ends of $\Gamma_C$. Is the friction
@@ -41,16 +49,13 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import ngdual as nd
-from ngdual.forms import assemble
-from ngdual.friction import build_friction_forms
-from ngdual.mesh import build_mesh
-from ngdual.solution import ConvergenceError
-from ngdual.solvers.nested import nested_uzawa
-from ngdual.solvers.projections import metric_matrix
-from ngdual.solvers.settings import NestedUzawaSettings
-from ngdual.studies.tutorials import Lesson
 
-lesson = Lesson("05_friction_inf_sup")              # figures and results.json go here
+nested_uzawa = nd.solvers.nested.nested_uzawa             # Algorithm 3.41
+NestedUzawaSettings = nd.solvers.NestedUzawaSettings      # its two step lengths, loop order
+ConvergenceError = nd.solvers.ConvergenceError            # an algorithm that did not converge
+metric_matrix = nd.solvers.projections.metric_matrix      # the metric W of the projection
+
+lesson = nd.Lesson("05_friction_inf_sup")              # figures and results.json go here
 QUICK = lesson.quick
 GAP0_LEVELS = [1, 2, 3] if QUICK else [1, 2, 3, 4]  # levels of the g = 0 study
 
@@ -93,7 +98,7 @@ lesson.save(nd.plot_geometry(gap0[2], level=GAP0_LEVELS[0],
 # %%
 def inf_sup(problem, F=None) -> dict:
     """Discrete inf-sup constant of q (3.72) for F (default 1 on Gamma_C), and the kernel."""
-    fr = build_friction_forms(problem)
+    fr = nd.friction_forms(problem)
     F = np.ones(len(fr.lengths)) if F is None else F
     rows = fr.per_hat_edge(F) > 0                                # the h^ edges of A_C
     Q = fr.q_matrix(F).toarray()[rows]
@@ -112,7 +117,7 @@ inf_sup_rows = []
 for level in GAP0_LEVELS:
     row = {"level": level}
     for factor, scene in gap0.items():
-        row[factor] = inf_sup(assemble(scene, build_mesh(scene.geometry, level)))
+        row[factor] = inf_sup(nd.assemble(scene, nd.build_mesh(scene.geometry, level)))
     inf_sup_rows.append(row)
     print(f"level {level}: h^ = h~: N_A = {row[1]['N_A']:3d} > N_C = {row[1]['N_C']:3d}, "
           f"beta = 0; h^ = 2h~: N_A = {row[2]['N_A']:3d}, beta = {row[2]['beta']:.4f}")
@@ -125,8 +130,8 @@ print("kernel of Q_F^T for h^ = h~ on level 1:", inf_sup_rows[0][1]["kernel"])
 
 # %%
 kernel = np.array(inf_sup_rows[0][1]["kernel"])
-problem_1 = assemble(gap0[1], build_mesh(gap0[1].geometry, GAP0_LEVELS[0]))
-fr_1 = build_friction_forms(problem_1)
+problem_1 = nd.assemble(gap0[1], nd.build_mesh(gap0[1].geometry, GAP0_LEVELS[0]))
+fr_1 = nd.friction_forms(problem_1)
 ends = np.sort(np.unique(np.round(np.r_[fr_1.midpoints[:, 0] - fr_1.lengths / 2,
                                         fr_1.midpoints[:, 0] + fr_1.lengths / 2], 12)))
 hat_ends = ends[::2]                                    # the h~ nodes (every other fine node)
@@ -151,8 +156,8 @@ lesson.save(fig, "checkerboard")
 
 # %%
 scene = gap0[1]
-problem_inner = assemble(scene, build_mesh(scene.geometry, GAP0_LEVELS[-1]))
-fr_inner = build_friction_forms(problem_inner)
+problem_inner = nd.assemble(scene, nd.build_mesh(scene.geometry, GAP0_LEVELS[-1]))
+fr_inner = nd.friction_forms(problem_inner)
 inner = inf_sup(problem_inner, (np.abs(fr_inner.midpoints[:, 0]) < 1.5).astype(float))
 print(f"h^ = h~, F = 1 on |x1| < 1.5 only: N_A = {inner['N_A']} <= N_C = {inner['N_C']}, "
       f"beta = {inner['beta']:.3f}")
@@ -170,7 +175,7 @@ gap0_runs = {1: [], 2: []}
 failure_messages = []
 for level in GAP0_LEVELS:
     for factor, scene in gap0.items():
-        problem = assemble(scene, build_mesh(scene.geometry, level))
+        problem = nd.assemble(scene, nd.build_mesh(scene.geometry, level))
         try:
             solution = nested_uzawa(problem, NestedUzawaSettings.from_scene(scene))
             gap0_runs[factor].append({"level": level, "outer": solution.iterations["outer"],

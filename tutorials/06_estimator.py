@@ -4,6 +4,14 @@
 # **Run time** on a 2-core laptop: about 5 s; about 6 s with `NGDUAL_QUICK=1`
 # (`ngdual tutorials run 06 --quick`).
 #
+# **The idea in words.** The error of a finite element solution is not known without the
+# exact solution, but it can be estimated from the computed solution alone: on every
+# triangle, measure how far the discrete stress is from satisfying what the exact one
+# satisfies (equilibrium, symmetry, compatibility, the boundary conditions and the contact
+# and friction laws). The sum of these local indicators bounds the error from above and
+# below up to constants, and the local values show where the mesh should be refined. The
+# pictures show where each term lives and how the estimate tracks the true error.
+#
 # **Problem.** Given a discrete solution
 # $(\sigma_h, \nu_h; u_h, \eta_h, \varphi_h, \lambda_t, \lambda_n)$ of (3.62), how large is
 # its error, and *where* is it made? Theorem 4.8 bounds the error in
@@ -51,14 +59,8 @@ import numpy as np
 from matplotlib.colors import LogNorm
 
 import ngdual as nd
-from ngdual.expr import Expression
-from ngdual.mesh import mesh_arrays
-from ngdual.rates import observed_rates
-from ngdual.scene import Geometry, Loads, Material
-from ngdual.studies.tutorials import Lesson
-from ngdual.verification.piecewise import Piecewise
 
-lesson = Lesson("06_estimator")               # figures and results.json go here
+lesson = nd.Lesson("06_estimator")               # figures and results.json go here
 QUICK = lesson.quick
 THESIS_LEVEL = 3 if QUICK else 4              # Example 3.46 for the pictures of every term
 LEVELS = [1, 2, 3] if QUICK else [1, 2, 3, 4, 5]   # uniform levels of the smooth problem
@@ -117,7 +119,7 @@ for name, value in sorted(summed.items(), key=lambda item: -item[1]):
 
 def plot_terms(mesh, terms: dict, title: str, columns: int = 2):
     """One tripcolor panel per (squared) indicator term, log colour scale, zeros blank."""
-    tri = mtri.Triangulation(*mesh_arrays(mesh)[0].T, mesh_arrays(mesh)[1])
+    tri = mtri.Triangulation(*nd.mesh_arrays(mesh)[0].T, nd.mesh_arrays(mesh)[1])
     rows = math.ceil(len(terms) / columns)
     largest = max(float(np.max(values)) for values in terms.values())
     fig, axes = plt.subplots(rows, columns, squeeze=False, figsize=(
@@ -173,8 +175,8 @@ lesson.save(plot_terms(mesh, {"eta_tot^2": est.indicators**2, **est.terms}, "Squ
 # exactly by `Piecewise` (here without breakpoints) and written as scene formulas.
 
 # %%
-x, y = Piecewise.x(), Piecewise.y()
-lam, mu = Material(E, NU).lame
+x, y = nd.verification.Piecewise.x(), nd.verification.Piecewise.y()
+lam, mu = nd.scene.Material(E, NU).lame
 psi = ((x - 2) ** 2 + (y - 1) ** 2) * ((x - 1) ** 2 + (y - 2) ** 2)
 w = [x * x - x * 3 + y * y - y * 3 + 4, x * x + x * y - x * 3]
 u = [psi.dy() + w[0] / lam, -psi.dx() + w[1] / lam]
@@ -185,20 +187,20 @@ sigma = [[(grad[i][j] + grad[j][i]) * mu + (div_u * lam if i == j else 0) for j 
 div_sigma = [sigma[i][0].dx() + sigma[i][1].dy() for i in range(2)]
 roof = [sigma[i][0] / math.sqrt(2) + sigma[i][1] / math.sqrt(2) for i in range(2)]  # n = (1, 1)/√2
 smooth = nd.Scene(name="pentagon-manufactured",
-                  geometry=Geometry(kind="polygon", maxh=MAXH,
+                  geometry=nd.scene.Geometry(kind="polygon", maxh=MAXH,
                                     points=[(0, 0), (2, 0), (2, 1), (1, 2), (0, 1)],
                                     labels=["bottom", "right", "roof_right", "roof_left", "left"]),
                   boundary={"dirichlet": ["bottom", "right", "roof_left", "left"],
                             "neumann": ["roof_right"]},
-                  material=Material(E=E, nu=NU),
-                  loads=Loads(body_force=[(-d).text() for d in div_sigma],
+                  material=nd.scene.Material(E=E, nu=NU),
+                  loads=nd.scene.Loads(body_force=[(-d).text() for d in div_sigma],
                               traction=[t.text() for t in roof],
                               displacement=[c.text() for c in u]))
 lesson.save(nd.plot_geometry(smooth, level=LEVELS[-1]), "geometry_smooth")
 
 
-def cf(*parts: Piecewise, dims=None) -> ngs.CoefficientFunction:
-    values = tuple(Expression(p.text()).coefficient() for p in parts)
+def cf(*parts: nd.verification.Piecewise, dims=None) -> ngs.CoefficientFunction:
+    values = tuple(nd.Expression(p.text()).coefficient() for p in parts)
     return values[0] if len(values) == 1 else ngs.CF(values, dims=dims)
 
 
@@ -232,8 +234,8 @@ for level in LEVELS:
                  "as_l2": math.sqrt(l2.summed()["asymmetry"]),
                  "as_hdiv": math.sqrt(hdiv.summed()["asymmetry"])})
 ndofs = [r["ndof"] for r in rows]
-for key in ("error", "eta"):  # ngdual.rates: the order in h_N = N^(-1/2)
-    for row, rate in zip(rows[1:], observed_rates(ndofs, [r[key] for r in rows])[1:]):
+for key in ("error", "eta"):  # nd.rates: the order in h_N = N^(-1/2)
+    for row, rate in zip(rows[1:], nd.rates.observed_rates(ndofs, [r[key] for r in rows])[1:]):
         row[f"rate_{key}"] = rate
 effectivity = [row["eta"] / row["error"] for row in rows]
 hdiv_ratio = [r["eta_hdiv"] / r["error"] for r in rows]

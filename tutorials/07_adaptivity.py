@@ -4,6 +4,12 @@
 # **Run time** on a 2-core laptop: about 30 s; about 8 s with `NGDUAL_QUICK=1`
 # (`ngdual tutorials run 07 --quick`).
 #
+# **The idea in words.** Contact solutions are rough where the contact zone ends and at
+# corners, so refining the mesh everywhere wastes most of the unknowns. The adaptive loop
+# solves, estimates the error per triangle, marks the triangles with the largest share of
+# the estimate and refines only those, then repeats. The pictures show the meshes it
+# builds and the error against the number of unknowns, uniform and adaptive.
+#
 # **Problem.** Solutions of contact problems are not smooth: $\sigma$ is singular at
 # corners where boundary conditions change, and at the ends of the contact zone. Uniform
 # refinement then converges slowly. The model case: an L-shaped domain with a re-entrant
@@ -46,11 +52,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import ngdual as nd
-from ngdual.studies.tutorials import Lesson  # where figures and results.json go
-from ngdual.verification import corner  # the L-shape and its exact solution
 
-mesh_arrays = nd.mesh.mesh_arrays              # vertices and triangles, for the plots
-lesson = Lesson("07_adaptivity")
+lesson = nd.Lesson("07_adaptivity")
 QUICK = lesson.quick
 RUNS = {"uniform": ("max", 0.0, 3 if QUICK else 5),
         "max": ("max", 0.5, 4 if QUICK else 10),
@@ -63,15 +66,15 @@ THETAS = {"max": 0.5, "fraction": 0.2, "dorfler": 0.5}    # of the MARK step by 
 #
 # $(-1,1)^2$ without the quarter $(0,1)\times(-1,0)$, traction free ($\Gamma_N$) on the
 # two sides at the re-entrant corner, $u = u_{\mathrm{exact}}$ ($\Gamma_D$) on the others.
-# `ngdual.verification.corner` holds the scene, Williams' solution written as scene
+# `nd.verification.corner` holds the scene, Williams' solution written as scene
 # expressions in $x$ and $y$, and the exact error of PEERS,
 # $(\|\sigma - \sigma_h\|^2 + \|\operatorname{div}\sigma_h\|^2 + \|u - u_h\|^2
 # + \|\eta - \eta_h\|^2)^{1/2}$.
 
 # %%
-l_shape = corner.l_shape_scene()
-alpha = corner.corner_exponent()
-exact = corner.exact_fields()
+l_shape = nd.verification.corner.l_shape_scene()
+alpha = nd.verification.corner.corner_exponent()
+exact = nd.verification.corner.exact_fields()
 lesson.save(nd.plot_geometry(l_shape, level=1), "geometry")
 print(f"corner exponent alpha = {alpha:.4f}: the rate of uniform refinement")
 
@@ -88,7 +91,7 @@ print(f"corner exponent alpha = {alpha:.4f}: the rate of uniform refinement")
 mesh = nd.build_mesh(l_shape.geometry, 1)
 coarse = nd.BoundaryMeshes.for_scene(l_shape, mesh)
 solution = nd.solve_on_mesh(l_shape, mesh, coarse)
-print(f"{mesh.ne} triangles, exact error {corner.exact_error(solution, exact):.3e}")
+print(f"{mesh.ne} triangles, exact error {nd.verification.corner.exact_error(solution, exact):.3e}")
 lesson.save(nd.plot_von_mises(mesh, nd.fields(solution).sigma, l_shape.material.nu,
                               "SOLVE: von Mises stress on the initial mesh"), "solve")
 
@@ -100,7 +103,7 @@ lesson.save(nd.plot_von_mises(mesh, nd.fields(solution).sigma, l_shape.material.
 # %%
 estimate = nd.estimate(solution)
 indicators = estimate.indicators
-points, triangles = mesh_arrays(mesh)
+points, triangles = nd.mesh_arrays(mesh)
 lesson.save(nd.plot_element_field(points, triangles, indicators,
                                   r"ESTIMATE: $\eta_{tot,T}$ of (4.50)", r"$\eta_{tot,T}$"),
             "estimate")
@@ -134,7 +137,7 @@ lesson.save(nd.plot_mesh(points, triangles, "MARK: Dörfler, theta = 0.5",
 
 # %%
 refined, refined_coarse = nd.refine_with_boundary(l_shape, mesh, coarse, marked["dorfler"])
-lesson.save(nd.plot_mesh(*mesh_arrays(refined), f"REFINE: {mesh.ne} -> {refined.ne} triangles"),
+lesson.save(nd.plot_mesh(*nd.mesh_arrays(refined), f"REFINE: {mesh.ne} -> {refined.ne} triangles"),
             "refine")
 
 # %% [markdown]
@@ -158,8 +161,8 @@ def run(marking: str, theta: float, steps: int) -> dict:
         marked = None if last else nd.mark(estimate.indicators, theta, marking)  # MARK
         kept["ndofs"].append(int(sum(solution.problem.spaces.dofs().values())))
         kept["etas"].append(estimate.total)
-        kept["errors"].append(corner.exact_error(solution, exact))
-        kept["meshes"].append((*mesh_arrays(mesh), marked))
+        kept["errors"].append(nd.verification.corner.exact_error(solution, exact))
+        kept["meshes"].append((*nd.mesh_arrays(mesh), marked))
         if not last:
             mesh, coarse = nd.refine_with_boundary(l_shape, mesh, coarse, marked)  # REFINE
     kept["rates"] = {"error": nd.rates.fitted_rate(kept["ndofs"][-3:], kept["errors"][-3:]),
@@ -204,7 +207,7 @@ ax.loglog(n_ref, e_ref * (n_ref / n_ref[0]) ** (-alpha / 2), "k:", lw=1,
           label=f"N^(-α/2), α = {alpha:.3f}")
 ax.loglog(n_ref, e_ref * (n_ref / n_ref[0]) ** -0.5, "k-.", lw=1, label="N^(-1/2)")
 ax.set(xlabel="degrees of freedom N", ylabel="error / estimator",
-       title="L-shape, corner singularity")
+       title="L-shape, nd.verification.corner singularity")
 ax.grid(True, which="both", alpha=0.3)
 ax.legend(fontsize=7, ncol=2)
 lesson.save(fig, "l_shape_convergence")

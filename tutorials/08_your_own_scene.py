@@ -4,6 +4,12 @@
 # **Run time** on a 2-core laptop: about 4 s; about 5 s with `NGDUAL_QUICK=1`
 # (`ngdual tutorials run 08 --quick`).
 #
+# **The idea in words.** A scene file describes a problem in words and numbers: the
+# outline of the body and the names of its sides, which sides are held, loaded or may
+# touch the foundation, the material and the loads. ngdual checks it before anything is
+# meshed and names every mistake. This tutorial writes a new scene, previews its geometry,
+# solves it on a few meshes and reads the results, in Python and from the command line.
+#
 # **Problem.** A new geometry, set up without writing any finite element code: an
 # elastic stamp (a hexagon) clamped at its two short vertical sides, loaded from
 # above, resting on a *curved* rigid foundation with gap $g(x) = 0.001 + 0.05\,x^2$: the
@@ -31,14 +37,31 @@
 
 # %%
 import json
+import subprocess
+import sys
+
+import numpy as np
 
 import ngdual as nd
-from ngdual.cli import main as ngdual_cli
-from ngdual.mesh import mesh_size
-from ngdual.studies.tutorials import Lesson
 
-lesson = Lesson("08_your_own_scene")           # figures, scene files, results.json go here
+lesson = nd.Lesson("08_your_own_scene")           # figures, scene files, results.json go here
 QUICK = lesson.quick
+
+
+def ngdual_cli(arguments: list[str]) -> int:
+    """Run the command line ``ngdual ARGUMENTS`` as from a terminal; its exit status."""
+    run = subprocess.run([sys.executable, "-m", "ngdual", *arguments], capture_output=True,
+                         text=True)
+    print(run.stdout + run.stderr, end="")
+    return run.returncode
+
+
+def mesh_size(mesh) -> float:
+    """The largest triangle diameter h (its longest edge), as in Table 3.1."""
+    points, triangles = nd.mesh_arrays(mesh)
+    corners = points[triangles]
+    return max(float(np.linalg.norm(corners[:, i] - corners[:, i - 1], axis=1).max())
+               for i in range(3))
 LEVELS = [1, 2] if QUICK else [1, 2, 3, 4]
 OUT = lesson.out
 

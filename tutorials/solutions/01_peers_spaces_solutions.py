@@ -8,16 +8,9 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import ngdual as nd
-from ngdual.forms import Spaces, assemble
-from ngdual.mesh import build_mesh
-from ngdual.studies.tutorials import Lesson
-from ngdual.verification.infsup import (
-    gram_matrix,
-    largest_singular_value,
-    smallest_singular_values,
-)
 
-lesson = Lesson("01_peers_spaces_solutions")
+infsup = nd.verification.infsup                  # Gram matrices and singular values of B
+lesson = nd.Lesson("01_peers_spaces_solutions")
 QUICK = lesson.quick
 LEVELS = [1, 2] if QUICK else [1, 2, 3, 4]
 
@@ -41,14 +34,14 @@ clamped = nd.load_scene("thesis-3.46-frictionless",
 
 singular = {"hdiv": [], "l2": []}
 for level in LEVELS:
-    problem = assemble(clamped, build_mesh(clamped.geometry, level))
+    problem = nd.assemble(clamped, nd.build_mesh(clamped.geometry, level))
     s, m = problem.sigma, problem.mult
     B = problem.block(s, m)
     for key, with_div in (("hdiv", True), ("l2", False)):
-        G = gram_matrix(problem, with_div)
+        G = infsup.gram_matrix(problem, with_div)
         X, Y = G[s][:, s], G[m][:, m]
-        singular[key].append((float(smallest_singular_values(X, B, Y, k=1)[0]),
-                              largest_singular_value(X, B, Y)))
+        singular[key].append((float(infsup.smallest_singular_values(X, B, Y, k=1)[0]),
+                              infsup.largest_singular_value(X, B, Y)))
     print(f"level {level}: (smallest, largest) in H(div) "
           f"({singular['hdiv'][-1][0]:.3f}, {singular['hdiv'][-1][1]:.3f}),  in L2 "
           f"({singular['l2'][-1][0]:.3f}, {singular['l2'][-1][1]:.3f})")
@@ -94,7 +87,7 @@ def formula(level: int) -> tuple[int, int, int]:
 assert all(formula(k) == TABLE_3_1[k] for k in TABLE_3_1)
 thesis = nd.load_scene("thesis-3.46-frictionless")
 for level in LEVELS:
-    dofs = Spaces.build(thesis, build_mesh(thesis.geometry, level)).dofs()
+    dofs = nd.assemble(thesis, nd.build_mesh(thesis.geometry, level)).spaces.dofs()
     assert (dofs["X"], dofs["M"], dofs["S"]) == formula(level)
 print("Euler's formula reproduces all eight rows of Table 3.1")
 

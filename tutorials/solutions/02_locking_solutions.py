@@ -8,12 +8,9 @@ import matplotlib.pyplot as plt
 import ngsolve as ngs
 import numpy as np
 
-from ngdual.expr import Expression
-from ngdual.mesh import mesh_arrays, polygon_mesh
-from ngdual.scene import Material
-from ngdual.studies.tutorials import Lesson
+import ngdual as nd
 
-lesson = Lesson("02_locking_solutions")
+lesson = nd.Lesson("02_locking_solutions")
 QUICK = lesson.quick
 LEVELS = [1, 2] if QUICK else [1, 2, 3, 4]
 NUS = [0.3, 0.49, 0.499, 0.4999]
@@ -37,7 +34,7 @@ def term(first: str, second: str) -> str:
 
 
 def cf(formula: str):
-    return Expression(formula).coefficient()
+    return nd.Expression(formula).coefficient()
 
 
 mu = 1.0
@@ -47,10 +44,12 @@ sigma_exact = ngs.CF((cf(f"{2 * mu}*{term('dp', 'dp')}"), cf(shear), cf(shear),
 force = ngs.CF((cf(f"-{mu}*({term('d2p', 'dp')} + {term('p', 'd3p')})"),
                 cf(f"{mu}*({term('d3p', 'p')} + {term('dp', 'd2p')})")))
 SIDES = ["bottom", "right", "top", "left"]
+SQUARE = nd.scene.Geometry(kind="polygon", points=[[0, 0], [1, 0], [1, 1], [0, 1]],
+                           labels=SIDES, maxh=0.25)
 
 
 def primal_stress_error(mesh, nu: float, order: int) -> float:
-    lam, shear_modulus = Material(2 * mu * (1 + nu), nu).lame
+    lam, shear_modulus = nd.scene.Material(2 * mu * (1 + nu), nu).lame
     space = ngs.VectorH1(mesh, order=order, dirichlet="|".join(SIDES))
     u, v = space.TnT()
     eps_u, eps_v = ngs.Sym(ngs.Grad(u)), ngs.Sym(ngs.Grad(v))
@@ -66,7 +65,7 @@ def primal_stress_error(mesh, nu: float, order: int) -> float:
                                          order=10)))
 
 
-mesh = polygon_mesh([[0, 0], [1, 0], [1, 1], [0, 1]], SIDES, maxh=0.25, level=LEVELS[-1])
+mesh = nd.build_mesh(SQUARE, LEVELS[-1])
 ratios, primal_errors = {}, {}
 for order in (1, 2):
     primal_errors[order] = [primal_stress_error(mesh, nu, order) for nu in NUS]
@@ -108,7 +107,7 @@ lesson.save(fig, "primal_locking")
 # %%
 def divergence_matrix(mesh) -> tuple[np.ndarray, int]:
     """D (T x 2 V_int): elementwise divergence of P1 fields vanishing on the boundary."""
-    points, triangles = mesh_arrays(mesh)
+    points, triangles = nd.mesh_arrays(mesh)
     boundary = {v.nr for el in mesh.Elements(ngs.BND) for v in el.vertices}
     interior = [k for k in range(len(points)) if k not in boundary]
     column = {k: i for i, k in enumerate(interior)}
@@ -124,7 +123,7 @@ def divergence_matrix(mesh) -> tuple[np.ndarray, int]:
 
 divergence_free = []
 for level in LEVELS:
-    square = polygon_mesh([[0, 0], [1, 0], [1, 1], [0, 1]], SIDES, maxh=0.25, level=level)
+    square = nd.build_mesh(SQUARE, level)
     D, n_interior = divergence_matrix(square)
     rank = np.linalg.matrix_rank(D)
     row = {"level": level, "T": D.shape[0], "unknowns": D.shape[1],

@@ -8,22 +8,21 @@ import matplotlib.pyplot as plt
 import numpy as np
 import scipy.sparse.linalg as spla
 
-from ngdual import post
-from ngdual.forms import assemble
-from ngdual.mesh import build_mesh
-from ngdual.scene import load_scene
-from ngdual.solvers.projections import NonnegativeProjection, metric_matrix
-from ngdual.solvers.qp import solve_qp
-from ngdual.solvers.settings import Model, UzawaSettings
-from ngdual.solvers.uzawa import uzawa
-from ngdual.studies.tutorials import Lesson
+import ngdual as nd
 
-lesson = Lesson("03_signorini_uzawa_solutions")
+uzawa = nd.solvers.uzawa.uzawa                            # Algorithm 3.38
+UzawaSettings = nd.solvers.UzawaSettings                  # its step length, metric, tolerance
+Model = nd.solvers.Model                                  # the law and moduli the QPs need
+metric_matrix = nd.solvers.projections.metric_matrix      # the metric W of the projection
+NonnegativeProjection = nd.solvers.projections.NonnegativeProjection  # P+ onto lambda_n >= 0
+solve_qp = nd.solvers.qp.solve_qp                         # the whole problem as one convex QP
+
+lesson = nd.Lesson("03_signorini_uzawa_solutions")
 QUICK = lesson.quick
 LEVELS = [1, 2] if QUICK else [1, 2, 3, 4]
 RHOS = [0.5, 1.0, 1.5, 2.0] if QUICK else list(np.arange(0.25, 2.51, 0.25))
-scene = load_scene("thesis-3.46-frictionless")
-problems = {level: assemble(scene, build_mesh(scene.geometry, level)) for level in LEVELS}
+scene = nd.load_scene("thesis-3.46-frictionless")
+problems = {level: nd.assemble(scene, nd.build_mesh(scene.geometry, level)) for level in LEVELS}
 
 # %% [markdown]
 # ## Exercise 1: the optimal step length
@@ -133,9 +132,9 @@ lesson.save(fig, "metrics_under_refinement")
 # %%
 gaps = {}
 for gap in ("abs(x)", "0.005 + 0.002*x*x"):
-    variant = load_scene("thesis-3.46-frictionless", [f"contact.gap='{gap}'"])
-    problem = assemble(variant, build_mesh(variant.geometry, 3 if QUICK else 4))
-    nodes = [post.contact_summary(s)["nodes_in_contact"]
+    variant = nd.load_scene("thesis-3.46-frictionless", [f"contact.gap='{gap}'"])
+    problem = nd.assemble(variant, nd.build_mesh(variant.geometry, 3 if QUICK else 4))
+    nodes = [nd.post.contact_summary(s)["nodes_in_contact"]
              for s in (uzawa(problem, UzawaSettings.from_scene(variant, eps=1e-10)),
                        solve_qp(problem, Model.of(variant)))]
     gaps[gap] = nodes

@@ -8,24 +8,23 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import ngdual as nd
-from ngdual import peers, post
-from ngdual.forms import assemble
-from ngdual.mesh import build_mesh
-from ngdual.solution import ConvergenceError
-from ngdual.solvers.nested import nested_uzawa
-from ngdual.solvers.settings import NestedUzawaSettings, UzawaSettings
-from ngdual.solvers.uzawa import uzawa
-from ngdual.studies.tutorials import Lesson
 
-lesson = Lesson("04_friction_solutions")
+uzawa = nd.solvers.uzawa.uzawa                            # Algorithm 3.38
+nested_uzawa = nd.solvers.nested.nested_uzawa             # Algorithm 3.41
+UzawaSettings = nd.solvers.UzawaSettings                  # its step length, metric, tolerance
+NestedUzawaSettings = nd.solvers.NestedUzawaSettings      # its two step lengths, loop order
+ConvergenceError = nd.solvers.ConvergenceError            # an algorithm that did not converge
+
+lesson = nd.Lesson("04_friction_solutions")
 QUICK = lesson.quick
+STRESS = ("r1", "r2", "b1", "b2")   # the stress unknowns: two RT0 rows, two Curl bubbles
 LEVEL = 3                                             # the first level with a stick zone
 RHO1S = [1.0] if QUICK else [0.5, 1.0, 1.5]
 RHO2S = [0.5, 1.0, 1.5] if QUICK else [0.25, 0.5, 1.0, 1.5]
 LARGE_RHO2S = [2.5, 8.0]
 MUS = [0.0, 0.1, 0.5, 1.0] if QUICK else [0.0, 0.1, 0.25, 0.5, 1.0]
 coulomb = nd.load_scene("thesis-3.46-coulomb")
-problem = assemble(coulomb, build_mesh(coulomb.geometry, LEVEL))
+problem = nd.assemble(coulomb, nd.build_mesh(coulomb.geometry, LEVEL))
 
 
 def attempt(**options):
@@ -89,20 +88,20 @@ lesson.save(fig, "step_lengths")
 
 # %%
 frictionless = nd.load_scene("thesis-3.46-frictionless")
-reference = uzawa(assemble(frictionless, build_mesh(frictionless.geometry, LEVEL)),
+reference = uzawa(nd.assemble(frictionless, nd.build_mesh(frictionless.geometry, LEVEL)),
                   UzawaSettings.from_scene(frictionless, eps=1e-10))
 by_mu = {}
 for mu in MUS:
     solution = nested_uzawa(problem, NestedUzawaSettings.from_scene(coulomb, mu_f=mu, eps1=1e-10,
                                                                     eps2=1e-9))
-    summary = post.contact_summary(solution)
+    summary = nd.post.contact_summary(solution)
     by_mu[str(mu)] = {"converged": solution.converged, "F_abs": summary["F_abs"],
                       "nodes_in_contact": summary["nodes_in_contact"],
                       "stick_nodes": summary["stick_nodes"], "slip_nodes": summary["slip_nodes"],
                       "sigma_vs_frictionless": float(
-                          np.linalg.norm(solution.part(*peers.STRESS)
-                                         - reference.part(*peers.STRESS))
-                          / np.linalg.norm(reference.part(*peers.STRESS)))}
+                          np.linalg.norm(solution.part(*STRESS)
+                                         - reference.part(*STRESS))
+                          / np.linalg.norm(reference.part(*STRESS)))}
     row = by_mu[str(mu)]
     # with F = 0 there are no h^ edges in A_C: the stick/slip split is meaningless
     split = (f"stick {row['stick_nodes']}, slip {row['slip_nodes']}" if mu > 0

@@ -8,14 +8,11 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import ngdual as nd
-from ngdual.forms import assemble
-from ngdual.friction import build_friction_forms
-from ngdual.mesh import build_mesh
-from ngdual.solvers.nested import nested_uzawa
-from ngdual.solvers.settings import NestedUzawaSettings
-from ngdual.studies.tutorials import Lesson
 
-lesson = Lesson("05_friction_inf_sup_solutions")
+nested_uzawa = nd.solvers.nested.nested_uzawa             # Algorithm 3.41
+NestedUzawaSettings = nd.solvers.NestedUzawaSettings      # its two step lengths, loop order
+
+lesson = nd.Lesson("05_friction_inf_sup_solutions")
 QUICK = lesson.quick
 GAP_ABS_LEVEL = 3 if QUICK else 4
 KERNEL_LEVEL = 2
@@ -36,14 +33,14 @@ KERNEL_LEVEL = 2
 gap_abs = {}
 for factor in (1, 2):
     scene = nd.load_scene("thesis-3.46-coulomb-gap-abs", [f"contact.hhat_factor={factor}"])
-    gap_abs[factor] = nested_uzawa(assemble(scene, build_mesh(scene.geometry, GAP_ABS_LEVEL)),
+    gap_abs[factor] = nested_uzawa(nd.assemble(scene, nd.build_mesh(scene.geometry, GAP_ABS_LEVEL)),
                                    NestedUzawaSettings.from_scene(scene, eps2=1e-8))
 a, b = gap_abs[1], gap_abs[2]
 scale = max(np.linalg.norm(b.part("lam_n")), np.linalg.norm(b.part("lam_t")))
 gap_abs_difference = {name: float(np.linalg.norm(a.part(name) - b.part(name)) / scale)
                       for name in ("lam_n", "lam_t")}
 for factor, solution in gap_abs.items():
-    forms = build_friction_forms(solution.problem)
+    forms = nd.friction_forms(solution.problem)
     F_hat = forms.per_hat_edge(solution.friction_bound)
     on_a_c = (F_hat > 1e-6 * F_hat.max())[forms.edge_of]
     print(f"h^ = {factor} h~: {solution.iterations}, converged {solution.converged}; "
@@ -82,7 +79,7 @@ lesson.save(fig, "gap_abs_lambda_t")
 
 # %%
 def kernel_of(problem, F) -> np.ndarray:
-    fr = build_friction_forms(problem)
+    fr = nd.friction_forms(problem)
     Q = fr.q_matrix(F).toarray()
     vector = np.linalg.svd(Q.T)[2][-1]
     residual = np.linalg.norm(Q.T @ vector)
@@ -91,8 +88,8 @@ def kernel_of(problem, F) -> np.ndarray:
 
 
 scene = nd.load_scene("thesis-3.46-coulomb-gap0", ["contact.hhat_factor=1"])
-problem = assemble(scene, build_mesh(scene.geometry, KERNEL_LEVEL))
-fr = build_friction_forms(problem)
+problem = nd.assemble(scene, nd.build_mesh(scene.geometry, KERNEL_LEVEL))
+fr = nd.friction_forms(problem)
 F_variable = 1.0 + fr.midpoints[:, 0] ** 2
 kernel_constant, _ = kernel_of(problem, np.ones(len(fr.lengths)))
 kernel_variable, _ = kernel_of(problem, F_variable)

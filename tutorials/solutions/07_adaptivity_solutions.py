@@ -9,19 +9,9 @@ import matplotlib.pyplot as plt
 import ngsolve as ngs
 import numpy as np
 
-from ngdual.afem import adapt, refine
-from ngdual.boundary import BoundaryMeshes
-from ngdual.estimator import estimate
-from ngdual.forms import assemble
-from ngdual.marking import mark
-from ngdual.mesh import build_mesh, mesh_arrays
-from ngdual.rates import fitted_rate
-from ngdual.scene import load_scene
-from ngdual.solvers import solve_problem, solve_scene
-from ngdual.studies.tutorials import Lesson
-from ngdual.verification import corner
+import ngdual as nd
 
-lesson = Lesson("07_adaptivity_solutions")
+lesson = nd.Lesson("07_adaptivity_solutions")
 QUICK = lesson.quick
 TARGET_DOFS = 1500 if QUICK else 8000       # Exercise 1: refine until N reaches this
 THETAS = [0.2, 0.5, 0.8]
@@ -37,20 +27,19 @@ def adapt_until(scene, marking, theta, max_dofs, level=1, indicator="indicators"
     ``indicator`` names an `Estimate` attribute ("indicators", "eta_sigma", "eta_u").
     Returns one row (ndof, eta, error or None) per step and the last mesh.
     """
-    mesh = build_mesh(scene.geometry, level)
-    coarse = BoundaryMeshes.for_scene(scene, mesh)
+    mesh = nd.build_mesh(scene.geometry, level)
+    coarse = nd.BoundaryMeshes.for_scene(scene, mesh)
     rows = []
     for _ in range(max_steps):
-        solution = solve_problem(assemble(scene, mesh, coarse))              # SOLVE
-        estimated = estimate(solution)                                       # ESTIMATE
+        solution = nd.solvers.solve_problem(nd.assemble(scene, mesh, coarse))              # SOLVE
+        estimated = nd.estimate(solution)                                       # ESTIMATE
         ndof = int(sum(solution.problem.spaces.dofs().values()))
         rows.append({"ndof": ndof, "eta": estimated.total,
                      "error": error(solution) if error else None})
         if ndof >= max_dofs:
             break
-        marked = mark(getattr(estimated, indicator), theta, marking)         # MARK
-        mesh = refine(mesh, marked)                                          # REFINE
-        coarse = coarse.follow(scene, mesh)
+        marked = nd.mark(getattr(estimated, indicator), theta, marking)         # MARK
+        mesh, coarse = nd.refine_with_boundary(scene, mesh, coarse, marked)  # REFINE
     return rows, mesh
 
 
@@ -66,12 +55,12 @@ def adapt_until(scene, marking, theta, max_dofs, level=1, indicator="indicators"
 # is the usual compromise.
 
 # %%
-l_shape = corner.l_shape_scene()          # Williams' corner solution (ngdual.verification.corner)
-exact = corner.exact_fields()
+l_shape = nd.verification.corner.l_shape_scene()  # Williams' corner solution
+exact = nd.verification.corner.exact_fields()
 
 
 def exact_error(solution) -> float:
-    return corner.exact_error(solution, exact)
+    return nd.verification.corner.exact_error(solution, exact)
 
 
 dorfler, curves = {}, {}
@@ -80,7 +69,7 @@ for theta in THETAS:
     ndofs, errors = [r["ndof"] for r in rows], [r["error"] for r in rows]
     curves[theta] = (ndofs, errors)
     dorfler[str(theta)] = {"steps": len(rows), "ndof": ndofs[-1], "error": errors[-1],
-                           "rate": fitted_rate(ndofs[-3:], errors[-3:])}
+                           "rate": nd.rates.fitted_rate(ndofs[-3:], errors[-3:])}
     row = dorfler[str(theta)]
     print(f"theta = {theta}: {row['steps']:2d} SOLVE steps to N = {row['ndof']:5d}, error "
           f"{row['error']:.3e}, rate (last 3 steps) {row['rate']:.3f}")
@@ -93,7 +82,7 @@ first_n, first_e = curves[THETAS[0]][0][0], curves[THETAS[0]][1][0]
 reference = np.array([first_n, TARGET_DOFS])
 ax.loglog(reference, first_e * (reference / first_n) ** -0.5, "k:", label=r"$N^{-1/2}$ (optimal)")
 ax.set_xlabel("degrees of freedom N")
-ax.set_ylabel("exact error e (Williams' corner solution)")
+ax.set_ylabel("exact error e (Williams' nd.verification.corner solution)")
 ax.set_title(r"Exercise 1: Dörfler marking on the L-shape for three $\theta$")
 ax.grid(True, which="both", alpha=0.3)
 ax.legend()
@@ -115,7 +104,7 @@ def edges_on(mesh: ngs.Mesh, label: str) -> int:
     return sum(1 for el in mesh.Elements(ngs.BND) if el.mat == label)
 
 
-thesis = load_scene("thesis-3.46-coulomb")
+thesis = nd.load_scene("thesis-3.46-coulomb")
 by_indicator, meshes = {}, {}
 for indicator in ("indicators", "eta_sigma"):
     rows, mesh = adapt_until(thesis, "fraction", 0.2, 10**9, level=2, indicator=indicator,
@@ -133,7 +122,7 @@ for indicator in ("indicators", "eta_sigma"):
 fig, axes = plt.subplots(2, 1, figsize=(9, 5.5), sharex=True)
 for ax, (indicator, label) in zip(axes, (("indicators", r"$\eta_{tot,T}$ (4.50)"),
                                          ("eta_sigma", r"$\eta_{\sigma,T}$ (4.15) only"))):
-    points, triangles = mesh_arrays(meshes[indicator])
+    points, triangles = nd.mesh_arrays(meshes[indicator])
     ax.triplot(points[:, 0], points[:, 1], triangles, color="0.3", lw=0.3)
     row = by_indicator[indicator]
     ax.set_title(f"marked with {label}: {row['elements']} triangles, {row['top_edges']} "
@@ -164,17 +153,17 @@ lesson.save(fig, "meshes_by_indicator")
 # %%
 corners = {}
 for gap in ("0.01", "0"):
-    scene = load_scene("thesis-3.46-frictionless", [f"contact.gap='{gap}'"])
-    solutions = [solve_scene(scene, level) for level in UNIFORM_LEVELS]
-    uniform = [estimate(solution) for solution in solutions]
+    scene = nd.load_scene("thesis-3.46-frictionless", [f"contact.gap='{gap}'"])
+    solutions = [nd.solve(scene, level) for level in UNIFORM_LEVELS]
+    uniform = [nd.estimate(solution) for solution in solutions]
     uniform_ndofs = [int(sum(s.problem.spaces.dofs().values())) for s in solutions]
-    history = adapt(scene, "dorfler", 0.5, CORNER_STEPS, level=1)
+    history = nd.adapt(scene, "dorfler", 0.5, CORNER_STEPS, level=1)
     ndofs, etas = [r["dofs"]["total"] for r in history], [r["estimator"] for r in history]
     corners[gap] = {"uniform_ndofs": uniform_ndofs, "uniform_eta": [e.total for e in uniform],
                     "uniform_as_max": [float(np.sqrt(e.terms["asymmetry"].max()))
                                        for e in uniform],
                     "dorfler_ndofs": ndofs, "dorfler_etas": etas,
-                    "dorfler_rate": fitted_rate(ndofs[-3:], etas[-3:])}
+                    "dorfler_rate": nd.rates.fitted_rate(ndofs[-3:], etas[-3:])}
     row = corners[gap]
     print(f"g = {gap:4s} uniform levels {UNIFORM_LEVELS}: eta {np.round(row['uniform_eta'], 1)}, "
           f"max eta_as,T {np.round(row['uniform_as_max'], 1)}")

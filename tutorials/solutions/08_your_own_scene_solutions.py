@@ -8,10 +8,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import ngdual as nd
-from ngdual.scene import Contact, Geometry, Loads, Material
-from ngdual.studies.tutorials import Lesson
 
-lesson = Lesson("08_your_own_scene_solutions")
+lesson = nd.Lesson("08_your_own_scene_solutions")
 QUICK = lesson.quick
 LEVELS = [1, 2, 3] if QUICK else [1, 2, 3, 4]
 OUT = lesson.out
@@ -20,14 +18,14 @@ OUT = lesson.out
 def stamp(load_factor: float = 1.0, gap: str = "0.001 + 0.05*x*x") -> nd.Scene:
     """The stamp of Tutorial 8, its load scaled by ``load_factor``, above the gap ``gap``."""
     labels = ["base", "right_clamp", "right_shoulder", "top", "left_shoulder", "left_clamp"]
-    scene = nd.Scene(name="stamp", material=Material(E=200000.0, nu=0.3),
-                     geometry=Geometry(kind="polygon", labels=labels, maxh=0.25, points=[
+    scene = nd.Scene(name="stamp", material=nd.scene.Material(E=200000.0, nu=0.3),
+                     geometry=nd.scene.Geometry(kind="polygon", labels=labels, maxh=0.25, points=[
                          [-1.0, 0.0], [1.0, 0.0], [1.0, 0.25], [0.4, 1.0], [-0.4, 1.0],
                          [-1.0, 0.25]]),
                      boundary={"dirichlet": labels[1::4], "neumann": labels[2:5],
                                "contact": labels[:1]},
-                     loads=Loads(traction=["0", f"{-1500 * load_factor}*(1 - x*x)"]),
-                     contact=Contact(gap=gap))
+                     loads=nd.scene.Loads(traction=["0", f"{-1500 * load_factor}*(1 - x*x)"]),
+                     contact=nd.scene.Contact(gap=gap))
     nd.validate(scene)
     return scene
 

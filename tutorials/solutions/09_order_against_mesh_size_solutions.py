@@ -9,18 +9,14 @@ import time
 import matplotlib.pyplot as plt
 
 import ngdual as nd
-from ngdual.rates import observed_rates
-from ngdual.studies.tutorials import Lesson
-from ngdual.verification.manufactured import manufactured_case
-from ngdual.verification.manufactured_errors import volume_errors
 
-lesson = Lesson("09_order_against_mesh_size_solutions")
+lesson = nd.Lesson("09_order_against_mesh_size_solutions")
 QUICK = lesson.quick
 LEVELS = ({0: [1, 2, 3], 1: [1, 2, 3], 2: [1, 2]} if QUICK
           else {0: [1, 2, 3, 4, 5], 1: [1, 2, 3, 4], 2: [1, 2, 3]})
 FACET_LEVELS = [2, 3] if QUICK else [2, 3, 4, 5]
 
-case = manufactured_case("frictionless")
+case = nd.verification.manufactured_case("frictionless")
 scene = case.scene()
 
 
@@ -31,14 +27,14 @@ def study(levels, **arguments) -> list[dict]:
         start = time.perf_counter()
         solution = nd.solve(scene, level, **arguments)
         seconds = time.perf_counter() - start
-        errors = volume_errors(case, solution)
+        errors = nd.verification.volume_errors(case, solution)
         rows.append({"level": level, "ndof": solution.problem.fes.ndof, "seconds": seconds,
                      **{q: errors[q] for q in ("sigma", "u", "eta")}})
     return rows
 
 
 def orders(rows: list[dict], quantity: str) -> list[float | None]:
-    return observed_rates([r["ndof"] for r in rows], [r[quantity] for r in rows])
+    return nd.rates.observed_rates([r["ndof"] for r in rows], [r[quantity] for r in rows])
 
 
 # %% [markdown]
@@ -62,7 +58,7 @@ for k, rows in runs.items():
 # The $P_0$ multipliers on the fine edges pair with the normal traces of $RT_0$ edge by
 # edge. The stress in the volume hardly changes — its error is that of $RT_0$ — while
 # the solver changes: the facet multipliers are solved by the hybridised system of order
-# $k$ (`ngdual.solvers.hybrid_order`), the thesis' multipliers by the thesis' one.
+# $k$ (`nd.solvers.hybrid_order`), the thesis' multipliers by the thesis' one.
 
 # %%
 pairings = {"coarse": study(FACET_LEVELS),

@@ -8,10 +8,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import ngdual as nd
-from ngdual.mesh import mesh_arrays
-from ngdual.studies.tutorials import Lesson
 
-lesson = Lesson("10_goal_and_tolerance_solutions")
+lesson = nd.Lesson("10_goal_and_tolerance_solutions")
 QUICK = lesson.quick
 TOL = 0.03 if QUICK else 0.01
 
@@ -25,7 +23,7 @@ def run(scene, steps: int = 20, **arguments) -> dict:
         kept["ndof"].append(record["dofs"]["total"])
         kept["relative_estimate"].append(record["relative_estimate"])
         kept["seconds"].append(record["elapsed_s"])
-        kept["mesh"] = mesh_arrays(solution.problem.fes.mesh)
+        kept["mesh"] = nd.mesh_arrays(solution.problem.fes.mesh)
 
     history = nd.adapt(scene, goal="pressure", tol=TOL, steps=steps, on_step=on_step,
                        **arguments)
