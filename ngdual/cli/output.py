@@ -117,7 +117,8 @@ def summary_table(summary: dict) -> str:
         return "\n".join(lines + ["no contact boundary: no contact quantities"])
     bench = summary.get("benchmark")
     n, t = (_direction(summary["directions"][k]) for k in ("normal", "tangent"))
-    lines.append(f"{'':32s}{'computed':>11s}" + (f"{bench['name']:>18s}{'difference':>12s}"
+    width = max(18, len(bench["name"]) + 2) if bench else 0
+    lines.append(f"{'':32s}{'computed':>11s}" + (f"{bench['name']:>{width}s}{'difference':>12s}"
                                                    if bench else ""))
     for key, name, symbol, kind in SUMMARY_ROWS:
         if summary.get(key) is None:
@@ -125,7 +126,7 @@ def summary_table(summary: dict) -> str:
         label = f"{name} {symbol}".strip() + _unit(summary, kind)
         row = f"{label:32s}{_g(summary[key]):>11s}"
         if bench and key in bench["values"]:
-            row += f"{_g(bench['values'][key]):>18s}"
+            row += f"{_g(bench['values'][key]):>{width}s}"
             if key in bench["difference"]:
                 row += f"{bench['difference'][key] * 100:>+10.3g} %"
         lines.append(row + {"half_width": f"   (node spacing {_g(summary['resolution'] or 0)})",
