@@ -21,9 +21,11 @@ vanish while the problem has data, and that scale with the units as the residual
   displacement, a multiplier equation (equilibrium, symmetry, the moments t_i on Gamma_C)
   those of a force; each is compared with its own row size.
 
-Scaling E, the lengths, the loads or the friction bound by a power of ten scales D, S and
-every row size as it scales the residual, so the relative residuals and the verdict do not
-change (tests/test_scaling.py).
+A change of units (E, the tractions and a Tresca bound by a factor e, the lengths by c)
+scales D, S and every row size as it scales the residual, so the relative residuals and the
+verdict do not change (tests/test_scaling.py); a friction bound enters the size of the
+friction conditions it bounds, so bounds far from the pressure (1e-6 to 1e6 of it) are
+judged like any other.
 """
 
 from __future__ import annotations
@@ -80,10 +82,12 @@ class Scales:
         size = float(np.linalg.norm(self.rows[rows]))
         return float(np.linalg.norm(residual)) / size if size > 0 else 0.0
 
-    def per_row(self, values: np.ndarray, rows: np.ndarray) -> float:
-        """max_i |values_i| / size of row i: the worst violation of a condition imposed row by
-        row (the contact and friction conditions on the moments of Gamma_C)."""
-        size = self.rows[rows]
+    def per_row(self, values: np.ndarray, rows: np.ndarray, extra: np.ndarray | float = 0.0
+                ) -> float:
+        """max_i |values_i| / (size of row i + ``extra``_i): the worst violation of a condition
+        imposed row by row (the contact and friction conditions on the moments of Gamma_C;
+        ``extra`` a friction bound that the condition compares with)."""
+        size = self.rows[rows] + extra
         if not len(size):
             return 0.0
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -133,10 +137,8 @@ def residuals(problem: DiscreteProblem, x: np.ndarray, law: str, mu_f: float,
         "complementarity": scales.per_row(lam_n * t_n, i_lam) / (D or 1.0),
     }
     if F is not None:
-        bounded = Scales(D, scales.stress, scales.rows[i_lam_t] + F)
-        every = np.arange(len(F))
-        found["friction_bound"] = bounded.per_row(np.maximum(np.abs(t_t) - F, 0.0), every)
-        found["slip"] = bounded.per_row(F * np.abs(lam_t) - lam_t * t_t, every) / (D or 1.0)
+        found["friction_bound"] = scales.per_row(np.maximum(np.abs(t_t) - F, 0.0), i_lam_t, F)
+        found["slip"] = scales.per_row(F * np.abs(lam_t) - lam_t * t_t, i_lam_t, F) / (D or 1.0)
     if law == "coulomb":
         # F of the moments on K as the solver defines it: zero where it vanishes (at most
         # 1e-6 of its largest value, tolerances.friction_vanishes), as the F it returns
