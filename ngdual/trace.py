@@ -60,8 +60,9 @@ class ContactTraces:
     basis functions psi_i over int psi_i ds: what the sign conditions of the facet family
     control. ``sigma_n``, ``sigma_t`` are the means of the P_k traces on the fine edges;
     ``trace_xy``, ``trace_sigma_n``, ``trace_sigma_t`` (n_edges, m) sample the traces
-    themselves along every edge, end points included, at every order k >= 1 and with either
-    multiplier family (None at k = 0: the RT_0 traces are constant per edge).
+    themselves along every edge, end points included, at every order k >= 1 with either
+    multiplier family and with the facet multipliers at k = 0 (None with the thesis' hats at
+    k = 0, whose hat projections are the profile).
     ``edge_active``: the edges with an unknown in contact.
     """
 
@@ -135,10 +136,13 @@ def contact_traces(solution: Solution) -> ContactTraces:
                       else np.zeros(0),
                       hat_projection(means, gamma_c.lengths, s_t) if means.shape[1]
                       else np.zeros(0)]
-    # at order k the traces are polynomials of degree k on every fine edge, sampled for
-    # either multiplier family: the profile of order k is the traces (verification.traction)
+    # the traces are polynomials of degree k on every fine edge, sampled wherever they are
+    # what the contact conditions control or resolve: at order k >= 1 with either family, and
+    # with the facet multipliers (the trace space of RT_k) at every k; the thesis' hats at
+    # k = 0 control the hat projections instead
+    sampled = pb.spaces.order > 0 or isinstance(contact, FacetMesh)
     facet = (dict(zip(("trace_xy", "trace_sigma_n", "trace_sigma_t"), _trace_samples(solution)))
-             if pb.spaces.order > 0 else {})
+             if sampled else {})
     if isinstance(contact, FacetMesh):
         projected[:2] = _facet_moments(solution)
         active = in_contact.reshape(-1, contact.order + 1).any(axis=1)

@@ -135,12 +135,13 @@ def _plane_coordinate(solution: Solution, points: np.ndarray) -> np.ndarray:
 
 def traction_profile(solution: Solution) -> TractionProfile:
     """The lumped L2 projections of -sigma_n^h and sigma_t^h onto the h~ hats (see the module
-    docstring for why these are the compared tractions); at order k >= 1 (either multiplier
-    family) the traces themselves (:func:`_facet_profile`)."""
+    docstring for why these are the compared tractions) with the thesis' hats at k = 0; the
+    traces themselves (:func:`_facet_profile`) wherever the contact trace samples them (order
+    k >= 1, and the facet multipliers at every k)."""
     pb = solution.problem
     gamma_c, coarse = pb.spaces.gamma_c, pb.spaces.contact
     traces = contact_traces(solution)
-    if pb.spaces.order > 0:
+    if traces.trace_xy is not None:   # the traces themselves are the profile
         return _facet_profile(solution, traces)
     hats = gamma_c.hat_means(pb.spaces.prolongations["lam_n"])          # dof hats
     end_hats = gamma_c.hat_means(pb.spaces.end_hats["lam_n"])           # fixed-end hats
