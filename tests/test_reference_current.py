@@ -83,6 +83,7 @@ def test_the_cli_reference_lists_every_subcommand_and_option():
 def test_the_generator_writes_the_files_and_check_names_the_command(tmp_path, capsys):
     assert reference.main(["--out", str(tmp_path)]) == 0
     assert reference.main(["--out", str(tmp_path), "--check"]) == 0
+    capsys.readouterr()
     (tmp_path / reference.CLI_COMMANDS).write_text("# edited by hand\n", encoding="utf-8")
     assert reference.main(["--out", str(tmp_path), "--check"]) == 1
     out = capsys.readouterr().out
