@@ -334,7 +334,7 @@ def estimate(solution: Solution, asymmetry: str = "l2") -> Estimate:
         on_edges["u_contact"] = he * edges.integrals(squared(mult + u_gamma), labels_c)
         if spaces.friction is not None and solution.friction_bound is not None:
             on_edges["friction"] = _friction_term(solution, edges, sigma_n * t, labels_c)
-        elif spaces.family == "facet" and solution.friction_bound is not None:
+        elif spaces.contact.traces and solution.friction_bound is not None:
             on_edges["friction"] = _moment_friction_term(solution, edges, sigma_n, labels_c)
     for name in ("jump_dirichlet", "jump_neumann", "jump_contact", "u_dirichlet", "u_neumann",
                  "u_contact", "friction", "neumann"):

@@ -170,7 +170,7 @@ def _edge_functionals(problem: DiscreteProblem) -> tuple[sp.csr_matrix, sp.csr_m
     traction = peers.stress_traction(trial["r1"], trial["r2"])
     # the facet multipliers' d_C acts with the normal of the boundary curve
     # (ngdual.forms): the traces measured against the moments t = C^T sigma need the same
-    n = curve_normal(problem.scene, fes.mesh) if problem.spaces.family == "facet" \
+    n = curve_normal(problem.scene, fes.mesh) if problem.spaces.contact.traces \
         else ngs.specialcf.normal(2)
     t = tangent(n)
     ds = ngs.ds(definedon=fes.mesh.Boundaries(boundary_regex(problem.scene.labels("contact"))))
@@ -282,7 +282,7 @@ def build_friction_forms(problem: DiscreteProblem) -> FrictionForms:
     gamma_c = problem.spaces.gamma_c
     int_n, int_t = _edge_functionals(problem)
     scale = sp.diags(1.0 / gamma_c.lengths)
-    kind = FacetFrictionForms if problem.spaces.family == "facet" else FrictionForms
+    kind = FacetFrictionForms if problem.spaces.contact.traces else FrictionForms
     return kind(gamma_c, T_n=(scale @ int_n).tocsr(), T_t=(scale @ int_t).tocsr(),
                 midpoint_hats=gamma_c.hat_means(problem.spaces.prolongations["lam_n"]),
                 normal_stress=problem.scene.friction.normal_stress)

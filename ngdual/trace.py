@@ -18,7 +18,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .boundary import FacetMesh
 from .checks import friction_forms_of
 from .checks import in_contact as _in_contact
 from .friction import hat_projection
@@ -140,10 +139,10 @@ def contact_traces(solution: Solution) -> ContactTraces:
     # what the contact conditions control or resolve: at order k >= 1 with either family, and
     # with the facet multipliers (the trace space of RT_k) at every k; the thesis' hats at
     # k = 0 control the hat projections instead
-    sampled = pb.spaces.order > 0 or isinstance(contact, FacetMesh)
+    sampled = pb.spaces.order > 0 or contact.traces
     facet = (dict(zip(("trace_xy", "trace_sigma_n", "trace_sigma_t"), _trace_samples(solution)))
              if sampled else {})
-    if isinstance(contact, FacetMesh):
+    if contact.traces:
         projected[:2] = _facet_moments(solution)
         active = in_contact.reshape(-1, contact.order + 1).any(axis=1)
         facet["node_kind"] = "control point"

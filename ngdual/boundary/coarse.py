@@ -23,6 +23,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from itertools import combinations
+from typing import ClassVar
 
 import ngsolve as ngs
 import numpy as np
@@ -79,7 +80,18 @@ class CoarseMesh:
     (a fixed end: its value is prescribed, zero or lifted from the data; the thesis'
     C_h~ of (3.61) has only fixed ends). ``breaks`` are the fine vertices where chains
     are cut (kinks).
+
+    As the space of the boundary multipliers it says what the rest of the code needs to know
+    of it (the thesis' P1 hats here; :class:`~ngdual.boundary.coarse_order.CoarseOrderMesh`
+    and :class:`~ngdual.boundary.facet.FacetMesh` say it of theirs): ``traces``, whether the
+    multipliers are P_k on every fine edge, the normal traces of RT_k themselves, so that
+    their moments are the traces and the friction law bounds every moment; ``curve_normal``,
+    whether d_C of (3.24) pairs them with the normal of the boundary curve rather than with
+    that of its chords (the thesis' hats at order 0 take the chords').
     """
+
+    traces: ClassVar[bool] = False
+    curve_normal: ClassVar[bool] = False
 
     chains: tuple[Chain, ...]
     nodes: tuple[np.ndarray, ...]

@@ -25,6 +25,7 @@ fine Bernstein functions go to the host by :meth:`~ngdual.boundary.facet.FacetMe
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 import ngsolve as ngs
 import numpy as np
@@ -43,6 +44,8 @@ class CoarseOrderMesh(WithoutP1, CoarseMesh):
     coarse edge that starts there, and so on; the coefficients of the fixed end nodes are
     numbered apart (``ends=True`` of :meth:`prolongation`), as the thesis' end hats are.
     """
+
+    curve_normal: ClassVar[bool] = True   # degree k + 1 resolves the curve's normal
 
     degree: int = 1
 

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from math import comb
+from typing import ClassVar
 
 import ngsolve as ngs
 import numpy as np
@@ -73,6 +74,9 @@ class FacetMesh(WithoutP1, CoarseMesh):
     "dofs" are the k + 1 Bernstein coefficients of every fine edge, chain by chain and
     edge by edge along the chain; :meth:`node_points` are their control points.
     """
+
+    traces: ClassVar[bool] = True   # P_k per fine edge: the normal traces of RT_k
+    curve_normal: ClassVar[bool] = True
 
     order: int = 0
 

@@ -85,8 +85,8 @@ def _load_share(solution: Solution, balance: ForceBalance) -> CheckWarning | Non
     """Order 0 with the facet multipliers where Gamma_C carries a small share of the load:
     the contact force is a small difference that magnifies the compliance error of PEERS_0
     with the tractions on every fine edge (module docstring, ``LOAD_SHARE_TOL``)."""
-    disc = solution.problem.scene.discretisation
-    if disc.order != 0 or disc.family != "facet":
+    spaces = solution.problem.spaces
+    if spaces.order != 0 or not spaces.contact.traces:
         return None
     if not np.any(in_contact(solution.part("lam_n"), solution.part("lam_t"))):
         return None

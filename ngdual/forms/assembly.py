@@ -50,7 +50,7 @@ def assemble(scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes | None = None
     names = list(spaces.components)
     fes = ngs.FESpace([spaces.components[n] for n in names])
     broken = broken_peers(spaces, scene.material.lame)
-    d, rhs = coupling_forms(scene, fes, names)
+    d, rhs = coupling_forms(scene, fes, names, spaces)
     for form in (d, rhs):
         if form is not None:
             form.Assemble()

@@ -36,7 +36,7 @@ def traction_coefficient(scene: Scene, mesh: ngs.Mesh) -> ngs.CoefficientFunctio
                             for label, both in pairs.items()}, default=ngs.CF((0.0, 0.0)))
 
 
-def coupling_forms(scene: Scene, fes: ngs.FESpace, names: list[str]):
+def coupling_forms(scene: Scene, fes: ngs.FESpace, names: list[str], spaces: Spaces):
     """The forms of (3.62) besides the PEERS block
     (:func:`~ngdual.forms.peers_block.broken_peers`): the couplings d_N, d_C with the
     boundary multipliers (None without Gamma_N and Gamma_C) and the right-hand side.
@@ -69,7 +69,7 @@ def coupling_forms(scene: Scene, fes: ngs.FESpace, names: list[str]):
     if "lam_n" in names:
         ds_c = ngs.ds(definedon=mesh.Boundaries(boundary_regex(scene.labels("contact"))),
                       intrules=TRACE_RULES)
-        if scene.discretisation.family == "facet" or scene.discretisation.order > 0:
+        if spaces.contact.curve_normal:
             # the normal and tangent of the boundary curve, not of its chords (curve_normal)
             n = curve_normal(scene, mesh)
             t = tangent(n)

@@ -133,13 +133,14 @@ class PressureEstimate:
         return {k: float(self.calibration[k] * np.sqrt(v.sum())) for k, v in self.terms.items()}
 
 
-def calibration(family: str, order: int, window: bool = False) -> dict[str, float]:
-    """The constant of every term of the goal at this multiplier ``family`` and ``order``,
-    with a ``window`` or on all of Gamma_C: CALIBRATION for all at order 0 with the hat
+def calibration(traces: bool, order: int, window: bool = False) -> dict[str, float]:
+    """The constant of every term of the goal at this ``order`` for multipliers that are
+    (``traces``: the facet multipliers, the normal traces of RT_k) or are not the traces of
+    sigma_h, with a ``window`` or on all of Gamma_C: CALIBRATION for all with the coarse
     multipliers; with the facet multipliers CALIBRATION_ORDER_K[k] for the edge terms (k = 1
     at order 0, k = 2 above 2) and CALIBRATION for the far field, but
     CALIBRATION_WINDOW_ORDER_K for a window's far field from order 1 on."""
-    if family != "facet":
+    if not traces:
         return dict.fromkeys(TERMS, CALIBRATION)
     edge = CALIBRATION_ORDER_K[min(max(order, 1), 2)]
     far = CALIBRATION_WINDOW_ORDER_K if window and order >= 1 else CALIBRATION
@@ -187,7 +188,7 @@ def goal_estimate(solution: Solution, estimated: Estimate,
     on_gamma_c = [edges.dof_of_edge[frozenset(map(int, p))] for p in gamma_c.vertices]
     element = edges.element[on_gamma_c]
 
-    if spaces.family == "facet":
+    if spaces.contact.traces:
         # the facet multipliers of order k are the traces of RT_k: p_h = -sigma_n^h
         pressure = _pressure(solution)
         p_mean, residual, p_squared = _trace_pressure(pressure, solution, edges, on_gamma_c)
@@ -217,7 +218,7 @@ def goal_estimate(solution: Solution, estimated: Estimate,
                                            spaces.end_hats["lam_n"])
     starts = _edge_starts(gamma_c)
     lam_mean = 0.5 * (lam_n[starts] + lam_n[starts + 1])
-    if spaces.family == "facet":   # lambda_n is P_k on every edge at order k: its own mean,
+    if spaces.contact.traces:   # lambda_n is P_k on every edge at order k: its own mean,
         # >= 0 as its Bernstein coefficients are (up to the solver's round-off)
         lam_mean = np.maximum(
             gamma_c.hat_means(spaces.prolongations["lam_n"]) @ solution.x[pb.lam_n], 0.0)
@@ -244,7 +245,8 @@ def goal_estimate(solution: Solution, estimated: Estimate,
     else:
         terms["far"] = eta_sigma * _dipole_weight(estimated.h, distance, h_near, spaces.order)
     return PressureEstimate(terms, size, float(np.sqrt(np.sum(p_squared))),
-                            calibration(spaces.family, spaces.order, window is not None))
+                            calibration(spaces.contact.traces, spaces.order,
+                                        window is not None))
 
 
 def _dipole_weight(h_t: np.ndarray, distance: np.ndarray, h_near: np.ndarray,

@@ -39,6 +39,7 @@ from ..scene import Scene, SceneError, SceneTypeError, check_level, ensure_valid
 from ..scene.values import show
 from ..solution import ConvergenceError, PhysicsWarning, Solution
 from .active_set import active_set_solve
+from .hybrid import HybridSystem
 from .hybrid_order import hybrid_active_set
 from .linear import solve_linear
 from .nested import nested_uzawa
@@ -222,8 +223,7 @@ def solve_problem(problem: DiscreteProblem, settings: Settings | None = None,
     if start is not None and not isinstance(settings, ActiveSetSettings):
         raise ValueError(f"a warm start is for the active-set method, not "
                          f"{type(settings).__name__}")
-    if isinstance(settings, ActiveSetSettings) and (problem.spaces.family == "facet"
-                                                    or problem.spaces.order > 0):
+    if isinstance(settings, ActiveSetSettings) and not HybridSystem.takes(problem.spaces):
         solution = hybrid_active_set(problem, settings, start=start)
     elif isinstance(settings, ActiveSetSettings):
         solution = active_set_solve(problem, settings, progress=progress, start=start)

@@ -165,6 +165,15 @@ class HybridSystem:
         Lamé's constants and the labels of Gamma_D, Gamma_N, Gamma_C.
     """
 
+    @staticmethod
+    def takes(spaces) -> bool:
+        """Whether this hybridisation solves a problem on ``spaces``: PEERS_0 with boundary
+        multipliers that pair with the chords' normals (the thesis' P1 hats on h~, whose
+        edge means reproduce d_C exactly against the constant RT_0 traces). Every other
+        space is hybridised by :class:`~ngdual.solvers.hybrid_order.OrderHybridSystem`."""
+        meshes = [m for m in (spaces.neumann, spaces.contact) if m is not None]
+        return spaces.order == 0 and not any(m.curve_normal for m in meshes)
+
     def __init__(self, problem: DiscreteProblem, model: Model):
         start = time.perf_counter()
         self.problem = problem

@@ -147,7 +147,7 @@ def solve_qp_friction(problem: DiscreteProblem, model: Model, tol: float = 1e-10
     if law not in ("tresca", "coulomb"):
         raise ValueError(f"the friction QP solves Tresca or Coulomb friction, not law {law!r}")
     forms = build_friction_forms(problem)
-    facet = problem.spaces.family == "facet"
+    facet = problem.spaces.contact.traces
     # the facet multipliers bound every Bernstein moment (ngdual.friction.MomentFriction)
     friction_law = MomentFriction() if facet else forms
 
