@@ -43,10 +43,10 @@ def contact_set(solution) -> list[tuple[float, float]]:
     largest): there the P_k function lambda_n^h is zero.
     """
     problem = solution.problem
-    disc = problem.scene.discretisation
-    if disc.family == "coarse":
+    spaces = problem.spaces
+    if not spaces.contact.traces:
         return discrete_sets(solution)["contact"]
-    lam = solution.part("lam_n").reshape(-1, disc.order + 1)
+    lam = solution.part("lam_n").reshape(-1, spaces.order + 1)
     touching = np.all(np.abs(lam) <= 1e-9 * np.abs(lam).max(initial=0.0), axis=1)
     gamma_c = problem.spaces.gamma_c
     mid, half = gamma_c.midpoints[touching, 0], 0.5 * gamma_c.lengths[touching]
@@ -63,7 +63,7 @@ def pressure_error(case, solution) -> float:
     n = ngs.specialcf.normal(2)
     sigma = fields(solution).sigma
     error = ngs.InnerProduct(sigma * n, n) - Expression(exact.text()).coefficient()
-    degree = 2 * max(solution.problem.scene.discretisation.order, exact.degree) + 2
+    degree = 2 * max(solution.problem.spaces.order, exact.degree) + 2
     region = mesh.Boundaries("|".join(solution.problem.scene.labels("contact")))
     return math.sqrt(max(ngs.Integrate(error * error, mesh, ngs.BND, order=degree,
                                        definedon=region), 0.0))
