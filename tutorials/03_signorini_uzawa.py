@@ -130,7 +130,8 @@ print(f"dofs (Table 3.1): {problem.spaces.dofs()}; A {A.shape}, B {B.shape}, C_n
 # Algorithm 3.38 starts from $\lambda_n^0 = 0$. Step 3 then solves the saddle-point system
 # without contact forces: the body falls through the foundation.
 # `nd.solvers.linear.solve_linear` does exactly this solve. The vector $C_n^\top\sigma^1$
-# tests $\sigma_n$ with the coarse hat functions; positive entries are where the contact condition is violated.
+# tests $\sigma_n$ with the coarse hat functions; positive entries are where the contact
+# condition is violated.
 
 # %%
 first = nd.solvers.linear.solve_linear(problem)
