@@ -135,7 +135,7 @@ def run(ctx):
         ax_c.set_xlabel(plot.unit_label(r"$x_1$ on $\Gamma_C$", scene.units.length))
         ax_c.set_ylabel(plot.unit_label("traction", scene.units.stress))
         ax_c.grid(alpha=0.3)
-        ax_c.legend(loc="upper right", fontsize=8)
+        ax_c.legend(loc="upper right", fontsize="small")
         ax_c.set_title(f"P = {P:.4g}" + (f", Q = {Q:.4g}" if abs(Q) > 1e-9 * abs(P) else ""))
         fig.suptitle(f"{name}: stress near the contact zone and tractions on $\\Gamma_C$")
         files += plot.save_figure(fig, ctx.figure_stem(f"contact_scenes_{name}"))

@@ -439,32 +439,123 @@ def curve_style(method: str) -> dict:
     return {"color": ORDER_COLOURS[order], "ls": ls, "marker": marker, "ms": 4, **hollow}
 
 
-def _panels(rows: list[dict], references: dict) -> list[dict]:
-    """One row per problem: pressure and sigma against wall time and against unknowns."""
+# the figures' file names per measure (work_precision_pressure.png, ..._sigma.png)
+SHORT = {"pressure": "pressure", "sigma_energy": "sigma"}
+ERROR_AXIS = {"pressure": "rel. $L^2$ error on $\\Gamma_C$ [-]",
+              "sigma_energy": "rel. error, compliance norm [-]"}
+WHAT_SHORT = {"pressure": "contact pressure", "sigma_energy": "stress $\\sigma$"}
+
+
+def _panels(rows: list[dict], references: dict, measure: str, xkey: str) -> list[dict]:
+    """One panel per problem: the true error ``measure`` of every solution against wall time
+    (``xkey`` "time_s") or unknowns ("ndof"), one curve per method, the targets as thin
+    lines and the reference's own error."""
     methods = list(dict.fromkeys(r["method"] for r in rows))
     style = {m: curve_style(m) for m in methods}
+    xlabel = "wall time [s]" if xkey == "time_s" else "unknowns [-]"
     panels = []
     for problem, tp in TRUTH_PROBLEMS.items():
-        for measure, ylabel in MEASURES.items():
-            floor = references[problem][measure]["overkill_error"]
-            for xkey, xlabel in (("time_s", "wall time [s]"), ("ndof", "unknowns [-]")):
-                curves = []
-                for m in methods:
-                    # in refinement order: the measured times carry noise
-                    pts = sorted((r for r in rows if r["problem"] == problem
-                                  and r["method"] == m and r.get(measure)),
-                                 key=lambda r: r["ndof"])
-                    if pts:
-                        curves.append({"x": [r[xkey] for r in pts],
-                                       "y": [r[measure] for r in pts], "label": m, **style[m]})
-                panels.append({
-                    "title": f"{tp.title}: {measure.replace('_', ' ')} vs "
-                             + ("time" if xkey == "time_s" else "unknowns"),
-                    "xlabel": xlabel, "ylabel": ylabel, "loglog": True, "curves": curves,
-                    "hlines": [(t, None, {"color": "0.7", "lw": 0.6}) for t in TARGETS]
-                    + ([(floor, "reference's own error",
-                         {"color": "k", "ls": "-.", "lw": 0.8})] if floor else [])})
+        floor = references[problem][measure]["overkill_error"]
+        curves = []
+        for m in methods:
+            # in refinement order: the measured times carry noise
+            pts = sorted((r for r in rows if r["problem"] == problem and r["method"] == m
+                          and r.get(measure)), key=lambda r: r["ndof"])
+            if pts:
+                curves.append({"x": [r[xkey] for r in pts], "y": [r[measure] for r in pts],
+                               "label": m, **style[m]})
+        panels.append({
+            "title": tp.title, "xlabel": xlabel, "ylabel": MEASURES[measure], "loglog": True,
+            "curves": curves,
+            "hlines": [(t, None, {"color": "0.7", "lw": 0.8}) for t in TARGETS]
+            + ([(floor, "reference's own error", {"color": "k", "ls": "-.", "lw": 1.0})]
+               if floor else [])})
     return panels
+
+
+def frontier_panels(table: list[dict], measure: str) -> list[dict]:
+    """One panel per problem: per method the least wall time to reach each target of
+    ``measure`` (the rows of ``work_precision_table.csv``), the targets on the error axis;
+    a target the reference does not resolve is named in the panel."""
+    methods = list(dict.fromkeys(r["method"] for r in table))
+    panels = []
+    for problem, tp in TRUTH_PROBLEMS.items():
+        mine = [r for r in table if (r["problem"], r["measure"]) == (problem, measure)]
+        curves = []
+        for m in methods:
+            hits = sorted((r for r in mine if r["method"] == m and r["time_s"] is not None),
+                          key=lambda r: -r["target"])
+            if hits:
+                curves.append({"x": [r["time_s"] for r in hits],
+                               "y": [r["target"] for r in hits], "label": m, **curve_style(m)})
+        unresolved = sorted({r["target"] for r in mine if not r["resolved"]})
+        panels.append({
+            "title": tp.title, "xlabel": "wall time [s]",
+            "ylabel": ERROR_AXIS[measure], "loglog": True, "curves": curves,
+            "ylim": (min(TARGETS) / 1.4, max(TARGETS) * 1.4),
+            **({"note": "reference does not resolve "
+                        + ", ".join(f"{t:.0%}" for t in unresolved)} if unresolved else {})})
+    return panels
+
+
+def measure_figures(panels: list[dict], title: str, percent: bool = False):
+    """Six problem panels (2 x 3) with one legend beside them (a 16:9 slide); ``percent``:
+    the error axis labelled at the targets in %."""
+    from matplotlib.ticker import FixedLocator, FuncFormatter, NullFormatter
+
+    fig = plot.plot_curves(panels, title, ncols=3, panel_size=(3.4, 3.2), figure_legend=True,
+                           legend_loc="outside right center")
+    for ax in fig.axes:
+        # plain numbers on the log axes; within a decade also at 2 and 5
+        low, high = ax.get_xlim()
+        ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.xaxis.set_minor_formatter(FuncFormatter(lambda v, _: f"{v:g}")
+                                     if high / low < 10 else NullFormatter())
+        if high / low < 10:
+            ax.xaxis.set_minor_locator(FixedLocator(
+                [m * 10.0 ** e for e in range(-4, 6) for m in (2, 5)]))
+        if percent:
+            ax.yaxis.set_major_locator(FixedLocator(TARGETS))
+            ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{100 * v:g} %"))
+            ax.yaxis.set_minor_formatter(NullFormatter())
+    return fig
+
+
+def plot_frontiers(table: list[dict], stem) -> list:
+    """``<stem>_pressure`` and ``<stem>_sigma``: the time to each target, one figure per
+    measure (:func:`frontier_panels`)."""
+    files = []
+    for measure, short in SHORT.items():
+        fig = measure_figures(frontier_panels(table, measure),
+                              f"What accuracy costs: least wall time to reach 5, 2, 1 % error "
+                              f"in the {WHAT_SHORT[measure]}", percent=True)
+        files += plot.save_figure(fig, f"{stem}_{short}")
+    return files
+
+
+def read_table(path) -> list[dict]:
+    """``work_precision_table.csv`` (a run's, or the gallery's copy) as :func:`accuracy_table`
+    rows: numbers as numbers, an empty time as None."""
+    import csv
+    from pathlib import Path
+
+    lines = [line for line in Path(path).read_text().splitlines() if not line.startswith("#")]
+    rows = []
+    for r in csv.DictReader(lines):
+        rows.append({**r, "target": float(r["target"]), "order": int(r["order"]),
+                     "time_s": float(r["time_s"]) if r["time_s"] else None,
+                     "ndof": int(r["ndof"]) if r["ndof"] else None,
+                     "resolved": r["resolved"] == "True", "failed": r["failed"] or None})
+    return rows
+
+
+def replot(table_csv, out) -> list:
+    """The time-to-accuracy figures again from a saved ``work_precision_table.csv`` (the
+    study takes 45 minutes; its table is enough for them), into ``out/figures``."""
+    from pathlib import Path
+
+    with plot.slides():
+        return plot_frontiers(read_table(table_csv), Path(out) / "figures" / "work_precision")
 
 
 def _numbers(verdict: list[dict], effectivity: list[dict], budget: list[dict]) -> dict:
@@ -555,14 +646,15 @@ def run(ctx):
                                  "least wall time to 5 %, 2 %, 1 % per order, the README's "
                                  "tables (u = uniform, s / p = adaptive with the stress / "
                                  "pressure goal, c = the coarse multipliers)")
-    # PLOT: one row per problem, pressure and sigma against time and unknowns
-    fig = plot.plot_curves(_panels(rows, references),
-                           "What accuracy costs: true errors against adaptive references; "
-                           "ngdual uniform and adaptive (stress / pressure goal) at order "
-                           "k = 0 (blue), 1 (orange), 2 (green), primal P1/P2 Nitsche peer",
-                           ncols=4, panel_size=(4.4, 3.2),
-                           figure_legend=True)
-    figs = plot.save_figure(fig, ctx.figure_stem("work_precision"))
+    # PLOT: per measure, the time to each target (the gallery's), and every solution's error
+    # against wall time and against unknowns; six problem panels each
+    figs = plot_frontiers(table, ctx.figure_stem("work_precision"))
+    for measure, short in SHORT.items():
+        for xkey, stem, against in (("time_s", "work_precision_curves", "wall time"),
+                                    ("ndof", "work_precision_unknowns", "unknowns")):
+            fig = measure_figures(_panels(rows, references, measure, xkey),
+                                  f"True error in the {WHAT_SHORT[measure]} against {against}")
+            figs += plot.save_figure(fig, ctx.figure_stem(f"{stem}_{short}"))
     ctx.entry(THESIS, "Work-precision: true errors against wall time and unknowns",
               [*figs, data, least, verdicts_csv, js, summary],
               _numbers(verdict, effectivity, budget),
@@ -585,4 +677,11 @@ def run(ctx):
 
 
 if __name__ == "__main__":
-    script_main(__file__)
+    import sys
+
+    if "--from-table" in sys.argv:  # python figures/work_precision.py --from-table CSV OUT
+        i = sys.argv.index("--from-table")
+        for path in replot(sys.argv[i + 1], sys.argv[i + 2]):
+            print(path)
+    else:
+        script_main(__file__)

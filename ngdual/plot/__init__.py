@@ -11,8 +11,9 @@ One module per kind of picture: :mod:`.fields` (element fields, von Mises), :mod
 (the deformed body), :mod:`.meshes`
 (the triangulation, the boundary parts, the domain of Example 3.46), :mod:`.traces` (the
 traces on Gamma_C), :mod:`.curves` (line plots and iteration-count grids), :mod:`.scales`
-(axis labels in the scene's units, clipped colour scales) and :mod:`.save` (files and the
-JSON sidecar).
+(axis labels in the scene's units, clipped colour scales), :mod:`.slides` (the slide
+geometry: 16:9, 1600 x 900 px, fonts sized for it) and :mod:`.save` (files and the JSON
+sidecar).
 
 Axis labels carry the units the scene declares in its ``[units]`` table
 (:class:`ngdual.scene.Units`, passed as ``units``); where it declares none a label names
@@ -32,6 +33,7 @@ from .fields import plot_element_field, plot_field_pair, plot_von_mises
 from .meshes import plot_domain, plot_geometry, plot_mesh
 from .save import figure_texts, save_figure
 from .scales import CORNER_CLIP, clipped_scale, unit_label
+from .slides import SLIDE_PIXELS, fit_slide, in_slides, slides
 from .traces import TRACE_CLIP, corner_note, plot_contact_traces, trace_range
 
 # in the order of the API page: the pictures of a solution, saving, the thesis' figures, the
@@ -40,4 +42,5 @@ __all__ = ["plot_geometry", "plot_mesh", "plot_element_field", "plot_von_mises",
            "plot_contact_traces", "plot_deformed", "plot_convergence", "save_figure",
            "figure_texts", "plot_field_pair", "plot_curves", "magnification",
            "plot_heatmaps", "plot_domain", "unit_label", "clipped_scale", "trace_range",
-           "corner_note", "CORNER_CLIP", "TRACE_CLIP"]
+           "corner_note", "CORNER_CLIP", "TRACE_CLIP", "slides", "in_slides", "fit_slide",
+           "SLIDE_PIXELS"]

@@ -11,13 +11,15 @@ from matplotlib.figure import Figure
 
 def plot_curves(panels: list[dict], suptitle: str, ncols: int = 2,
                 panel_size: tuple[float, float] = (5.6, 3.4),
-                figure_legend: bool = False) -> Figure:
+                figure_legend: bool = False, legend_loc: str = "outside lower center",
+                legend_ncol: int | None = None) -> Figure:
     """Line plots, one panel per dict: ``title``, ``xlabel``, ``ylabel``, ``curves`` (dicts of
     ``x``, ``y``, ``label`` and matplotlib style keywords), optional ``loglog``, ``hlines``
     (``(y, label, style)``), ``note`` (text in the corner), ``xlim``, ``ylim``.
 
-    ``figure_legend``: one legend below all panels (the labels of all panels, once each)
-    instead of one per panel."""
+    ``figure_legend``: one legend for all panels (the labels of all panels, once each)
+    instead of one per panel, at ``legend_loc`` (below them; ``"outside right upper"``
+    beside them) in ``legend_ncol`` columns (default: 3 below, 1 beside)."""
     n = len(panels)
     ncols = min(ncols, n)
     nrows = int(np.ceil(n / ncols))
@@ -39,7 +41,7 @@ def plot_curves(panels: list[dict], suptitle: str, ncols: int = 2,
         if panel.get("ylim"):
             ax.set_ylim(*panel["ylim"])
         if panel.get("note"):
-            ax.text(0.02, 0.03, panel["note"], transform=ax.transAxes, fontsize=8,
+            ax.text(0.02, 0.03, panel["note"], transform=ax.transAxes, fontsize="small",
                     va="bottom", ha="left", bbox={"fc": "white", "alpha": 0.8, "lw": 0})
         ax.set_title(panel["title"])
         ax.set_xlabel(panel["xlabel"])
@@ -47,7 +49,7 @@ def plot_curves(panels: list[dict], suptitle: str, ncols: int = 2,
         ax.grid(alpha=0.3, which="both" if panel.get("loglog") else "major")
         labelled = any(not line.get_label().startswith("_") for line in ax.get_lines())
         if labelled and not figure_legend:
-            ax.legend(loc=panel.get("legend_loc", "best"), fontsize=8)
+            ax.legend(loc=panel.get("legend_loc", "best"), fontsize="small")
     for ax in axes.ravel()[n:]:
         ax.remove()
     if figure_legend:
@@ -55,8 +57,9 @@ def plot_curves(panels: list[dict], suptitle: str, ncols: int = 2,
         for ax in axes.ravel()[:n]:
             for handle, label in zip(*ax.get_legend_handles_labels()):
                 handles.setdefault(label, handle)
-        fig.legend(handles.values(), handles.keys(), loc="outside lower center",
-                   ncol=min(3, len(handles)), fontsize=8)
+        ncol = legend_ncol or (1 if "right" in legend_loc or "left" in legend_loc else 3)
+        fig.legend(handles.values(), handles.keys(), loc=legend_loc,
+                   ncol=min(ncol, len(handles)), fontsize="small")
     fig.suptitle(suptitle)
     return fig
 
@@ -76,7 +79,7 @@ def plot_heatmaps(x: np.ndarray, y: np.ndarray, grids: list[np.ndarray], titles:
             for j in range(len(y)):
                 v = grid[i][j]
                 ax.text(i + 0.5, j + 0.5, "x" if not np.isfinite(v) else f"{v:.0f}",
-                        ha="center", va="center", fontsize=7)
+                        ha="center", va="center", fontsize="x-small")
         ax.set_xticks(np.arange(len(x)) + 0.5, [f"{v:g}" for v in x])
         ax.set_yticks(np.arange(len(y)) + 0.5, [f"{v:g}" for v in y])
         ax.set_xlabel(xlabel)

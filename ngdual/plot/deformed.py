@@ -94,7 +94,7 @@ def plot_deformed(solution, scale: float | None = None, title: str | None = None
         ax.axline(point, point + np.array([normal[1], -normal[0]]), color="k", ls="--", lw=1.0,
                   label="rigid foundation (not magnified: the magnified body crosses it)")
     ax.plot([], [], color="0.6", lw=0.8, label="undeformed")
-    ax.legend(loc="upper right", fontsize=8)
+    ax.legend(loc="upper right", fontsize="small")
     colorbar(fig, art, ax, unit_label(r"displacement $|u_h|$", length_unit(scene.units)),
              "neither", "", is_wide(points))
     coordinates(ax, scene.units)

@@ -40,7 +40,7 @@ def plot_mesh(points: np.ndarray, triangles: np.ndarray, title: str = "",
     coordinates(ax, units)
     ax.set_title(title or f"{len(triangles)} triangles")
     ax.legend(handles=[*ax.get_legend_handles_labels()[0][:1], *handles], loc="upper center",
-              bbox_to_anchor=(0.5, -0.25 if aspect < 0.5 else -0.12), ncol=2, fontsize=8)
+              bbox_to_anchor=(0.5, -0.25 if aspect < 0.5 else -0.12), ncol=2, fontsize="small")
     return fig
 
 
@@ -81,11 +81,12 @@ def plot_geometry(scene, mesh=None, level: int | None = None, title: str = "") -
             inward = 22 * (centre - middle) / (np.linalg.norm(centre - middle) or 1.0)
             ax.annotate(f"{symbol} ({label})", middle, xytext=tuple(inward),
                         textcoords="offset points", color=colour, ha="center", va="center",
-                        fontsize=9, bbox={"fc": "white", "ec": "none", "alpha": 0.85, "pad": 1})
+                        fontsize="small",
+                        bbox={"fc": "white", "ec": "none", "alpha": 0.85, "pad": 1})
     coordinates(ax, scene.units)
     ax.margins(0.1)
     ax.set_title(title or f"{scene.name}: boundary parts and mesh ({mesh.ne} triangles)")
-    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=3, fontsize=9,
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=3, fontsize="small",
               frameon=False)
     fig.tight_layout()
     return fig
@@ -116,13 +117,13 @@ def plot_domain(points: np.ndarray, triangles: np.ndarray, x: np.ndarray, load: 
     coordinates(ax, units)
     ax.set_ylim(-3.3, 1.9)
     ax.set_title(r"$\Omega = [-4, 4] \times [-1, 1]$, level-1 mesh")
-    ax.legend(loc="upper center", ncol=3, fontsize=8)
+    ax.legend(loc="upper center", ncol=3, fontsize="small")
     for gx, gy, label, style in gaps:
         ag.plot(gx, gy, label=label, **style)
     ag.set_xlabel(unit_label(r"$x_1$ on $\Gamma_C$", length_unit(units)))
     ag.set_ylabel(unit_label(r"gap $g(x_1)$", length_unit(units)))
     ag.set_title("Gap functions of the shipped scenes")
     ag.grid(alpha=0.3)
-    ag.legend(fontsize=8)
+    ag.legend(fontsize="small")
     fig.suptitle(suptitle)
     return fig

@@ -1,5 +1,6 @@
 """Saving a figure: one file for a path with a suffix, or PNG and PDF with a JSON sidecar of
-what the figure says (titles, labels, legends, colour bars) for a stem without one."""
+what the figure says (titles, labels, legends, colour bars) for a stem without one; inside
+:func:`~ngdual.plot.slides` at the slide geometry (16:9, 1600 x 900 px)."""
 
 from __future__ import annotations
 
@@ -8,6 +9,8 @@ from pathlib import Path
 
 import matplotlib.pyplot as plt
 from matplotlib.figure import Figure
+
+from .slides import SLIDE_DPI, fit_slide, in_slides
 
 SIDECAR_FORMATS = (".png", ".pdf")  # what a stem without suffix becomes, with its .json
 
@@ -33,14 +36,23 @@ def figure_texts(fig: Figure) -> dict:
     return {"suptitle": suptitle, "axes": axes, "figure_legend": legends}
 
 
-def save_figure(fig: Figure, target: str | Path, dpi: int = 130) -> list[Path]:
+def save_figure(fig: Figure, target: str | Path, dpi: int = 130,
+                slide: bool | None = None) -> list[Path]:
     """Write ``fig`` atomically and close it; returns the files written.
 
     ``target`` with a suffix (``out/von_mises.png``) is that one file; a stem without
     suffix (``figures/fig_3_11``) becomes ``stem.png``, ``stem.pdf`` and ``stem.json``
     (:func:`figure_texts`: what the figure says, for tests and indexes).
+
+    ``slide`` (default: inside :func:`~ngdual.plot.slides`): the figure laid out again at
+    16:9 and written at exactly 1600 x 900 px (:func:`~ngdual.plot.slides.fit_slide`; ``dpi``
+    is then the slide's); otherwise at ``dpi``, cropped to what the figure shows.
     """
     target = Path(target)
+    if slide is None:
+        slide = in_slides()
+    if slide:
+        fit_slide(fig)
     target.parent.mkdir(parents=True, exist_ok=True)
     texts = figure_texts(fig) if not target.suffix else None
     written = []
@@ -48,7 +60,10 @@ def save_figure(fig: Figure, target: str | Path, dpi: int = 130) -> list[Path]:
         for path in [target] if target.suffix else [target.with_suffix(s)
                                                     for s in SIDECAR_FORMATS]:
             tmp = path.with_name(path.stem + ".part" + path.suffix)
-            fig.savefig(tmp, dpi=dpi, bbox_inches="tight")
+            if slide:
+                fig.savefig(tmp, dpi=SLIDE_DPI)
+            else:
+                fig.savefig(tmp, dpi=dpi, bbox_inches="tight")
             tmp.replace(path)
             written.append(path)
     finally:

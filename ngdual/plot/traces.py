@@ -69,7 +69,7 @@ def trace_range(main: np.ndarray, secondary: list[tuple[np.ndarray, str]],
 def corner_note(ax, lines: list[str]) -> None:
     """``lines`` in a white box in the lower left corner of ``ax`` (what is off scale)."""
     if lines:
-        ax.text(0.02, 0.03, "\n".join(lines), transform=ax.transAxes, fontsize=7,
+        ax.text(0.02, 0.03, "\n".join(lines), transform=ax.transAxes, fontsize="x-small",
                 va="bottom", ha="left", bbox={"fc": "white", "alpha": 0.8, "lw": 0})
 
 
@@ -230,7 +230,7 @@ def plot_contact_traces(traces, title: str = "", units=None, clip: float | None 
         ax.set_ylim(lo, hi)
         corner_note(ax, own + notes)
         ax.set_ylabel(ylabel)
-        ax.set_title(name, fontsize=10)
+        ax.set_title(name, fontsize="medium")
         ax.set_xlabel(unit_label(r"$x_1$ on $\Gamma_C$", length))
     x_node = traces.node_xy[:, 0]
     fine_order = np.argsort(x_node, kind="stable")
@@ -246,15 +246,15 @@ def plot_contact_traces(traces, title: str = "", units=None, clip: float | None 
                             (axes[1, 1], rf"$\lambda_t^{{{mesh}}} = -u_t$",
                              "Tangential multiplier")):
         ax.set_ylabel(unit_label(label, length))
-        ax.set_title(name, fontsize=10)
+        ax.set_title(name, fontsize="medium")
         ax.set_xlabel(unit_label(r"$x_1$ on $\Gamma_C$", length))
-    axes[0, 0].legend(loc="best", fontsize=7)
-    axes[0, 1].legend(loc="best", fontsize=7)
+    axes[0, 0].legend(loc="best", fontsize="x-small")
+    axes[0, 1].legend(loc="best", fontsize="x-small")
     handles = [plt.Rectangle((0, 0), 1, 1, color=ZONE_COLOURS[k][0], alpha=0.25)
                for k in ("contact", "stick", "slip") if k in shown]
     names = [f"{k} zone" for k in ("contact", "stick", "slip") if k in shown]
     line = axes[1, 0].get_legend_handles_labels()
-    axes[1, 0].legend([*line[0], *handles], [*line[1], *names], loc="best", fontsize=7)
+    axes[1, 0].legend([*line[0], *handles], [*line[1], *names], loc="best", fontsize="x-small")
     fig.suptitle(title or r"Traces on the contact boundary $\Gamma_C$")
     fig.tight_layout()
     return fig

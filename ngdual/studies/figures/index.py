@@ -1,4 +1,4 @@
-"""The index of a run (``DIR/index.md``), its markdown tables and the README gallery."""
+"""The index of a run (``DIR/index.md``), its markdown tables and the docs' gallery."""
 
 from __future__ import annotations
 
@@ -78,31 +78,44 @@ def write_index(out: Path, summary: dict, template: Path) -> Path:
 
 
 GALLERY = ("fig_3_11_von_mises", "fig_3_19_tangential_displacement", "fig_3_23_rho_grid",
-           "fig_4_13_", "work_precision",
+           "fig_4_13_", "work_precision_pressure", "work_precision_sigma",
            *(f"contact_scenes_{name}" for name in ("hertz-cylinder", "flat-punch",
                                                     "cattaneo-mindlin", "wedge")))
+GALLERY_SIZE = (1600, 900)  # the slide geometry of ngdual.plot.slides: 16:9
 
 
-def write_gallery(out: str | Path, dest: str | Path, width: int = 900,
+def write_gallery(out: str | Path, dest: str | Path, size: tuple[int, int] = GALLERY_SIZE,
                   names: tuple[str, ...] = GALLERY) -> list[Path]:
-    """Small copies (``width`` pixels, 8-bit palette) of the PNGs starting with ``names``,
-    for the README."""
-    from PIL import Image
-
+    """Copies of the PNGs of ``out/figures`` starting with ``names`` (8-bit palette) for the
+    docs' gallery, each ``size`` pixels (16:9, for slides): a slide-sized figure as it is,
+    any other scaled to fit and centred on white."""
     dest = Path(dest)
     dest.mkdir(parents=True, exist_ok=True)
     written = []
     for name in names:
         for path in sorted((Path(out) / "figures").glob(f"{name}*.png"))[:1]:
-            with Image.open(path) as img:
-                img = img.convert("RGB")
-                if img.width > width:
-                    img = img.resize((width, round(img.height * width / img.width)),
-                                     Image.LANCZOS)
-                target = dest / re.sub(r"_step\d+", "", path.name)  # stable for the README
-                img.quantize(colors=256, method=Image.FASTOCTREE).save(target, optimize=True)
-                written.append(target)
+            target = dest / re.sub(r"_step\d+", "", path.name)  # stable for the docs
+            written.append(gallery_copy(path, target, size))
     return written
+
+
+def gallery_copy(source: str | Path, target: str | Path,
+                 size: tuple[int, int] = GALLERY_SIZE) -> Path:
+    """``source`` as an 8-bit PNG of ``size`` pixels at ``target``: scaled to fit (never
+    above its own resolution unless it is smaller than ``size``) and centred on white."""
+    from PIL import Image
+
+    with Image.open(source) as img:
+        img = img.convert("RGB")
+        if img.size != tuple(size):
+            scale = min(size[0] / img.width, size[1] / img.height)
+            img = img.resize((round(img.width * scale), round(img.height * scale)),
+                             Image.LANCZOS)
+            canvas = Image.new("RGB", tuple(size), "white")
+            canvas.paste(img, ((size[0] - img.width) // 2, (size[1] - img.height) // 2))
+            img = canvas
+        img.quantize(colors=256, method=Image.FASTOCTREE).save(target, optimize=True)
+    return Path(target)
 
 
 def markdown_table(rows: list[dict], columns: dict[str, str], missing: str = "-") -> str:

@@ -9,7 +9,8 @@ from it). A run first computes all studies the selected scripts declare (``STUDI
 one dask sweep (:class:`~ngdual.studies.sweep.Runner`) whose records go to
 ``DIR/records`` -- re-running skips them -- then runs the scripts, which only read records
 through a :class:`~ngdual.studies.figures.output.Context`, and writes ``DIR/index.md``:
-every output next to its thesis counterpart, with our numbers.
+every output next to its thesis counterpart, with our numbers. The scripts run inside
+:func:`ngdual.plot.slides`: every picture is a 16:9 slide of 1600 x 900 px.
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from datetime import datetime
 from pathlib import Path
 
 from ...io import versions, write_json
+from ...plot.slides import slides
 from ...scene import SceneError
 from ..sources import scripts_folder
 from ..sweep import Runner, Task
@@ -108,7 +110,8 @@ def run_figures(max_level: int | None = None, out: str | Path = "figures-output"
             ctx.script = stem
             t0 = time.perf_counter()
             try:
-                module.run(ctx)
+                with slides():  # every picture a 16:9 slide, 1600 x 900 px
+                    module.run(ctx)
                 status = "ok"
             except Exception as err:  # noqa: BLE001 - one broken figure must not stop the rest
                 import traceback
