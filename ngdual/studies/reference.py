@@ -274,7 +274,8 @@ def _usage(title: str, p: argparse.ArgumentParser) -> str:
     words = [title]
     for action in _shown(p._actions):
         if isinstance(action, argparse._SubParsersAction):
-            words.append(_metavar(action) + " ...")
+            word = _metavar(action) + " ..."
+            words.append(word if action.required else f"[{word}]")
             continue
         if not action.option_strings:
             words.append(_metavar(action))
