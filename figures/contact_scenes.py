@@ -81,7 +81,8 @@ def run(ctx):
             row["exact_half_width"] = half_width(exact)
         rows.append(row)
         # PLOT
-        fig, (ax_f, ax_c) = plt.subplots(1, 2, figsize=(12.5, 3.6), constrained_layout=True)
+        fig, (ax_f, ax_c) = plt.subplots(1, 2, figsize=(12.8, 7.2), width_ratios=[1.2, 1],
+                                         constrained_layout=True)
         pts, tri = arrays["points"], arrays["triangles"]
         centroids = pts[tri].mean(axis=1)
         inside = ((centroids[:, 0] >= box[0]) & (centroids[:, 0] <= box[1])
@@ -90,15 +91,15 @@ def run(ctx):
         art = ax_f.tripcolor(mtri.Triangulation(pts[:, 0], pts[:, 1], tri),
                              facecolors=arrays["von_mises"], cmap="viridis", vmin=0, vmax=vmax,
                              edgecolors="none", rasterized=True)
-        fig.colorbar(art, ax=ax_f, extend="max",
-                     label=plot.unit_label(r"$\sigma_0$", scene.units.stress)
+        fig.colorbar(art, ax=ax_f, extend="max", location="bottom", shrink=0.9, aspect=30,
+                     label=plot.unit_label(r"von Mises stress $\sigma_0$", scene.units.stress)
                      + f", clipped at its {CLIP:g}th percentile")
         ax_f.set_xlim(box[0], box[1])
         ax_f.set_ylim(box[2], box[3])
         ax_f.set_aspect("equal")
         ax_f.set_xlabel(plot.unit_label(r"$x_1$", scene.units.length))
         ax_f.set_ylabel(plot.unit_label(r"$x_2$", scene.units.length))
-        ax_f.set_title(f"{name}: von Mises stress near $\\Gamma_C$ (level {level})")
+        ax_f.set_title(f"von Mises stress near $\\Gamma_C$ (level {level})")
         order = np.argsort(x)
         hat = np.argsort(arrays["hat_x"])
         ax_c.plot(x[order], p_h[order], drawstyle="steps-mid", lw=0.6, color="0.7",
@@ -133,10 +134,15 @@ def run(ctx):
         ax_c.set_ylim(low, high)
         plot.corner_note(ax_c, notes)
         ax_c.set_xlabel(plot.unit_label(r"$x_1$ on $\Gamma_C$", scene.units.length))
-        ax_c.set_ylabel(plot.unit_label("traction", scene.units.stress))
+        ax_c.set_ylabel(plot.unit_label("pressure $p$" + (", shear $q$" if hasattr(exact, "shear")
+                                                          else ""), scene.units.stress))
         ax_c.grid(alpha=0.3)
         ax_c.legend(loc="upper right", fontsize="small")
-        ax_c.set_title(f"P = {P:.4g}" + (f", Q = {Q:.4g}" if abs(Q) > 1e-9 * abs(P) else ""))
+        force = plot.unit_label("", scene.units.stress and scene.units.length
+                                and f"{scene.units.stress} {scene.units.length}").strip()
+        ax_c.set_title(f"tractions on $\\Gamma_C$: P = {P:.4g}"
+                       + (f", Q = {Q:.4g}" if abs(Q) > 1e-9 * abs(P) else "")
+                       + (f" {force}" if force else ""))
         fig.suptitle(f"{name}: stress near the contact zone and tractions on $\\Gamma_C$")
         files += plot.save_figure(fig, ctx.figure_stem(f"contact_scenes_{name}"))
         numbers[f"{name}: contact zone"] = [row["contact_from"], row["contact_to"]]

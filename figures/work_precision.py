@@ -522,15 +522,64 @@ def measure_figures(panels: list[dict], title: str, percent: bool = False):
 
 
 def plot_frontiers(table: list[dict], stem) -> list:
-    """``<stem>_pressure`` and ``<stem>_sigma``: the time to each target, one figure per
-    measure (:func:`frontier_panels`)."""
-    files = []
+    """``<stem>``: the summary (:func:`plot_summary`); ``<stem>_pressure`` and
+    ``<stem>_sigma``: the time to each target, one figure per measure
+    (:func:`frontier_panels`)."""
+    files = plot.save_figure(plot_summary(table), stem)
     for measure, short in SHORT.items():
         fig = measure_figures(frontier_panels(table, measure),
                               f"What accuracy costs: least wall time to reach 5, 2, 1 % error "
                               f"in the {WHAT_SHORT[measure]}", percent=True)
         files += plot.save_figure(fig, f"{stem}_{short}")
     return files
+
+
+SUMMARY_TARGET = 0.01
+SUMMARY_KINDS = {  # the summary's markers: which methods each takes the fastest of
+    "uniform, k = 0": (lambda r: r["method"] == UNIFORM, "C0", "o"),
+    "adaptive, k = 0": (lambda r: r["method"].startswith("adaptive") and r["order"] == 0,
+                        "C0", "D"),
+    "fastest ngdual, k ≥ 1": (lambda r: not is_peer(r["method"]) and r["order"] >= 1,
+                              "C2", "s"),
+    "primal P2": (lambda r: r["method"] == P2, "k", "^")}
+
+
+def plot_summary(table: list[dict]):
+    """The study on one slide: per measure and problem the least wall time to
+    :data:`SUMMARY_TARGET` of uniform and adaptive refinement at k = 0, the fastest ngdual
+    method of order k >= 1 and the primal P2 peer (no marker: not reached)."""
+    import matplotlib.pyplot as plt
+    import numpy as np
+    from matplotlib.ticker import FuncFormatter
+
+    fig, axes = plt.subplots(1, 2, figsize=(12.8, 7.2), sharey=True, constrained_layout=True)
+    names = list(TRUTH_PROBLEMS)
+    for ax, measure in zip(axes, MEASURES):
+        for i, (kind, (which, colour, marker)) in enumerate(SUMMARY_KINDS.items()):
+            xs, ys = [], []
+            for j, problem in enumerate(names):
+                hits = [r for r in table if (r["problem"], r["measure"], r["target"])
+                        == (problem, measure, SUMMARY_TARGET) and r["time_s"] is not None
+                        and which(r)]
+                if hits:
+                    xs.append(j + 0.16 * (i - 1.5))
+                    ys.append(min(r["time_s"] for r in hits))
+            ax.plot(xs, ys, ls="none", marker=marker, ms=10, color=colour,
+                    mfc="none" if kind.startswith("uniform") else colour, label=kind)
+        ax.set_yscale("log")
+        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.set_xticks(np.arange(len(names)),
+                      [TRUTH_PROBLEMS[n].title + (" (core)" if n == "flat-punch"
+                                                  and measure == "pressure" else "")
+                       for n in names], rotation=25, ha="right", rotation_mode="anchor")
+        ax.set_xlabel("problem")
+        ax.set_ylabel(f"least wall time to {SUMMARY_TARGET:.0%} error [s]".replace("%", " %"))
+        ax.set_title(f"error in the {WHAT_SHORT[measure]}")
+        ax.grid(alpha=0.3, which="both", axis="y")
+    fig.legend(*axes[0].get_legend_handles_labels(), loc="outside lower center", ncol=4)
+    fig.suptitle(f"What accuracy costs: least wall time to {SUMMARY_TARGET:.0%} true error "
+                 "(no marker: not reached)".replace("%", " %"))
+    return fig
 
 
 def read_table(path) -> list[dict]:

@@ -57,13 +57,18 @@ def plot_von_mises(mesh, sigma, nu: float, title: str, clip: float | None = CORN
 def plot_field_pair(points: np.ndarray, triangles: np.ndarray, values: list[np.ndarray],
                     titles: list[str], label: str, suptitle: str, clip: float | None = None,
                     units=None) -> Figure:
-    """Element fields on one mesh side by side with one colour bar (Figs. 3.11-3.14).
+    """Element fields on one mesh with one colour bar (Figs. 3.11-3.14): side by side, or one
+    above the other where that fills a 16:9 frame better (wide domains, :func:`stacked`).
 
     ``clip``: the colour scale ends at this percentile of all values (the colour bar is
     extended and says so), so that corner singularities do not wash out the rest.
     """
-    fig, axes = plt.subplots(1, len(values), figsize=(6.2 * len(values), 3.4),
-                             constrained_layout=True)
+    n = len(values)
+    if stacked(points, n):
+        fig, axes = plt.subplots(n, 1, figsize=(10.0, 2.8 * n + 1.2), sharex=True,
+                                 constrained_layout=True)
+    else:
+        fig, axes = plt.subplots(1, n, figsize=(6.2 * n, 3.4), constrained_layout=True)
     axes = np.atleast_1d(axes)
     tri = mtri.Triangulation(points[:, 0], points[:, 1], triangles)
     vmin, vmax, extend, note = clipped_scale(np.concatenate(values), clip)
@@ -75,3 +80,15 @@ def plot_field_pair(points: np.ndarray, triangles: np.ndarray, values: list[np.n
     colorbar(fig, art, list(axes), label, extend, note, is_wide(points))
     fig.suptitle(suptitle)
     return fig
+
+
+def stacked(points: np.ndarray, n: int) -> bool:
+    """Whether ``n`` panels of the domain of ``points`` fill a 16:9 frame better one above
+    the other than side by side (the aspect of the whole nearer 16:9, in ratio).
+
+    >>> wide = np.array([[0.0, 0.0], [8.0, 2.0]])
+    >>> stacked(wide, 2), stacked(wide[:, ::-1], 2)
+    (True, False)
+    """
+    aspect = float(np.ptp(points[:, 0])) / max(float(np.ptp(points[:, 1])), 1e-300)
+    return bool(abs(np.log(aspect / n / (16 / 9))) < abs(np.log(aspect * n / (16 / 9))))
