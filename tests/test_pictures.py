@@ -15,6 +15,7 @@ import os
 import subprocess
 import sys
 
+import matplotlib
 import matplotlib.pyplot as plt
 import numpy as np
 import pytest
@@ -101,6 +102,20 @@ def test_save_figure_writes_one_file_or_a_stem_with_its_sidecar_and_closes_the_f
     assert sidecar["axes"][0]["title"] == "a stem"
     assert all(p.stat().st_size > 0 for p in written)
     assert not list(tmp_path.rglob("*.part*"))
+
+
+def test_every_picture_drawn_for_slides_is_16_to_9_at_1600_px_with_legible_fonts(tmp_path):
+    """Inside ``plot.slides()`` each picture is laid out again at 16:9 and written at
+    1600 x 900 px (``ngdual figures`` and the gallery), no text under 9 pt (15 px)."""
+    with plot.slides():
+        figures = every_figure()
+        for name, fig in figures.items():
+            fig.canvas.draw()
+            sizes = {t.get_fontsize() for t in fig.findobj(matplotlib.text.Text)
+                     if t.get_text().strip()}
+            assert min(sizes) >= 9, (name, sorted(sizes))
+            [png] = plot.save_figure(fig, tmp_path / f"{name}.png")
+            assert plt.imread(png).shape[:2] == (900, 1600), name
 
 
 def test_importing_ngdual_plot_leaves_the_matplotlib_backend_alone():
