@@ -119,6 +119,13 @@ def api_reference_rst() -> list[str]:
         if name == "__version__":
             continue
         value = getattr(ngdual, name)
+        if inspect.ismodule(value):
+            # a public module: its docstring's first paragraph; its members are in the
+            # sections below, whose automodule is :no-index: so that the name is listed once
+            summary = inspect.cleandoc(value.__doc__ or "").split("\n\n")[0]
+            lines += [f".. py:data:: ngdual.{name}", "   :type: module", ""]
+            lines += ["   " + line for line in summary.splitlines()] + [""]
+            continue
         kind = "autoclass" if inspect.isclass(value) else "autofunction"
         lines += [f".. {kind}:: ngdual.{name}", ""]
     return lines
