@@ -9,6 +9,7 @@ read from the source; a module may import its own stage or earlier ones, never a
 """
 
 import ast
+import re
 from pathlib import Path
 
 import pytest
@@ -110,3 +111,27 @@ def test_no_solver_reads_the_scene():
     readers = [p.name for p in (PACKAGE / "solvers").glob("*.py")
                if p.name not in ("dispatch.py", "settings.py") and ".scene" in p.read_text()]
     assert not readers, readers
+
+
+# where the multiplier family is a name: the scene that states it, the module that builds the
+# spaces from it, the boundary meshes themselves and Gamma_C's gap interpolation per mesh
+FAMILY_READERS = ("scene/", "forms/spaces.py", "boundary/", "contact.py", "studies/",
+                  "peers.py")
+FAMILY_QUESTION = re.compile(r"family\s*[!=]=|isinstance\([^)]*(FacetMesh|CoarseOrderMesh|"
+                             r"CoarseMesh)\b")
+
+
+def test_no_module_asks_which_multiplier_family_it_runs_on():
+    """One method, configured (STYLE.md): the order and the multiplier family are read where
+    the spaces are built; the rest of the code asks the multiplier space what it is
+    (``traces``, ``curve_normal``), never which family it is."""
+    asking = []
+    for path in sorted(PACKAGE.rglob("*.py")):
+        rel = path.relative_to(PACKAGE).as_posix()
+        if rel.startswith(FAMILY_READERS):
+            continue
+        for number, line in enumerate(path.read_text().splitlines(), 1):
+            code = line.split("#")[0]
+            if FAMILY_QUESTION.search(code):
+                asking.append(f"{rel}:{number}: {line.strip()}")
+    assert not asking, asking

@@ -282,8 +282,8 @@ def solution_samples(solution) -> dict:
     of every fine edge, discontinuous from edge to edge; ``p_edges``: the fine edges of
     Gamma_C, (m, 2, 2), for the arc-length weights) when the scene has a contact
     boundary."""
-    from ..boundary.facet import FacetMesh
     from ..quantities import fields
+    from ..trace import contact_traces
     from .traction import traction_profile
 
     f = fields(solution)
@@ -295,9 +295,9 @@ def solution_samples(solution) -> dict:
         # an h~ node with a prescribed lambda (a clamped end of Gamma_C) has no contact
         # condition: its hat moment is the support's reaction, not a pressure; the scenes
         # measured here leave a gap open at their clamped ends, so the pressure there is 0
-        # (at order k the profile is the traces, which no multiplier prescribes)
+        # (where the profile is the traces, no multiplier prescribes them)
         coarse = pb.spaces.contact
-        if pb.spaces.order == 0 and not isinstance(coarse, FacetMesh):
+        if contact_traces(solution).trace_xy is None:   # the profile is the hat moments
             fixed = np.concatenate([
                 [int(q) not in {int(d) for d in coarse.dof_positions(c)}
                  for q in (coarse.nodes[c][:-1] if chain.closed else coarse.nodes[c])]
