@@ -384,7 +384,9 @@ def test_the_pressure_estimate_is_within_a_factor_3_of_the_true_pressure_error(
         true = pressure_errors(solution, exact, x0=center_coordinate(scene))[measure]
         effectivity.append(record["relative_estimate"] / true)
 
-    adapt(scene, steps=5, goal="pressure", theta=THETA_TOL, on_step=on_step, window=window)
+    # from level 3 (cattaneo-mindlin's default level is 5, which its teaching picture needs)
+    adapt(scene, steps=5, level=3, goal="pressure", theta=THETA_TOL, on_step=on_step,
+          window=window)
     print(f"{name}: effectivity {np.round(effectivity, 2).tolist()}")
     assert 0.3 <= min(effectivity) and max(effectivity) <= 3
 
