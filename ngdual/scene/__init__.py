@@ -46,6 +46,7 @@ from .domain import (
     role_of,
     validate_geometry,
 )
+from .errors import SceneError, SceneTypeError
 from .load import (
     apply_overrides,
     load_scene,
@@ -78,8 +79,6 @@ from .tables import (
     Loads,
     Material,
     Scene,
-    SceneError,
-    SceneTypeError,
     Solver,
     Units,
 )

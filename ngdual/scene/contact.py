@@ -10,7 +10,8 @@ import numpy as np
 from .. import geometry
 from ..expr import Expression
 from .domain import role_of
-from .tables import CONTACT_ENDS, Contact, Problems, Scene, SceneError
+from .errors import Problems, SceneError
+from .tables import CONTACT_ENDS, Contact, Scene
 from .values import finite, show
 
 KINK_ANGLE = 1e-6  # radians: two contact sides meeting at a larger angle form a kink

@@ -10,15 +10,8 @@ import numpy as np
 
 from .. import geometry
 from ..expr import Expression, quote
-from .tables import (
-    GEOMETRY_KINDS,
-    ROLES,
-    Geometry,
-    Problems,
-    Scene,
-    SceneError,
-    SceneTypeError,
-)
+from .errors import Problems, SceneError, SceneTypeError
+from .tables import GEOMETRY_KINDS, ROLES, Geometry, Scene
 from .values import field_type_problems, finite, positive, show
 
 LABEL = re.compile(r"[A-Za-z0-9_-]+")

@@ -12,7 +12,8 @@ try:
 except ModuleNotFoundError:  # Python < 3.11
     import tomli as tomllib
 
-from .tables import ROLES, SECTIONS, Problems, Scene, SceneError, SceneTypeError
+from .errors import Problems, SceneError, SceneTypeError
+from .tables import ROLES, SECTIONS, Scene
 from .validate import ensure_valid
 from .values import show
 

@@ -8,6 +8,7 @@ import numpy as np
 
 from .contact import validate_contact, validate_gap_and_bound
 from .domain import validate_boundary, validate_formulas_on_sides, validate_geometry
+from .errors import Problems, SceneError, SceneTypeError
 from .tables import (
     BENCHMARK_KINDS,
     CONTACT_ENDS,
@@ -26,10 +27,7 @@ from .tables import (
     Contact,
     Discretisation,
     Material,
-    Problems,
     Scene,
-    SceneError,
-    SceneTypeError,
     Solver,
     Units,
 )

@@ -7,7 +7,8 @@ import dataclasses
 import math
 
 from ..expr import Expression, ExpressionError
-from .tables import ROLES, SECTIONS, Problems, Scene, SceneError
+from .errors import Problems, SceneError
+from .tables import ROLES, SECTIONS, Scene
 
 
 def show(value, width: int = 60) -> str:
