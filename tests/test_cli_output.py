@@ -142,3 +142,24 @@ def test_a_reader_that_stops_early_is_not_reported_as_a_bug():
     err = proc.stderr.read().decode()
     assert proc.wait(timeout=60) == 141, err
     assert "internal error" not in err and "Traceback" not in err, err
+
+
+def test_the_adapt_help_states_the_loops_own_defaults():
+    """``ngdual adapt --help`` names the defaults ``nd.adapt`` takes (ngdual.loop_defaults:
+    theta 0.5, with --tol 0.9; 5 solves, with --tol at most 30; with --tol from level 1)."""
+    import re
+
+    from ngdual import loop_defaults as d
+    from ngdual.cli import parser
+
+    sub = next(a for a in parser()._actions if isinstance(a, argparse._SubParsersAction))
+    text = " ".join(sub.choices["adapt"].format_help().split())
+    assert re.search(rf"default {d.THETA:g}, the thesis'; with --tol {d.THETA_TOL:g}\b", text)
+    assert re.search(rf"default {d.STEPS}\); with --tol the largest number \(default "
+                     rf"{d.STEPS_TOL}\)", text)
+    assert re.search(rf"with --tol {d.LEVEL_TOL}\)", text)
+    # and the loop takes the same ones (a run records theta: tests/test_goal.py)
+    from ngdual.afem import loop_defaults
+
+    assert loop_defaults(None, None, None) == (d.THETA, d.STEPS, None)
+    assert loop_defaults(0.01, None, None) == (d.THETA_TOL, d.STEPS_TOL, d.LEVEL_TOL)

@@ -18,7 +18,8 @@ PACKAGE = Path(__file__).resolve().parents[1] / "ngdual"
 
 # (stage, module prefixes), in the order the data flows
 STAGES = [
-    ("foundation", ["expr", "extras", "geometry", "tolerances", "rates", "sparse"]),
+    ("foundation", ["expr", "extras", "geometry", "tolerances", "rates", "sparse",
+                    "loop_defaults"]),
     ("scene", ["scene", "scenes"]),
     ("mesh", ["mesh", "budget", "io"]),
     ("spaces", ["peers", "boundary", "contact"]),

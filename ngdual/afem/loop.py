@@ -18,6 +18,7 @@ from .. import budget
 from ..boundary import BoundaryMeshes
 from ..estimator import Estimate, estimate
 from ..goal import Goal, goal_for
+from ..loop_defaults import LEVEL_TOL, MARKING, STEPS, STEPS_TOL, THETA, THETA_TOL
 from ..marking import mark
 from ..mesh import build_mesh
 from ..scene import Scene
@@ -32,23 +33,6 @@ from .stops import Stop, StopRules, out_of_memory
 
 StepCallback = Callable[[dict, Solution, Estimate, np.ndarray | None], None]
 
-# The thesis' marking (Section 4.2, Tables 4.1-4.4): Doerfler with theta = 0.5.
-MARKING, THETA = "dorfler", 0.5
-# Doerfler's theta of a tolerance-driven run. With growth g per step the loop's time to a
-# target is about g / ln g times one solve of the mesh the target needs (all steps, and the
-# overshoot of the last), least at g = e. theta = 0.9 grows the unknowns faster than 0.8 on
-# every problem and order measured (mean growth per step 1.08-2.75 against 1.07-2.36; the
-# goals whose estimate sits on a few triangles grow by 1.1-1.3x at either;
-# docs/theory/estimator.md, "A goal and a tolerance").
-THETA_TOL = 0.9
-# The number of solves: the thesis' runs take 5; a tolerance-driven run stops by its
-# tolerance (or the memory budget), and STEPS_TOL only bounds a tolerance it cannot reach.
-STEPS, STEPS_TOL = 5, 30
-# The initial level of a tolerance-driven run: the coarsest. On a finer start mesh the first
-# steps refine a band around the singularities or Gamma_C inside a mesh already fine
-# elsewhere and grow the unknowns by 1.01-1.2x (hertz-cylinder --goal pressure --tol 0.01:
-# 4.6 s from level 1, 12.5 s from level 2, 11.7 s from its level 3; docs/theory/estimator.md).
-LEVEL_TOL = 1
 def loop_defaults(tol: float | None, theta: float | None, steps: int | None,
                   level: int | None = None) -> tuple[float, int, int | None]:
     """(theta, steps, level) of :func:`adapt`, the ones not given taking their defaults:

@@ -41,6 +41,7 @@ import os
 import sys
 
 from ..extras import MissingExtraError
+from ..loop_defaults import LEVEL_TOL, MARKING, STEPS, STEPS_TOL, THETA, THETA_TOL
 from ..marking import STRATEGIES
 from ..scene import SceneError
 from .output import (
@@ -105,17 +106,17 @@ def parser() -> argparse.ArgumentParser:
     ad = sub.add_parser("adapt", help="adaptive refinement (Chapter 4), writes DIR/history.json",
                         parents=[sized])
     ad.add_argument("scene", help="path to a TOML scene or the name of a shipped scene")
-    ad.add_argument("--marking", choices=STRATEGIES, default="dorfler",
+    ad.add_argument("--marking", choices=STRATEGIES, default=MARKING,
                     help="marking strategy (Section 4.2): max (eta_T >= theta max eta_T), "
                          "fraction (the theta share of the triangles with the largest "
                          "eta_T) or dorfler (the fewest triangles carrying theta of the "
                          "squared estimate, Doerfler; default)")
     ad.add_argument("--theta", type=float, default=None,
-                    help="marking parameter in [0, 1] (default 0.5, the thesis'; with --tol "
-                         "0.8, which grows the unknowns faster)")
+                    help=f"marking parameter in [0, 1] (default {THETA:g}, the thesis'; with "
+                         f"--tol {THETA_TOL:g}, which grows the unknowns faster)")
     ad.add_argument("--steps", type=int, default=None,
-                    help="number of solves (default 5); with --tol the largest number "
-                         "(default 30)")
+                    help=f"number of solves (default {STEPS}); with --tol the largest number "
+                         f"(default {STEPS_TOL})")
     ad.add_argument("--goal", choices=["stress", "pressure"], default="stress",
                     help="what the indicators estimate: stress, the error of (3.124) by "
                          "(4.50) (default), or pressure, ||p - p_h|| in L2 on Gamma_C")
@@ -133,7 +134,7 @@ def parser() -> argparse.ArgumentParser:
                          "is not in L2 at the punch edges; a window without contact stops "
                          "on the first solve, with status 1")
     ad.add_argument("--level", type=int, default=None,
-                    help="initial mesh level (default: the scene's; with --tol 1)")
+                    help=f"initial mesh level (default: the scene's; with --tol {LEVEL_TOL})")
     ad.add_argument("--asymmetry", choices=["hdiv", "l2"], default="l2",
                     help="norm of as(sigma_h) in the estimator (default: L2; 'hdiv' as printed "
                          "in eq. 4.15 does not decrease for PEERS)")
