@@ -198,6 +198,15 @@ lesson.save(nd.plot_contact_traces(nd.contact_traces(solution),
 lesson.draw(nd.post.von_mises(sigma_h, scene.material.nu), mesh, "von_mises")
 
 # %% [markdown]
+# How the body moves: `nd.plot_deformed` draws the mesh displaced by $u_h$, magnified so
+# that the largest displacement is a few percent of the body's size (the title states the
+# factor; the foundation is not magnified, so the magnified body crosses it where it
+# touches).
+
+# %%
+lesson.save(nd.plot_deformed(solution), "deformed")
+
+# %% [markdown]
 # Two things stand out, and both are mathematics rather than bugs:
 #
 # * The stress concentrates at the corners where a clamped side meets the base. Mixed
