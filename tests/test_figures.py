@@ -243,15 +243,23 @@ def test_work_precision_measures_true_errors_against_references_it_checks(coarse
                    for r in resolved)
     assert any(e["problem"] == "hertz-cylinder" for e in result["effectivity"])
     assert any("PEERS_2" in result["references"][p]["sigma_energy"]["method"] for p in problems)
-    # one figure per measure and idea: the time to each target, the errors against wall time
-    # and against unknowns; six problem panels and one legend each
+    # a summary (both measures), then one figure per measure and idea: the time to each
+    # target (a method that reaches none has no curve), the errors against wall time and
+    # against unknowns; six problem panels and one legend each
+    summary_fig = json.loads((coarse_run / "figures" / "work_precision.json").read_text())
+    assert len(summary_fig["axes"]) == 2 and summary_fig["figure_legend"]
+    table_rows = read_csv(coarse_run / "data" / "work_precision_table.csv")
     for stem in ("work_precision", "work_precision_curves", "work_precision_unknowns"):
-        for measure in ("pressure", "sigma"):
+        for measure, key in (("pressure", "pressure"), ("sigma", "sigma_energy")):
             sidecar = json.loads((coarse_run / "figures" / f"{stem}_{measure}.json").read_text())
             assert len(sidecar["axes"]) == 6, (stem, measure)
             labels = set(sidecar["figure_legend"])
-            assert {"primal P1", "primal P2", "uniform", "adaptive, pressure goal",
-                    "uniform, k = 2", "adaptive, pressure goal, k = 1"} <= labels, labels
+            if stem == "work_precision":
+                assert labels == {r["method"] for r in table_rows
+                                  if r["measure"] == key and r["time_s"]}, labels
+            else:
+                assert {"primal P1", "primal P2", "uniform", "adaptive, pressure goal",
+                        "uniform, k = 2", "adaptive, pressure goal, k = 1"} <= labels, labels
     table = read_csv(coarse_run / "data" / "work_precision_table.csv")
     assert {(r["order"], r["multipliers"]) for r in table if "primal" not in r["method"]} == {
         ("0", "coarse"), ("1", "facet"), ("2", "facet"), ("1", "coarse"), ("2", "coarse")}
