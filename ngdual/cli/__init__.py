@@ -210,8 +210,8 @@ def parser() -> argparse.ArgumentParser:
     fg.add_argument("--source", default=None, metavar="DIR",
                     help="figure scripts folder (default: figures/ of the source checkout)")
     fg.add_argument("--gallery", default=None, metavar="DIR",
-                    help="also write small copies of a few figures into DIR (docs/gallery "
-                         "for the README)")
+                    help="also write 16:9 slide copies (1600 x 900 px) of a few figures "
+                         "into DIR (docs/gallery, for the docs site and the README)")
     fg.set_defaults(func=cmd_figures)
     be = sub.add_parser("bench", help="benchmarks: the solvers' and the estimator's cost, the "
                                       "inf-sup constants, the primal peer (a table; JSON with "
