@@ -138,8 +138,7 @@ def run(ctx):
                                                           else ""), scene.units.stress))
         ax_c.grid(alpha=0.3)
         ax_c.legend(loc="upper right", fontsize="small")
-        force = plot.unit_label("", scene.units.stress and scene.units.length
-                                and f"{scene.units.stress} {scene.units.length}").strip()
+        force = plot.unit_label("", scene.units.force).strip()
         ax_c.set_title(f"tractions on $\\Gamma_C$: P = {P:.4g}"
                        + (f", Q = {Q:.4g}" if abs(Q) > 1e-9 * abs(P) else "")
                        + (f" {force}" if force else ""))

@@ -118,7 +118,8 @@ def solution_summary(solution: Solution, exact=None, name: str | None = None) ->
                           "order": scene.discretisation.order,
                           "multipliers": scene.discretisation.family,
                           "solver": solution.method, "converged": bool(solution.converged)},
-               "units": {"length": scene.units.length, "stress": scene.units.stress},
+               "units": {"length": scene.units.length, "stress": scene.units.stress,
+                         "force": scene.units.force},
                "contact": pb.spaces.contact is not None}
     if pb.spaces.contact is None:
         return summary

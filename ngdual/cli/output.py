@@ -89,10 +89,7 @@ def _g(value: float) -> str:
 
 
 def _unit(summary: dict, kind: str) -> str:
-    units = summary["units"]
-    length, stress = units["length"], units["stress"]
-    unit = {"length": length, "stress": stress,
-            "force": f"{stress}*{length}" if stress and length else None}[kind]
+    unit = summary["units"][kind]
     return f" [{unit}]" if unit else ""
 
 

@@ -30,6 +30,10 @@ SOLVER_METHODS = ("auto", "uzawa", "active-set")
 GEOMETRY_KINDS = ("thesis-3.46", "polygon")
 
 
+# a stress times a length by its usual name: the unit of a force per unit thickness
+FORCE_PER_THICKNESS = {("Pa", "m"): "N/m", ("kPa", "m"): "kN/m", ("MPa", "m"): "MN/m",
+                       ("MPa", "mm"): "N/mm", ("N/mm^2", "mm"): "N/mm", ("GPa", "mm"): "kN/mm",
+                       ("psi", "in"): "lbf/in", ("ksi", "in"): "kip/in"}
 LENGTH_UNITS = ("m", "cm", "mm", "um", "km", "in", "ft")
 
 
@@ -259,6 +263,20 @@ class Units:
 
     length: str | None = None
     stress: str | None = None
+
+    @property
+    def force(self) -> str | None:
+        """The unit of a force in 2D, a force per unit thickness (a stress times a length),
+        by its usual name where it has one (MPa and mm: N/mm), else ``stress*length``; None
+        where either unit is not declared.
+
+        >>> Units("mm", "MPa").force, Units("m", "Pa").force, Units("cm", "MPa").force
+        ('N/mm', 'N/m', 'MPa*cm')
+        """
+        if not (self.length and self.stress):
+            return None
+        return FORCE_PER_THICKNESS.get((self.stress, self.length),
+                                       f"{self.stress}*{self.length}")
 
 
 BENCHMARK_KINDS = ("none", "hertz", "flat-punch", "cattaneo-mindlin", "wedge")
