@@ -5,7 +5,9 @@ fine edges of Gamma_C and sampled along them, the contact pressure p_h and shear
 the contact conditions of (3.62) control (:func:`ngdual.friction.hat_projection` on the
 h~ hats; the moments of the facet multipliers), the multipliers, the discrete gap and the
 contact, stick and slip sets (:func:`friction_diagnostics`). Post-processing, the plots,
-the sweeps and the verification read this one object.
+the sweeps and the verification read this one object; :func:`pressure_field` is the same
+pressure as a field on the boundary, for the integrals of the pressure goal and of the
+verification.
 
 Sign conventions (Theorem 3.10): u is the displacement, lambda_n = g - u_n (so lambda_n -
 g = -u_n and lambda_n = 0 where the gap is closed) and lambda_t = -u_t on Gamma_C; p_h =
@@ -16,6 +18,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import ngsolve as ngs
 import numpy as np
 
 from .checks import friction_forms_of
@@ -161,6 +164,15 @@ def contact_traces(solution: Solution) -> ContactTraces:
                            **facet)
     solution.trace = traces
     return traces
+
+
+def pressure_field(solution: Solution) -> ngs.CoefficientFunction:
+    """p_h = -sigma_n^h = -n . sigma_h n on the boundary, as a CoefficientFunction to
+    integrate along Gamma_C: the normal traces of RT_k, P_k on every fine edge (with the
+    facet multipliers exactly what the contact conditions control). The node values of p_h
+    are :attr:`ContactTraces.pressure`."""
+    n = ngs.specialcf.normal(2)
+    return -(ngs.BoundaryFromVolumeCF(fields(solution).sigma) * n) * n
 
 
 def _facet_moments(solution: Solution) -> list[np.ndarray]:

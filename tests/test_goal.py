@@ -540,13 +540,14 @@ def test_the_vertex_jumps_of_the_order_k_pressure_are_those_read_on_each_side():
     search; against p_h read by NGSolve's point search a thousandth of an edge from every
     interior vertex on either side (p_h is P_1 on every edge: the offset moves it by a
     thousandth of its change along the edge)."""
-    from ngdual.goal.indicators import _pressure, _vertex_jumps
+    from ngdual.goal.indicators import _vertex_jumps
+    from ngdual.trace import pressure_field
 
     scene = load_scene("hertz-cylinder", ["discretisation.order=1"])
     mesh = build_mesh(scene.geometry, 2)
     solution = solve_on_mesh(scene, mesh)
     gamma_c = solution.problem.spaces.gamma_c
-    p = _pressure(solution)
+    p = pressure_field(solution)
     got = _vertex_jumps(p, mesh, gamma_c)
     expected, offset = np.zeros(len(gamma_c)), 0
     for chain in gamma_c.coarse.chains:

@@ -54,16 +54,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import ngsolve as ngs  # the pressure of order k, a trace of sigma_h
+import ngsolve as ngs
 import numpy as np
 from scipy.spatial import cKDTree
 
 from ..estimator import BoundaryEdges, Estimate
 from ..mesh import boundary_segments, mesh_arrays
-from ..quantities import fields  # the trace of sigma_h at order k
 from ..scene import SceneError
 from ..solution import Solution
-from ..trace import contact_traces
+from ..trace import contact_traces, pressure_field
 
 __all__ = ["CALIBRATION", "CALIBRATION_ORDER_K", "CALIBRATION_WINDOW_ORDER_K", "TERMS",
            "PressureEstimate", "calibration", "goal_estimate", "in_window"]
@@ -190,7 +189,7 @@ def goal_estimate(solution: Solution, estimated: Estimate,
 
     if spaces.contact.traces:
         # the facet multipliers of order k are the traces of RT_k: p_h = -sigma_n^h
-        pressure = _pressure(solution)
+        pressure = pressure_field(solution)
         p_mean, residual, p_squared = _trace_pressure(pressure, solution, edges, on_gamma_c)
         jumps = _vertex_jumps(pressure, mesh, gamma_c)
     else:
@@ -291,17 +290,11 @@ def _in_window(x: np.ndarray, window: tuple[float, float] | None) -> np.ndarray:
     return inside
 
 
-def _pressure(solution: Solution) -> ngs.CoefficientFunction:
-    """p_h = -sigma_n^h on the boundary, the pressure of order k with the facet multipliers."""
-    n = ngs.specialcf.normal(2)
-    return -(ngs.BoundaryFromVolumeCF(fields(solution).sigma) * n) * n
-
-
 def _trace_pressure(p: ngs.CoefficientFunction, solution: Solution, edges: BoundaryEdges,
                     on_gamma_c: list[int]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """p_h = -sigma_n^h (``p``, :func:`_pressure`) at order k with the facet multipliers: on
-    every fine edge e of Gamma_C (``on_gamma_c``: their dofs in ``edges``) its mean, its
-    tension ||min(p_h, 0)||_e^2 and ||p_h||_e^2.
+    """p_h = -sigma_n^h (``p``, :func:`ngdual.trace.pressure_field`) at order k with the
+    facet multipliers: on every fine edge e of Gamma_C (``on_gamma_c``: their dofs in
+    ``edges``) its mean, its tension ||min(p_h, 0)||_e^2 and ||p_h||_e^2.
 
     The facet multipliers are the normal traces of RT_k (docs/theory/order.md), so the
     pressure the contact conditions control is the trace itself and the residual of the
@@ -319,7 +312,8 @@ def _trace_pressure(p: ngs.CoefficientFunction, solution: Solution, edges: Bound
 
 def _vertex_jumps(p: ngs.CoefficientFunction, mesh: ngs.Mesh, gamma_c) -> np.ndarray:
     """|e| [p_h]_v^2 / 2 on both fine edges of Gamma_C at every interior vertex v of a chain,
-    [p_h]_v the jump of the pressure ``p`` (:func:`_pressure`) between the two edges.
+    [p_h]_v the jump of the pressure ``p`` (:func:`ngdual.trace.pressure_field`) between the
+    two edges.
 
     p_h is read at both ends of every boundary segment (the points 0 and 1 of its reference
     interval, each mapped into the segment's own triangle: no point search).
