@@ -15,6 +15,7 @@ import sys
 import ngsolve as ngs
 import pytest
 from netgen.geom2d import unit_square
+from test_core_dependencies import UNINSTALL
 
 from ngdual.cli import main
 from ngdual.studies.tutorials import Lesson, list_tutorials, percent_cells
@@ -23,17 +24,7 @@ TUTORIALS = list_tutorials()
 EVERY_FILE = TUTORIALS + list_tutorials(solutions=True)
 RUN_TIME = re.compile(r"\*\*Run time\*\* on a 2-core laptop: about \d+ (s|min)")
 
-WRITE_WITHOUT_EXTRAS = r"""
-import importlib.abc, json, sys
-
-BLOCKED = set(json.loads(sys.argv[1]))
-
-class Uninstalled(importlib.abc.MetaPathFinder):
-    def find_spec(self, name, path=None, target=None):
-        if name.partition(".")[0] in BLOCKED:
-            raise ModuleNotFoundError(f"No module named {name!r} (blocked)", name=name)
-
-sys.meta_path.insert(0, Uninstalled())
+WRITE_WITHOUT_EXTRAS = UNINSTALL + r"""
 from ngdual.cli import main
 sys.exit(main(["tutorials", "--notebooks", sys.argv[2], "--solutions"]))
 """
