@@ -43,6 +43,14 @@ TOLERANCE = 1e-9   # relative residuals of (3.62) accepted as round-off
 DISPLACEMENTS = ("u1", "u2", "phi1", "phi2", "lam_n", "lam_t")
 
 
+def displacement_scale(problem: DiscreteProblem, x: np.ndarray) -> float:
+    """D: the largest displacement-like unknown of ``x`` (u, phi, lambda_n, lambda_t) or
+    prescribed end value of phi (module docstring)."""
+    moved = np.abs(x[problem.index(*DISPLACEMENTS)])
+    return max(float(np.max(moved, initial=0.0)),
+               float(np.max(np.abs(problem.lift), initial=0.0)))
+
+
 @dataclass(frozen=True)
 class Scales:
     """The scales of one discrete problem at one solution (module docstring).
@@ -64,9 +72,7 @@ class Scales:
     @classmethod
     def of(cls, problem: DiscreteProblem, x: np.ndarray) -> Scales:
         """The scales of ``problem`` at its solution ``x``."""
-        moved = np.abs(x[problem.index(*DISPLACEMENTS)])
-        D = max(float(np.max(moved, initial=0.0)), float(np.max(np.abs(problem.lift),
-                                                                initial=0.0)))
+        D = displacement_scale(problem, x)
         modulus, L = problem.units
         sigma = problem.index(*STRESS)
         S = max(modulus * D / L, float(np.max(np.abs(x[sigma]), initial=0.0)))

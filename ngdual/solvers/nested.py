@@ -42,7 +42,7 @@ from ..friction import FrictionForms, build_friction_forms, tresca_bound
 from ..solution import ConvergenceError, Solution
 from ..tolerances import CLARABEL_TOLERANCES, DIVERGENCE_FACTOR, friction_vanishes
 from .condensed import CondensedResponse
-from .convergence import Scales
+from .convergence import displacement_scale
 from .settings import Model, NestedUzawaSettings
 from .uzawa import ContactLoop
 
@@ -74,8 +74,9 @@ def sign_residual(Q: sp.spmatrix, nu: np.ndarray, lam_t: np.ndarray,
 
     Zero iff nu_j = sign q_j wherever q_j != 0; relative to the friction work j =
     max(int F |lambda_t| ds, int F ds times the problem's ``displacement`` scale D
-    (:class:`~ngdual.solvers.convergence.Scales`)), so that stick (q = 0) counts as exact and
-    the round-off of a vanishing lambda_t (no load) is not measured against itself.
+    (:func:`~ngdual.solvers.convergence.displacement_scale`)), so that stick (q = 0) counts
+    as exact and the round-off of a vanishing lambda_t (no load) is not measured against
+    itself.
     """
     q = Q @ lam_t
     work = max(float(np.sum(Q @ np.abs(lam_t))), float(np.sum(Q)) * displacement)
@@ -107,7 +108,7 @@ def friction_residuals(forms: FrictionForms, problem: DiscreteProblem, x: np.nda
     scale = max(np.max(np.abs(tangential), initial=0.0), np.max(np.abs(normal), initial=0.0),
                 np.max(hat_bound, initial=0.0), traction_scale) or 1.0
     return {
-        "nu_sign": sign_residual(Q, nu, lam_t, Scales.of(problem, x).displacement),
+        "nu_sign": sign_residual(Q, nu, lam_t, displacement_scale(problem, x)),
         "nu_bound": float(max(0.0, np.abs(nu).max(initial=0.0) - 1.0)),
         "tangential": float(np.max(np.abs(tangential - Q.T @ nu), initial=0.0) / scale),
         "sigma_t_bound": float(max(0.0, np.max(np.abs(tangential) - hat_bound, initial=0.0))
