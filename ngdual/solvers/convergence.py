@@ -79,7 +79,8 @@ class Scales:
         reference = np.full(problem.n, D)
         reference[sigma] = S
         reference[problem.index("eta")] = D / L   # a rotation: a strain
-        rows = problem.terms(reference) + problem.terms(x) + np.abs(problem.rhs)
+        # |K| x_ref + |K| |x| in one product: the terms are linear in the magnitudes
+        rows = problem.terms(reference + np.abs(x)) + np.abs(problem.rhs)
         return cls(D, S, rows)
 
     def relative(self, residual: np.ndarray, rows: np.ndarray) -> float:
