@@ -33,6 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from . import geometry
+from .forms.spaces import Variant, variant_of
 from .scene import Geometry, Scene, SceneError
 
 UNKNOWNS_PER_ELEMENT = 7.5    # PEERS_0 (3.61): unknowns_per_element(0)
@@ -121,7 +122,7 @@ def solve_memory(elements: float, method: str = "auto", order: int = 0,
     """Predicted peak bytes of a solve with ``method`` of PEERS_``order`` with the multiplier
     family ``multipliers`` on a mesh of ``elements`` triangles (either family at order
     k >= 1 and the facet family at k = 0: the hybridised system of order k)."""
-    if multipliers == "facet" or order > 0:
+    if Variant(order, multipliers).hybridised:
         return BASE_BYTES + BYTES_PER_UNKNOWN_ORDER[order] * unknowns_per_element(order) * elements
     per_unknown = BYTES_PER_UNKNOWN.get(method, max(BYTES_PER_UNKNOWN.values()))
     return BASE_BYTES + per_unknown * UNKNOWNS_PER_ELEMENT * elements
@@ -262,9 +263,9 @@ def check_scene(scene: Scene, level: int | None = None, field_name: str = "geome
                 allow_large: bool = False, mesh_only: bool = False) -> Estimate:
     """:func:`check` for the run ``scene`` asks for: its geometry, ``solver.method``, the
     order k and the multiplier family of ``[discretisation]``."""
-    disc = scene.discretisation
+    variant = variant_of(scene)
     return check(scene.geometry, level, field_name, allow_large, mesh_only,
-                 scene.solver.method, disc.order, disc.family)
+                 scene.solver.method, variant.order, variant.family)
 
 
 def _finest_size(geo: Geometry) -> tuple[str, str]:

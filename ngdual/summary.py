@@ -115,8 +115,7 @@ def solution_summary(solution: Solution, exact=None, name: str | None = None) ->
     pb = solution.problem
     scene = pb.scene
     summary = {"method": {"scene": scene.name, "level": pb.level,
-                          "order": scene.discretisation.order,
-                          "multipliers": scene.discretisation.family,
+                          "order": pb.spaces.order, "multipliers": pb.spaces.family,
                           "solver": solution.method, "converged": bool(solution.converged)},
                "units": {"length": scene.units.length, "stress": scene.units.stress,
                          "force": scene.units.force},

@@ -21,9 +21,11 @@ STAGES = [
     ("foundation", ["expr", "extras", "geometry", "tolerances", "rates", "sparse",
                     "loop_defaults"]),
     ("scene", ["scene", "scenes"]),
-    ("mesh", ["mesh", "budget", "io"]),
+    ("mesh", ["mesh", "io"]),
     ("spaces", ["peers", "boundary", "contact"]),
     ("forms", ["forms", "friction", "quadrature_check"]),
+    # the size of a run: the mesh of a level and the unknowns of the spaces' variant
+    ("budget", ["budget"]),
     ("solution", ["solution"]),
     ("solvers", ["solvers", "checks"]),
     ("quantities", ["quantities", "trace"]),
@@ -136,3 +138,49 @@ def test_no_module_asks_which_multiplier_family_it_runs_on():
             if FAMILY_QUESTION.search(code):
                 asking.append(f"{rel}:{number}: {line.strip()}")
     assert not asking, asking
+
+
+# where the order k and the multiplier family are read from the scene: the scene that states
+# and validates them and the module that builds the spaces from them
+DISCRETISATION_READERS = ("scene/", "forms/spaces.py")
+# TODO: afem/stops.py reads them for the memory budget; remove once it asks forms.spaces
+KNOWN_READERS = ("afem/stops.py",)
+DISCRETISATION_FIELDS = {"order", "family", "multipliers"}
+
+
+def discretisation_reads(tree: ast.AST) -> list[int]:
+    """Lines of ``tree`` that read ``<x>.discretisation.order`` (``.family``,
+    ``.multipliers``), directly or through a name bound to ``<x>.discretisation``."""
+    def is_discretisation(node):
+        return isinstance(node, ast.Attribute) and node.attr == "discretisation"
+
+    bound = {target.id for node in ast.walk(tree)
+             if isinstance(node, (ast.Assign, ast.AnnAssign)) and is_discretisation(node.value)
+             for target in (node.targets if isinstance(node, ast.Assign) else [node.target])
+             if isinstance(target, ast.Name)}
+    return sorted(node.lineno for node in ast.walk(tree)
+                  if isinstance(node, ast.Attribute) and node.attr in DISCRETISATION_FIELDS
+                  and (is_discretisation(node.value)
+                       or isinstance(node.value, ast.Name) and node.value.id in bound))
+
+
+def test_the_order_and_the_multiplier_family_are_read_where_the_spaces_are_built():
+    """One method, configured (STYLE.md): ``[discretisation]`` is read by
+    :func:`ngdual.forms.spaces.variant_of`; the rest of the code asks the variant or the
+    spaces (``spaces.order``, ``spaces.family``)."""
+    reading = []
+    for path in sorted(PACKAGE.rglob("*.py")):
+        rel = path.relative_to(PACKAGE).as_posix()
+        if rel.startswith(DISCRETISATION_READERS + KNOWN_READERS):
+            continue
+        reading += [f"{rel}:{line}" for line in discretisation_reads(ast.parse(path.read_text()))]
+    assert not reading, reading
+
+
+def test_the_check_finds_a_direct_and_a_named_read_of_the_discretisation():
+    tree = ast.parse("k = scene.discretisation.order\n"
+                     "disc = pb.scene.discretisation\n"
+                     "f(disc.family, disc.multipliers)\n"
+                     "spaces.order, variant.family, other.order\n"
+                     "replace(scene.discretisation, order=1)\n")
+    assert discretisation_reads(tree) == [1, 3, 3]

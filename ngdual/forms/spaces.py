@@ -1,5 +1,9 @@
 """The fine component spaces of (3.62), the boundary meshes of the multipliers and their
-prolongations (:class:`Spaces`): all that DOF counting needs, nothing assembled."""
+prolongations (:class:`Spaces`): all that DOF counting needs, nothing assembled.
+
+The one place outside :mod:`ngdual.scene` that reads the order k and the multiplier family
+of a scene's ``[discretisation]`` (:func:`variant_of`); the rest of the code asks the
+:class:`Variant` or the :class:`Spaces` built from it."""
 
 from __future__ import annotations
 
@@ -13,6 +17,41 @@ from ..boundary import BoundaryMeshes, CoarseMesh, FacetMesh, end_rule, host_spa
 from ..boundary.coarse_order import CoarseOrderMesh
 from ..contact import ContactBoundary, trace_space
 from ..scene import Scene
+
+
+@dataclass(frozen=True)
+class Variant:
+    """The variant of the method a scene asks for: PEERS_k of order ``order`` with the
+    multipliers of ``family`` (``"coarse"``: continuous on the h~ meshes, ``"facet"``: P_k on
+    the fine edges of T_h).
+
+    The thesis' pairing (3.61) is order 0 with the coarse family; every other variant is
+    solved through the hybridised system of order k (``hybridised``).
+
+    >>> Variant(0, "coarse").hybridised, Variant(0, "facet").hybridised, Variant(1).hybridised
+    (False, True, True)
+    """
+
+    order: int = 0
+    family: str = "coarse"
+
+    @property
+    def hybridised(self) -> bool:
+        """Whether the spaces are those of order k (:meth:`Spaces._order_k`): every variant
+        except the thesis' P1 multipliers on h~ at k = 0."""
+        return self.family == "facet" or self.order > 0
+
+
+def variant_of(scene: Scene) -> Variant:
+    """The order k and the multiplier family of ``scene``'s ``[discretisation]`` (its
+    ``multipliers = "auto"`` resolved at that order).
+
+    >>> from ngdual.scene import load_scene
+    >>> variant_of(load_scene("hertz-cylinder", ["discretisation.order=1"]))
+    Variant(order=1, family='facet')
+    """
+    disc = scene.discretisation
+    return Variant(disc.order, disc.family)
 
 
 def boundary_regex(labels: list[str]) -> str:
@@ -50,8 +89,9 @@ class Spaces:
     def build(cls, scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes | None = None) -> Spaces:
         """Spaces on ``mesh``; ``coarse`` carries coarse meshes over from an adaptive step
         (the facet multipliers live on the fine edges of ``mesh`` and need none)."""
-        if scene.discretisation.family == "facet" or scene.discretisation.order > 0:
-            return cls._order_k(scene, mesh, coarse)
+        variant = variant_of(scene)
+        if variant.hybridised:
+            return cls._order_k(scene, mesh, coarse, variant)
         comps = peers.peers_spaces(mesh)
         coarse = coarse or BoundaryMeshes.for_scene(scene, mesh)
         neumann = contact = friction = None
@@ -77,11 +117,12 @@ class Spaces:
         return cls(mesh, comps, neumann, contact, friction, prolong, end_hats, gamma_c)
 
     @classmethod
-    def _order_k(cls, scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes | None) -> Spaces:
+    def _order_k(cls, scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes | None,
+                 variant: Variant) -> Spaces:
         """PEERS_k with the multipliers of its family: the facet P_k on the fine edges (no
         end is fixed, so nothing is lifted), or the coarse P_{k+1} on the h~ meshes
         (``coarse``, or grouped afresh), fixed at the fixed ends as the P1 hats are."""
-        order, family = scene.discretisation.order, scene.discretisation.family
+        order, family = variant.order, variant.family
         comps = peers.peers_spaces(mesh, order)
         if family == "coarse":
             coarse = coarse or BoundaryMeshes.for_scene(scene, mesh)

@@ -6,7 +6,6 @@
 # %%
 import matplotlib.pyplot as plt
 import numpy as np
-import scipy.sparse.linalg as spla
 
 import ngdual as nd
 
@@ -15,6 +14,7 @@ UzawaSettings = nd.solvers.UzawaSettings                  # its step length, met
 Model = nd.solvers.Model                                  # the law and moduli the QPs need
 metric_matrix = nd.solvers.projections.metric_matrix      # the metric W of the projection
 NonnegativeProjection = nd.solvers.projections.NonnegativeProjection  # P+ onto lambda_n >= 0
+Factorization = nd.solvers.linear.Factorization           # sparse LU factors, solved many times
 solve_qp = nd.solvers.qp.solve_qp                         # the whole problem as one convex QP
 
 lesson = nd.Lesson("03_signorini_uzawa_solutions")
@@ -76,7 +76,7 @@ lesson.save(fig, "optimal_rho")
 def uzawa_by_hand(problem, W, rho=1.0, eps=1e-8, max_iter=2000):
     """Algorithm 3.38 with the projection P+ in the metric W; returns (iterations, converged)."""
     saddle = problem.saddle
-    lu = spla.splu(problem.block(saddle, saddle).tocsc())
+    lu = Factorization(problem.block(saddle, saddle))
     C_n = problem.block(problem.sigma, problem.lam_n)
     n_sigma = len(problem.sigma)
     project = NonnegativeProjection(W)
