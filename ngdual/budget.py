@@ -10,7 +10,7 @@ solve. The thesis' pairing (k = 0, coarse multipliers) peaks at about 2.5 kB per
 with the active-set solver (Example 3.46 with Coulomb friction on level 8, 3.9e6 unknowns:
 9 GB) and 8.5 kB with the Uzawa algorithms and their saddle-point factorisation (0.6 GB on
 level 5 and 2.2 GB on level 6). Order k >= 1 and the facet multipliers are solved by the
-hybridised system of order k (:mod:`ngdual.solvers.hybrid_order`), whose peak per unknown
+same hybridised system (:mod:`ngdual.solvers.hybrid`), whose peak per unknown
 :data:`BYTES_PER_UNKNOWN_ORDER` grows with the size of its element blocks.
 :func:`check` refuses a run whose estimate exceeds the memory this process may use
 (:func:`available_memory`: the smallest of the machine's available memory, the address

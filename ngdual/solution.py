@@ -55,6 +55,10 @@ class Solution:
     :func:`ngdual.checks.physics_checks`; filled by
     :func:`~ngdual.solvers.solve_problem`), empty for a solution to believe. ``trace`` is
     its contact trace once computed (:func:`ngdual.trace.contact_traces`: one per solution).
+    ``roundoff`` is the relative round-off level of the computed unknowns where the solver
+    measures it (the active-set method, :mod:`ngdual.solvers.active_set`): the accuracy to
+    which two solves of the same problem can agree; ``residuals`` hold the convergence
+    test's residuals only (:mod:`ngdual.solvers.convergence`).
     """
 
     problem: DiscreteProblem
@@ -71,6 +75,7 @@ class Solution:
     friction_forms: FrictionForms | None = None
     settings: object | None = None
     warnings: list[CheckWarning] = field(default_factory=list)
+    roundoff: float | None = None
     trace: object | None = field(default=None, repr=False, compare=False)
 
     def part(self, *names: str) -> np.ndarray:

@@ -36,7 +36,7 @@ def test_the_multipliers_argument_at_order_0_gives_the_facet_family():
     scene = nd.load_scene("thesis-3.46-frictionless", [CONSISTENT])
     solution = nd.solve(scene, 1, multipliers="facet")
     assert solution.problem.scene.discretisation.family == "facet"
-    assert solution.method == "active-set-hybrid"
+    assert solution.method == "active-set"
 
 
 def test_order_1_is_closer_to_the_exact_manufactured_stress_than_order_0():

@@ -12,7 +12,6 @@ from ngdual import forms, peers
 from ngdual.mesh import build_mesh
 from ngdual.scene import load_scene
 from ngdual.solvers.hybrid import HybridSystem
-from ngdual.solvers.settings import solver_settings
 
 
 def _assert_same_bits(first, second):
@@ -30,10 +29,10 @@ def test_differentiated_integrands_give_the_matrices_of_3_62_to_the_bit(name, mo
 
     def assembled():
         problem = forms.assemble(scene, mesh)
-        return problem, HybridSystem(problem, solver_settings(scene).model)
+        return problem, HybridSystem(problem, friction=scene.has_friction)
 
     def matrices(problem, hybrid):  # broken.matrix lives as long as its problem
-        return problem.K, problem.rhs, problem.broken.matrix, hybrid.H, hybrid.r
+        return problem.K, problem.rhs, problem.broken.matrix, hybrid.H, hybrid.rhs(problem.rhs)
 
     differentiated = assembled()
     monkeypatch.setattr(forms.peers_block, "differentiated_integrands", contextlib.nullcontext)

@@ -9,13 +9,12 @@ from ngdual import forms
 from ngdual.mesh import build_mesh
 from ngdual.scene import load_scene
 from ngdual.solvers.hybrid import HybridSystem
-from ngdual.solvers.settings import solver_settings
 
 
 def assembled(scene, mesh):
     problem = forms.assemble(scene, mesh)
-    hybrid = HybridSystem(problem, solver_settings(scene).model)
-    return problem.K, problem.rhs, hybrid.H, hybrid.r
+    hybrid = HybridSystem(problem, friction=scene.has_friction)
+    return problem.K, problem.rhs, hybrid.H, hybrid.rhs(problem.rhs)
 
 
 def test_parallel_and_serial_assembly_agree_bit_for_bit(monkeypatch):

@@ -11,7 +11,7 @@ So each case's relative tolerance is derived from the settings its scene calls f
 * Direct solves (no friction, or a given Tresca bound: the active-set method ends exactly
   on its contact and stick sets, then one factorised solve): ``SAFETY delta``, the level
   to which the solver itself accepts its residuals, with ``delta`` its round-off level of
-  this problem (``residuals["roundoff_level"]``, :mod:`ngdual.solvers.active_set`).
+  this problem (``solution.roundoff``, :mod:`ngdual.solvers.active_set`).
   On levels 1-4 of the shipped scenes SAFETY delta is 4e-13 to 1e-11, except on
   cattaneo-mindlin (nu = 0.4999: the compliance's condition (lambda + 2 mu) / mu is 5001),
   1e-10 to 5e-8.
@@ -81,7 +81,7 @@ def pin_tolerance(settings, solution) -> float:
         return STABILITY * max(settings.eps1, settings.eps2)
     if not isinstance(settings, ActiveSetSettings):
         pytest.fail(f"no pin tolerance is derived for {type(settings).__name__}")
-    roundoff = SAFETY * solution.residuals["roundoff_level"]
+    roundoff = SAFETY * solution.roundoff
     if settings.model.law == "coulomb":
         return STABILITY * max(COULOMB_FIXED_POINT_TOL, roundoff)
     return roundoff

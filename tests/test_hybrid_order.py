@@ -1,9 +1,10 @@
-"""The hybridised solver at order k (issue 27): the same discrete solution as the conforming one.
+"""The hybridised active-set solver at every order (issues 27, 48): the same discrete solution
+as the conforming one.
 
 Truth: :func:`ngdual.solvers.conforming.conforming_active_set`, which solves (3.62) on the
 assembled conforming K with one sparse LU and shares neither the broken spaces, the edge
 multipliers, the static condensation nor the Cholesky factorisation with
-:func:`ngdual.solvers.hybrid_order.hybrid_active_set`. Fast: Example 3.46 (consistent ends)
+:func:`ngdual.solvers.active_set.active_set_solve`. Fast: Example 3.46 (consistent ends)
 at k = 0 (facet), 1, 2 without friction and with Tresca and Coulomb friction, Hertz at k = 1;
 slow: Hertz at k = 2 and level 2 of Example 3.46 with Coulomb friction at k = 2.
 """
@@ -16,9 +17,10 @@ from ngdual.forms import assemble, broken_peers, conforming_peers
 from ngdual.mesh import build_mesh
 from ngdual.scene import load_scene
 from ngdual.solvers import solve_scene
+from ngdual.solvers.active_set import active_set_solve
 from ngdual.solvers.conforming import conforming_active_set
 from ngdual.solvers.convergence import TOLERANCE
-from ngdual.solvers.hybrid_order import OrderHybridSystem, _element_schur, hybrid_active_set
+from ngdual.solvers.hybrid import HybridSystem, _element_schur
 from ngdual.solvers.linear import solve_linear
 from ngdual.solvers.settings import solver_settings
 from ngdual.verification.manufactured import manufactured_case
@@ -39,7 +41,7 @@ def _assert_same_solution(name: str, order: int, level: int) -> None:
 
 
 def _assert_same(problem, settings) -> None:
-    hybrid = hybrid_active_set(problem, settings)
+    hybrid = active_set_solve(problem, settings)
     conforming = conforming_active_set(problem, settings)
     assert np.max(np.abs(hybrid.x - conforming.x)) <= ROUND_OFF * np.max(np.abs(conforming.x))
     assert max(hybrid.residuals.values()) < 1e-11
@@ -98,7 +100,7 @@ def test_the_products_and_blocks_of_an_unformed_k_are_those_of_k(monkeypatch):
         raise AssertionError("the hybridised solver summed K's PEERS block")
 
     monkeypatch.setattr(BrokenPeers, "summed", refuse)
-    solution = hybrid_active_set(problem, settings)
+    solution = active_set_solve(problem, settings)
     x = solution.x
     applied = problem.apply(x)
     blocks = [problem.block(problem.sigma, problem.lam_n),
@@ -113,15 +115,30 @@ def test_the_products_and_blocks_of_an_unformed_k_are_those_of_k(monkeypatch):
 
 def test_the_hybridised_matrix_is_symmetric_positive_definite():
     problem, _ = _problem("thesis-3.46-coulomb", 1, 1)
-    H = OrderHybridSystem(problem, friction=True).H.toarray()
+    H = HybridSystem(problem, friction=True).H.toarray()
     assert np.array_equal(H, H.T)
     assert np.linalg.eigvalsh(H)[0] > 0.0
 
 
-def test_the_order_k_default_solver_is_the_hybridised_one():
-    scene = load_scene("thesis-3.46-frictionless", ["discretisation.order=1",
-                                                    "contact.ends='consistent'"])
-    assert solve_scene(scene, 1).method == "active-set-hybrid"
+@pytest.mark.parametrize("settings", [[], ["discretisation.order=1",
+                                           "contact.ends='consistent'"]])
+def test_the_default_solver_is_the_hybridised_one_at_every_order(settings):
+    """The thesis' configuration and order k run through the one hybridised system."""
+    solution = solve_scene(load_scene("thesis-3.46-frictionless", settings), 1)
+    assert solution.method == "active-set" and "hybridize" in solution.timings
+
+
+@pytest.mark.parametrize("name", ["thesis-3.46-frictionless", "hertz-cylinder"])
+def test_the_thesis_configuration_agrees_with_the_conforming_solver(name):
+    """Order 0 with the thesis' P1 hats on h~: the hybridised solver against the sparse LU
+    of K (no shared factorisation, no shared condensation)."""
+    scene = load_scene(name)
+    problem = assemble(scene, build_mesh(scene.geometry, 2))
+    settings = solver_settings(scene)
+    hybrid = active_set_solve(problem, settings)
+    conforming = conforming_active_set(problem, settings)
+    scale = np.max(np.abs(conforming.x))
+    assert np.max(np.abs(hybrid.x - conforming.x)) <= ROUND_OFF * scale
 
 
 def test_without_contact_the_hybridised_solution_is_the_sparse_lu_one():
@@ -130,7 +147,7 @@ def test_without_contact_the_hybridised_solution_is_the_sparse_lu_one():
         "discretisation.order=1", "contact.ends='consistent'", "boundary.contact=[]",
         "boundary.neumann=['top', 'bottom']"])
     problem = assemble(scene, build_mesh(scene.geometry, 1))
-    hybrid = hybrid_active_set(problem, solver_settings(scene))
+    hybrid = active_set_solve(problem, solver_settings(scene))
     lu = solve_linear(problem)
     assert np.max(np.abs(hybrid.x - lu.x)) <= ROUND_OFF * np.max(np.abs(lu.x))
 
@@ -144,7 +161,7 @@ def test_the_hybridised_solution_is_the_conforming_one_on_cattaneo_mindlin():
     (lambda + 2 mu) / mu = 5001 lets two such solutions differ by up to about ten times
     that (measured: 2e-9)."""
     problem, settings = _problem("cattaneo-mindlin", 1, 2)
-    hybrid = hybrid_active_set(problem, settings)
+    hybrid = active_set_solve(problem, settings)
     conforming = conforming_active_set(problem, settings)
     assert max(hybrid.residuals.values()) <= TOLERANCE
     assert np.max(np.abs(hybrid.x - conforming.x)) <= 1e-8 * np.max(np.abs(conforming.x))
@@ -155,7 +172,7 @@ def test_the_element_schur_complements_sum_to_the_sparse_product(order):
     """C^T B^{-1} C from the dense blocks of every triangle (in batches, the last one
     short) is the product of the sparse matrices, to round-off."""
     problem, _ = _problem("thesis-3.46-coulomb", order, 2)
-    hybrid = OrderHybridSystem(problem, friction=True)
+    hybrid = HybridSystem(problem, friction=True)
     sparse = (hybrid.A_LI.T @ (hybrid.B_inv @ hybrid.A_LI)).toarray()
     for chunk in (2048, 37):
         batched = _element_schur(hybrid.B_inv, hybrid.A_LI, chunk).toarray()

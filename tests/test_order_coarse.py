@@ -118,7 +118,7 @@ def test_both_active_set_solvers_give_the_qp_solution_with_the_coarse_multiplier
     conforming = conforming_active_set(problem, settings)
     qp = solve_qp(problem, Model.of(scene))
     scale = np.max(np.abs(hybrid.x))
-    assert hybrid.method == "active-set-hybrid"
+    assert hybrid.method == "active-set"
     assert np.max(np.abs(hybrid.x - qp.x)) <= 1e-9 * scale
     assert np.max(np.abs(conforming.x - qp.x)) <= 1e-9 * scale
     assert max(hybrid.residuals.values()) < 1e-11

@@ -101,7 +101,7 @@ def test_the_active_set_method_at_order_k_gives_the_qp_solution(order):
     scene = _scene(order, "discretisation.multipliers='facet'")
     solution = solve_scene(scene, 2)
     qp = solve_qp(solution.problem, Model.of(scene))
-    assert solution.method == "active-set-hybrid"
+    assert solution.method == "active-set"
     assert np.max(np.abs(solution.x - qp.x)) <= 1e-9 * np.max(np.abs(solution.x))
     assert max(solution.residuals.values()) < 1e-12
     assert not solution.warnings

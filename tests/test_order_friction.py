@@ -20,7 +20,7 @@ from ngdual.forms import assemble
 from ngdual.friction import tresca_moments
 from ngdual.mesh import build_mesh
 from ngdual.scene import load_scene
-from ngdual.solvers import conforming, convergence, solve_problem
+from ngdual.solvers import conforming, contact_problem, convergence, solve_problem
 from ngdual.solvers.qp import solve_qp, solve_qp_friction
 from ngdual.solvers.semismooth import semismooth_newton
 from ngdual.solvers.settings import Model, solver_settings
@@ -211,13 +211,13 @@ def test_a_side_in_contact_and_sticking_is_solved_with_vanishing_multipliers():
 @pytest.mark.parametrize("order, level", [(1, 2), (2, 3)])
 def test_the_coulomb_law_solved_on_the_fixed_points_sets_is_its_fixed_point(order, level,
                                                                            monkeypatch):
-    """On the sets of a Tresca solution (conforming.coulomb_on_sets) the Coulomb problem is
+    """On the sets of a Tresca solution (contact_problem.coulomb_on_sets) the Coulomb problem is
     linear: solved there, the fixed point of Remark 3.45 stops after a few steps (the plain
     iteration takes 12-16, rate ~0.1) at the solution the plain iteration reaches, and
     F = mu_f (-t_n) holds on every coefficient."""
     problem = _problem("thesis-3.46-coulomb", order, level)
     fast = solve_problem(problem)
-    monkeypatch.setattr(conforming, "coulomb_on_sets", lambda cond, mu_f, state: None)
+    monkeypatch.setattr(contact_problem, "coulomb_on_sets", lambda cond, mu_f, state: None)
     plain = solve_problem(problem)
     assert fast.iterations["outer"] <= 6 < plain.iterations["outer"]
     for part in (problem.sigma, problem.lam_n, problem.index("lam_t")):

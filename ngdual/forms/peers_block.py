@@ -62,9 +62,8 @@ class BrokenPeers:
     of a~ + b + s are the same as on the conforming space, but no two triangles share a
     stress unknown, so ``matrix`` keeps every triangle's matrix apart: the conforming PEERS
     block is K = E^T K_b E (:meth:`summed`), E the 0/1 map from conforming to broken
-    unknowns, and the hybridisation (:class:`ngdual.solvers.hybrid.HybridSystem`,
-    :class:`ngdual.solvers.hybrid_order.OrderHybridSystem`) eliminates the element-local
-    unknowns from the same matrix.
+    unknowns, and the hybridisation (:class:`ngdual.solvers.hybrid.HybridSystem`)
+    eliminates the element-local unknowns from the same matrix.
 
     Attributes
     ----------

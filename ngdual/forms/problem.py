@@ -43,8 +43,7 @@ class DiscreteProblem:
         Position of every component in the unknown vector.
     broken : BrokenPeers
         The PEERS block element by element, from which K's PEERS block is summed (the
-        input of the hybridised solvers, :mod:`ngdual.solvers.hybrid` and
-        :mod:`ngdual.solvers.hybrid_order`).
+        input of the hybridised solver, :mod:`ngdual.solvers.hybrid`).
     """
 
     scene: Scene

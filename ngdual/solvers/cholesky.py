@@ -167,4 +167,6 @@ class SchurCholesky:
         """x with x_I = ``x_last`` and the J rows of H x = r satisfied (y = L^{-1} P r)."""
         y = y.copy()
         y[self.n - self.m:] = self.tail.T @ x_last
-        return self.backward(y)
+        x = self.backward(y)
+        x[self.perm[self.n - self.m:]] = x_last  # exactly: a contact coefficient at zero stays zero
+        return x

@@ -1,12 +1,11 @@
 """The active-set method on the conforming system K: contact and friction at every order k.
 
-The hybridised solver of :mod:`ngdual.solvers.active_set` eliminates broken RT_0 rows and
-P1 traces on the h~ mesh (:class:`~ngdual.solvers.hybrid.HybridSystem`); at order k >= 1,
-or with the facet multipliers (:mod:`ngdual.boundary.facet`), there is no such system, and
-the problem (3.62) can be solved on the assembled K itself, with one sparse LU factorisation
-(UMFPACK, :class:`~ngdual.solvers.linear.Factorization`). The default at order k is the
-hybridised system of the facet multipliers (:mod:`ngdual.solvers.hybrid_order`); this
-solver is its fallback where that system is singular, and a second solver to check it by.
+The default solver (:mod:`ngdual.solvers.active_set`) condenses the hybridised system
+(:class:`~ngdual.solvers.hybrid.HybridSystem`) onto the contact multipliers. The same
+problem (3.62) can be solved on the assembled K itself, with one sparse LU factorisation
+(UMFPACK, :class:`~ngdual.solvers.linear.Factorization`), sharing neither the broken
+spaces, the condensation nor the Cholesky factor: this solver is the default's fallback
+where the hybridised system is singular, and a second solver to check it by.
 
 The contact and friction conditions act on the Bernstein coefficients of lambda_n and
 lambda_t and on their moments t = C^T sigma - r (C = K_sigma,lambda, r the lambda rows of
@@ -56,10 +55,7 @@ round-off, or a :class:`ConvergenceError` names every one that is not.
 
 from __future__ import annotations
 
-import functools
 import time
-import warnings
-from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg as sla
@@ -68,43 +64,16 @@ from ..forms import DiscreteProblem
 from ..friction import MomentFriction, build_friction_forms, tresca_moments
 from ..solution import ConvergenceError, Solution
 from ..tolerances import COULOMB_FIXED_POINT_TOL
+from .contact_problem import Condensed, solve_contact
 from .convergence import TOLERANCE, moments, residuals
-from .coulomb import coulomb_fixed_point
 from .linear import Factorization
-from .semismooth import EPS, SAFETY, BoundarySolution, condition_number, semismooth_newton
+from .semismooth import EPS, SAFETY
 from .settings import ActiveSetSettings
 from .start import ContactStart
 
 REGULAR = 1e-8     # the free solve of a regular K leaves relative residuals below this
 CONTACT_START = 1e-8  # a warm start's lambda_n in contact: below this of its largest value
 DEEPEST = 0.5      # candidates per round: penetrations of at least this share of the deepest
-
-
-@dataclass
-class Condensed:
-    """The contact problem on the coefficients ``J``: t(z) = b - G z, z = (lambda_n,
-    lambda_t) on J, each of length ``n_c`` = |J| (module docstring)."""
-
-    G: np.ndarray
-    b: np.ndarray
-    J: np.ndarray
-
-    @property
-    def n_c(self) -> int:
-        return len(self.J)
-
-    @property
-    def roundoff(self) -> float:
-        """eps max(kappa_1(G), dim G): the relative accuracy of the small problem."""
-        return EPS * max(condition_number(self.G), float(len(self.b)), 1.0)
-
-    def traction(self, state: BoundarySolution) -> np.ndarray:
-        """t = b - G z for the state's multipliers."""
-        return self.b - self.G @ np.concatenate([state.lam_n, state.lam_t])
-
-    def normal_stress(self, state: BoundarySolution) -> np.ndarray:
-        """The normal moments t_n on J (what the Coulomb bound is made of)."""
-        return self.traction(state)[:self.n_c]
 
 
 class WholeFactorization:
@@ -245,70 +214,6 @@ def checked_solution(problem: DiscreteProblem, x: np.ndarray, law: str, mu_f: fl
                     timings=seconds)
 
 
-def _start_state(first, J: np.ndarray, friction: bool, n_rows: int) -> BoundarySolution | None:
-    """The Newton start on J from a coarser solution's (lambda_n, lambda_t)."""
-    if first is None:
-        return None
-    lam_t = first[1][J] if friction else np.zeros(len(J))
-    return BoundarySolution(np.maximum(first[0][J], 0.0), lam_t, np.zeros(n_rows),
-                            np.zeros(len(J), dtype=bool), np.zeros(n_rows, dtype=bool), 0,
-                            False, {})
-
-
-def coulomb_on_sets(cond: Condensed, mu_f: float, state: BoundarySolution
-                    ) -> np.ndarray | None:
-    """The normal moments t_n of the Coulomb problem on the sets of the Tresca solution
-    ``state`` (None if that linear system is singular): with t = b - G z and F_i = mu_f
-    (-t_n,i) (:class:`~ngdual.friction.MomentFriction`), the conditions on fixed sets are
-    linear in z alone,
-
-        lambda_n,i = 0 (contact),           t_n,i = 0 (separation),
-        lambda_t,i = 0 (stick),             t_t,i + mu_f s_i t_n,i = 0 (slip with sign s_i,
-                                             t_t,i = 0 where F_i = 0),
-
-    the Newton step of the Coulomb law itself (Hueber, Stadler and Wohlmuth) on the sets the
-    fixed point of Remark 3.45 has found; :func:`ngdual.solvers.coulomb.coulomb_fixed_point`
-    checks it as it checks its own steps."""
-    n = cond.n_c
-    G, b = cond.G, cond.b
-    stick = state.stick
-    sign = np.where(stick, 0.0, np.sign(state.nu))
-    rows = np.vstack([-G[:n], -G[n:] - mu_f * sign[:, None] * G[:n]])
-    rhs = np.concatenate([-b[:n], -b[n:] - mu_f * sign * b[:n]])
-    fixed = np.concatenate([state.contact, stick])   # lambda_n = 0, lambda_t = 0 there
-    rows[fixed] = np.eye(2 * n)[fixed]
-    rhs[fixed] = 0.0
-    try:
-        with warnings.catch_warnings():   # an ill-conditioned system is no step, not noise
-            warnings.simplefilter("error", sla.LinAlgWarning)
-            z = sla.solve(rows, rhs, check_finite=False)
-    except (sla.LinAlgError, sla.LinAlgWarning, ValueError):
-        return None
-    return (b - G @ z)[:n] if np.all(np.isfinite(z)) else None
-
-
-def solve_condensed(cond: Condensed, law: str, mu_f: float, bound: np.ndarray | None,
-                    friction: MomentFriction, first, max_iter: int, tol: float):
-    """The contact (and friction) problem t(z) = b - G z on J by the semismooth Newton
-    method (the Coulomb fixed point of Remark 3.45 around it): (state, F on J or None,
-    history, iterations). ``first`` holds a start's (lambda_n, lambda_t) on every
-    coefficient, ``bound`` a Tresca bound on every coefficient."""
-    floor = SAFETY * cond.roundoff
-    if law == "coulomb":
-        noise = floor * mu_f * float(np.max(np.abs(cond.b), initial=0.0))
-        state, F, history, iterations = coulomb_fixed_point(
-            cond, friction, mu_f, tol, max_iter, None, noise,
-            _start_state(first, cond.J, True, 0),
-            functools.partial(coulomb_on_sets, cond, mu_f))
-        return state, F, history, iterations
-    F = bound[cond.J] if law == "tresca" else None
-    Q = friction.q_matrix(F).toarray() if F is not None else None
-    state = semismooth_newton(cond.G, cond.b, cond.n_c, Q,
-                              _start_state(first, cond.J, F is not None,
-                                           0 if F is None else cond.n_c), tol=floor)
-    return state, F, [], {"outer": 1, "inner": int(state.iterations)}
-
-
 def _on_candidates(whole: WholeFactorization, law: str, mu_f: float, bound, friction, first,
                    max_iter: int, tol: float):
     """Condense onto the candidates J from the factorisation of the whole K, enlarging J
@@ -326,8 +231,8 @@ def _on_candidates(whole: WholeFactorization, law: str, mu_f: float, bound, fric
         J = np.flatnonzero(candidate)
         cond, H = whole.condensed(J, has_friction)
         if len(J):
-            state, F_J, hist, its = solve_condensed(cond, law, mu_f, bound, friction, first,
-                                                     max_iter, tol)
+            state, F_J, hist, its = solve_contact(cond, law, mu_f, _on(bound, J), friction,
+                                                  first, max_iter, tol)
             t = cond.traction(state)
         else:
             state, F_J, hist, its = None, None, [], {"outer": 0, "inner": 0}
@@ -361,6 +266,11 @@ def _on_candidates(whole: WholeFactorization, law: str, mu_f: float, bound, fric
                          "history": history, "unknowns": len(J), "solves": whole.solves}
 
 
+def _on(bound: np.ndarray | None, J: np.ndarray) -> np.ndarray | None:
+    """A Tresca bound on every coefficient restricted to J."""
+    return None if bound is None else bound[J]
+
+
 def _deepest(lam_n: np.ndarray, level: float) -> np.ndarray:
     """The coefficients that penetrate (lambda_n < -``level``) by at least ``DEEPEST`` of the
     deepest penetration: contact there lifts the body elsewhere, so the shallow ones are
@@ -391,8 +301,8 @@ def _on_every_coefficient(problem: DiscreteProblem, law: str, mu_f: float, bound
         G = sla.block_diag(G, np.eye(n_c))
         b = np.concatenate([b, np.zeros(n_c)])
     cond = Condensed(G, b, np.arange(n_c))
-    state, F, history, its = solve_condensed(cond, law, mu_f, bound, friction, first,
-                                              max_iter, tol)
+    state, F, history, its = solve_contact(cond, law, mu_f, bound, friction, first,
+                                            max_iter, tol)
     z = np.concatenate([state.lam_n, state.lam_t])[:len(L)]
     x[rest] -= W @ z
     x[L] = z

@@ -31,11 +31,12 @@ judged like any other.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
 from ..forms import DiscreteProblem
-from ..friction import MomentFriction
+from ..friction import FrictionForms, MomentFriction
 from ..peers import STRESS
 from .coulomb import coulomb_bound
 
@@ -109,7 +110,7 @@ def moments(problem: DiscreteProblem, x: np.ndarray) -> tuple[np.ndarray, np.nda
 
 
 def residuals(problem: DiscreteProblem, x: np.ndarray, law: str, mu_f: float,
-              F: np.ndarray | None) -> dict:
+              F: np.ndarray | None, edges: EdgeFriction | None = None) -> dict:
     """Relative residuals of (3.103) on ``problem.K`` and, with the bound F on the
     coefficients, of the friction law, each against the scales of the problem
     (:class:`~ngdual.solvers.convergence.Scales`: the displacement scale D and the size of each
@@ -126,7 +127,17 @@ def residuals(problem: DiscreteProblem, x: np.ndarray, law: str, mu_f: float,
       slip along t_t,i); for Coulomb ``coulomb_bound`` = max |F_i - mu_f (-t_n,i)| /
       (mu_f T_i), zero where that vanishes (a moment at 1e-6 of the largest, as the
       fixed point sets it: :func:`ngdual.tolerances.friction_vanishes`).
+
+    With the thesis' nu on the h^ mesh (``edges``: its friction forms and nu; F given per
+    fine edge, Q = Q_F of (3.95)) the friction law reads t_t = Q^T nu, |nu_j| <= 1,
+    nu_j q_j = |q_j| (q = Q lambda_t): the lambda_t rows belong to ``equality`` with Q^T nu
+    on their right, ``friction_bound`` = max (|nu_j| - 1)^+, ``slip`` the sign residual
+    sum_j (|q_j| - nu_j q_j) over the friction work at D
+    (:func:`ngdual.solvers.nested.sign_residual`), and ``coulomb_bound`` = max |F_e -
+    F(sigma_h)_e| / (mu_f S) over the fine edges, F(sigma_h) the thesis' (3.123).
     """
+    if edges is not None:
+        return _edge_residuals(problem, x, law, mu_f, F, edges)
     scales = Scales.of(problem, x)
     i_lam, i_lam_t = problem.lam_n, problem.index("lam_t")
     residual = problem.apply(x) - problem.rhs
@@ -151,4 +162,40 @@ def residuals(problem: DiscreteProblem, x: np.ndarray, law: str, mu_f: float,
         # 1e-6 of its largest value, tolerances.friction_vanishes), as the F it returns
         mapped = coulomb_bound(MomentFriction(), t_n, mu_f, 0.0)
         found["coulomb_bound"] = scales.per_row(mapped - F, i_lam) / mu_f
+    return found
+
+
+class EdgeFriction(NamedTuple):
+    """The thesis' friction law on the h^ mesh: its forms and the multiplier nu."""
+
+    forms: FrictionForms
+    nu: np.ndarray
+
+
+def _edge_residuals(problem: DiscreteProblem, x: np.ndarray, law: str, mu_f: float,
+                    F: np.ndarray, edges: EdgeFriction) -> dict:
+    """:func:`residuals` with the thesis' friction law on the h^ mesh (its docstring)."""
+    from .nested import sign_residual  # nested imports this module's displacement scale
+
+    scales = Scales.of(problem, x)
+    D, i_lam = scales.displacement, problem.lam_n
+    i_lam_t = problem.index("lam_t")
+    Q = edges.forms.q_matrix(F)
+    residual = problem.apply(x) - problem.rhs
+    t_n = residual[i_lam]
+    residual[i_lam_t] -= Q.T @ edges.nu
+    lam_n = x[i_lam]
+    found = {
+        "stationarity": scales.relative(residual[problem.sigma], problem.sigma),
+        "equality": scales.relative(residual[problem.mult], problem.mult),
+        "lambda_n_negative": float(max(0.0, -lam_n.min(initial=0.0))) / (D or 1.0),
+        "sigma_n_positive": scales.per_row(np.maximum(t_n, 0.0), i_lam),
+        "complementarity": scales.per_row(lam_n * t_n, i_lam) / (D or 1.0),
+        "friction_bound": float(max(0.0, np.max(np.abs(edges.nu), initial=0.0) - 1.0)),
+        "slip": sign_residual(Q, edges.nu, x[i_lam_t], D),
+    }
+    if law == "coulomb":
+        mapped = coulomb_bound(edges.forms, edges.forms.T_n @ x, mu_f, 0.0)
+        found["coulomb_bound"] = float(np.max(np.abs(mapped - F), initial=0.0)
+                                       / (mu_f * scales.stress or 1.0))
     return found

@@ -4,7 +4,8 @@ Coulomb friction bounds the tangential traction by mu_f |sigma_n|, which depends
 solution; Remark 3.45 solves it as a sequence of Tresca problems, F^{m+1} = Phi(F^m) =
 mu_f |sigma_n(F^m)| of (3.123). :func:`coulomb_fixed_point` runs that iteration around the
 semismooth Newton method of :mod:`ngdual.solvers.semismooth`, on any condensed problem with
-t(z) = b - G z (``boundary``: ``G``, ``b``, ``n_c``, ``roundoff`` and ``normal_stress(state)``)
+t(z) = b - G z (``boundary``: ``G``, ``b``, ``n_c``, ``roundoff``, ``normal_stress(state)`` and
+optionally ``stress_roundoff``, the relative round-off of that normal stress)
 and any friction law with ``q_matrix(F)`` and ``coulomb_bound_of(sigma_n, mu_f)``.
 """
 
@@ -31,7 +32,8 @@ def coulomb_fixed_point(boundary, forms: FrictionForms, mu_f: float,
     frictionless solve starts from ``first`` (None: z = 0).
 
     Stops when the fixed-point residual ||Phi(F) - F|| / ||Phi(F)|| is <= ``tol``, or when it
-    has stagnated (no longer halves) below SAFETY eps kappa_1(G), the round-off of F;
+    has stagnated (no longer halves) below SAFETY times the round-off of F (that of the
+    normal stress it is made of, at least eps kappa_1(G));
     the returned F is then Phi(F) with its own Tresca solution.
 
     Relaxation: the step is F <- F + omega (Phi(F) - F), omega = 1 (the plain fixed point of
@@ -47,12 +49,14 @@ def coulomb_fixed_point(boundary, forms: FrictionForms, mu_f: float,
     on fixed sets Phi is affine, and its fixed point is one linear solve away. Each new set
     of a Tresca solution is tried once in place of a relaxed step; if the sets are the
     solution's, the next Tresca solve reproduces F to round-off and the iteration stops by
-    the same criterion, otherwise it goes on from there (:func:`ngdual.solvers.conforming.
+    the same criterion, otherwise it goes on from there (:func:`ngdual.solvers.contact_problem.
     coulomb_on_sets`; the plain iteration takes 12-16 steps on Example 3.46 at order k,
     levels 1-4, this one 2-7).
     """
     G, b, n_c = boundary.G, boundary.b, boundary.n_c
     floor = SAFETY * boundary.roundoff  # = kkt_tolerance(G)
+    # F is made of the normal stress: it cannot settle below that stress's round-off
+    settled = SAFETY * getattr(boundary, "stress_roundoff", boundary.roundoff)
     state = semismooth_newton(G, b, n_c, start=first, tol=floor)
     inner = state.iterations
     bound = coulomb_bound(forms, boundary.normal_stress(state), mu_f, noise)
@@ -70,7 +74,7 @@ def coulomb_fixed_point(boundary, forms: FrictionForms, mu_f: float,
         if progress:
             progress(outer, change)
         previous = history[-2] if len(history) > 1 else np.inf
-        if change <= tol or (change <= floor and change > 0.5 * previous):
+        if change <= tol or (change <= settled and change > 0.5 * previous):
             # the last F: its own Tresca solution, so that F, nu and z belong together
             bound = mapped
             state = semismooth_newton(G, b, n_c, forms.q_matrix(bound).toarray(), start=state,

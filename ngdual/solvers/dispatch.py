@@ -10,14 +10,12 @@ no contact boundary  -> one linear saddle-point solve
 contact, no friction -> Algorithm 3.38 (Uzawa)
 Tresca / Coulomb     -> Algorithm 3.41 / Remark 3.45 (nested Uzawa)
 
-``solver.method = "active-set"`` or ``"auto"`` (default): the hybridised system, one
-Cholesky factorisation, and for contact the semismooth Newton method on Gamma_C
-(:mod:`ngdual.solvers.active_set`): the same discrete solution at about the cost of one linear
-solve. The hybridisation is that of broken RT_0 rows and the P1 multipliers on h~; at order
-k >= 1 or with the facet multipliers (``discretisation``) it is that of broken RT_k rows
-and the facet multipliers themselves (:mod:`ngdual.solvers.hybrid_order`);
-:mod:`ngdual.solvers.conforming` solves the same problem on the conforming K, the
-independent check of the tests.
+``solver.method = "active-set"`` or ``"auto"`` (default): the hybridised system of broken
+RT_k rows with the contact multipliers last (:mod:`ngdual.solvers.hybrid`), one Cholesky
+factorisation, and for contact the semismooth Newton method on the contact multipliers
+(:mod:`ngdual.solvers.active_set`): the same discrete solution at about the cost of one
+linear solve, for every order and multiplier family. :mod:`ngdual.solvers.conforming`
+solves the same problem on the conforming K, the independent check of the tests.
 """
 
 from __future__ import annotations
@@ -39,8 +37,6 @@ from ..scene import Scene, SceneError, SceneTypeError, check_level, ensure_valid
 from ..scene.values import show
 from ..solution import ConvergenceError, PhysicsWarning, Solution
 from .active_set import active_set_solve
-from .hybrid import HybridSystem
-from .hybrid_order import hybrid_active_set
 from .linear import solve_linear
 from .nested import nested_uzawa
 from .settings import (
@@ -223,9 +219,7 @@ def solve_problem(problem: DiscreteProblem, settings: Settings | None = None,
     if start is not None and not isinstance(settings, ActiveSetSettings):
         raise ValueError(f"a warm start is for the active-set method, not "
                          f"{type(settings).__name__}")
-    if isinstance(settings, ActiveSetSettings) and not HybridSystem.takes(problem.spaces):
-        solution = hybrid_active_set(problem, settings, start=start)
-    elif isinstance(settings, ActiveSetSettings):
+    if isinstance(settings, ActiveSetSettings):
         solution = active_set_solve(problem, settings, progress=progress, start=start)
     elif isinstance(settings, LinearSettings):
         solution = solve_linear(problem)

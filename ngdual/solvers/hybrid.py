@@ -1,400 +1,299 @@
-"""Hybridisation of the PEERS system: the same discrete solution from a symmetric positive
-definite matrix, with the contact tractions as its last unknowns.
+"""The hybridised system of (3.62): PEERS_k with its boundary multipliers as a symmetric
+positive definite matrix whose last unknowns are the contact multipliers.
 
-The saddle-point matrix [[A, B], [B^T, 0]] of (3.97) is indefinite, which rules out a
-Cholesky factorisation. Breaking the normal continuity of the Raviart-Thomas rows
-(Arnold-Brezzi hybridisation) and enforcing it again by a multiplier mu per edge and row,
+One construction for every order k and multiplier family. The saddle-point matrix of
+(3.97) is indefinite, which rules out a Cholesky factorisation; breaking the normal
+continuity of the Raviart-Thomas rows (Arnold-Brezzi hybridisation, ``problem.broken``,
+:func:`ngdual.forms.broken_peers`: every triangle has its own RT_k functions) and enforcing
+it again across every interior edge e by a multiplier mu of degree k per edge and row,
 
-    a~(sigma, tau) + b(u, tau) + s(eta, tau) + sum_T int_{dT} mu . tau n_T ds = ...,
+    a~(sigma, tau) + b(u, tau) + s(eta, tau) + sum_T int_{dT} mu . tau n_T ds
+        + d(lambda, tau) = F(tau),
 
-makes sigma, the bubbles and u element-local. They are eliminated triangle by triangle
-from the element matrices the problem assembled (:class:`ngdual.forms.BrokenPeers`); what
-remains couples only the edge multipliers mu and the rotation eta,
-and its negative is symmetric positive definite (the negated Schur complement of an
-invertible saddle point whose multipliers satisfy the inf-sup condition).
+makes sigma, the bubbles and u element-local. d are the couplings of (3.24) to phi on
+Gamma_N and lambda_n, lambda_t on Gamma_C, F the data (u_D on Gamma_D, the gap g on
+Gamma_C). A boundary edge has one triangle, so its broken functions are the conforming
+ones and d and F are taken from ``problem.K`` and ``problem.rhs`` as they are, whatever the
+multipliers' space: the thesis' P1 hats on the h~ mesh (k = 0), the continuous P_{k+1} on
+h~ (:mod:`ngdual.boundary.coarse_order`) or the facet P_k on the fine edges
+(:mod:`ngdual.boundary.facet`); on Gamma_D nothing is added (the normal trace is free).
+With B_T the block of the element-local unknowns (the saddle point of a~ and b on T,
+invertible because div maps RT_k onto P_k), C their coupling to the global unknowns
+x_I = (eta, mu, phi, lambda) and f their load, the global unknowns solve
 
-mu is minus the displacement trace. On the boundary it is what the formulation already
-prescribes: mu = -mean_e(u_D) on Gamma_D (the right-hand side of (3.62)), the edge means of
-the coarse P1 phi on Gamma_N (d_N of (3.24)), and on every fine Gamma_C edge e
+    H x_I = r,    H = C^T B^{-1} C - K_II,    r = C^T B^{-1} f - F_I,
 
-    mu_e = n_e zeta_n,e + t_e zeta_t,e,   zeta_n = M lambda_n - mean_e(g),  zeta_t = M lambda_t,
+H = -(K_II - C^T B^{-1} C) symmetric positive definite: eta, mu, phi and lambda are all
+multipliers of sigma, and the sigma block of B_T^{-1} is positive semidefinite with a
+kernel on which the inf-sup condition of the multipliers acts. The contact multipliers
+(the coefficients of lambda_n, and of lambda_t with friction) are ordered last; the
+Cholesky factorisation of H with them last (:class:`~ngdual.solvers.cholesky.SchurCholesky`)
+gives the Schur complement G on them for free, and the lambda rows of (3.62) read
 
-(plus the known end values of lambda where Gamma_C meets Gamma_D, :class:`ContactEdges`)
+    t(z) = b - G z,    t = C_lambda^T sigma - r_lambda,
 
-with M the edge means of the coarse h~ hats (the RT_0 normal trace is constant on e, so
-int_e lambda tau.n ds = |e| mean_e(lambda) (tau.n)_e: d_{C,n}, d_{C,t} and g(tau) of (3.24)
-are reproduced exactly). The fine contact values zeta are left free in the matrix H and
-ordered last; a Cholesky factorisation with them last yields the Schur complement
-S = H_zz - H_zJ H_JJ^{-1} H_Jz (the Steklov-Poincare operator of Gamma_C) at no extra
-cost: the edge moments of the traction, t_e = (int_e sigma_n, int_e sigma_t), are the
-affine function t(zeta) = t_hat - S zeta of zeta (:class:`ContactSchur`).
+the contact problem of :mod:`ngdual.solvers.contact_problem`, on the exact discrete problem
+(3.62) (:mod:`ngdual.solvers.active_set` solves it). One back substitution, the element
+solves and one step of iterative refinement against the residual of ``problem.K``
+(:meth:`HybridSystem.solve`) give every unknown.
+
+The thesis hybridises differently (Section 3.5: the fine Gamma_C traces zeta last, their
+Schur complement S, G = M^T S M with M the hats' edge means); H here has the multipliers'
+coefficients last instead, and is the same discrete problem: on the thesis' configuration
+the two give the same solution to round-off (5e-15 to 4e-12 of the unknowns, levels 2-4 of
+Example 3.46, Hertz and the punch; docs/theory/order.md).
 """
 
 from __future__ import annotations
 
-import re
 import time
-from dataclasses import dataclass
 
 import ngsolve as ngs
 import numpy as np
 import scipy.sparse as sp
 
 from .. import peers
-from ..forms import DiscreteProblem, boundary_regex
-from ..geometry import tangent
+from ..forms import DiscreteProblem
 from ..sparse import to_scipy
-from .settings import Model
+from .cholesky import SchurCholesky
 
-
-@dataclass
-class ContactEdges:
-    """The fine edges of Gamma_C, chain by chain (the order of :mod:`ngdual.friction`).
-
-    ``edges`` are their facet dofs; ``hat_means`` (n_edges x N_C) is M: the mean of
-    every coarse h~ hat on every fine edge; ``normals`` the outward unit normals,
-    ``lengths`` |e|. ``gap`` and ``offset_t`` are the known parts of the fine contact
-    values, zeta_n = M lambda_n - gap and zeta_t = M lambda_t - offset_t: ``gap`` is
-    mean_e(g) minus the edge mean of the prescribed end values of lambda_n (where
-    Gamma_C meets Gamma_D), ``offset_t`` minus that of lambda_t.
-    """
-
-    edges: np.ndarray
-    lengths: np.ndarray
-    normals: np.ndarray
-    hat_means: sp.csr_matrix
-    gap: np.ndarray
-    offset_t: np.ndarray
-
-    @property
-    def tangents(self) -> np.ndarray:
-        """t = (n_2, -n_1), the tangent of (3.24)."""
-        return tangent(self.normals)
-
-    def __len__(self) -> int:
-        return len(self.edges)
-
-
-def _boundary_edges(mesh: ngs.Mesh, facet: ngs.FESpace, hdiv: ngs.FESpace
-                    ) -> dict[str, np.ndarray]:
-    """Rows (facet dof, RT_0 dof, vertex a, vertex b) of every boundary segment, by label.
-
-    Read from two forms on every labelled part of the boundary, int_e mu (psi . n) ds and
-    int_e mu v ds (mu the edge multipliers, psi the RT_0 functions, v the P1 hats): on a
-    segment e only its own mu and psi and the hats of its two vertices do not vanish. Dof
-    numbers, not edge numbers: netgen keeps the edges of coarser levels after
-    ``mesh.Refine()``, and the facet space numbers only the edges in use.
-    """
-    hats = ngs.H1(mesh, order=1)
-    n = ngs.specialcf.normal(2)
-    out = {}
-    for label in dict.fromkeys(mesh.GetBoundaries()):
-        ds = ngs.ds(definedon=mesh.Boundaries(re.escape(label)))
-        flux = ngs.BilinearForm(trialspace=facet, testspace=hdiv)
-        flux += facet.TrialFunction() * (hdiv.TestFunction().Trace() * n) * ds
-        ends = ngs.BilinearForm(trialspace=facet, testspace=hats)
-        ends += facet.TrialFunction() * hats.TestFunction() * ds
-        rt, edges = _nonzeros(flux.Assemble().mat)
-        vertices, edges_v = _nonzeros(ends.Assemble().mat)
-        if not len(edges):
-            continue
-        order = np.argsort(edges_v, kind="stable")
-        pairs = vertices[order].reshape(-1, 2)
-        if not (np.array_equal(edges_v[order][::2], edges)
-                and np.array_equal(edges_v[order][1::2], edges)):
-            raise RuntimeError(f"the boundary segments of {label!r} are not edges with "
-                               "one RT_0 function and two vertices")
-        out[label] = np.column_stack([edges, rt, pairs])
-    return out
-
-
-def _nonzeros(matrix) -> tuple[np.ndarray, np.ndarray]:
-    """(row, column) of the entries of an assembled NGSolve matrix that do not vanish (up
-    to rounding), sorted by column."""
-    A = to_scipy(matrix, copy=False).tocsc()
-    rows = A.indices
-    cols = np.repeat(np.arange(A.shape[1]), np.diff(A.indptr))
-    keep = np.abs(A.data) > 1e-12 * np.abs(A.data).max(initial=0.0)
-    return rows[keep].astype(int), cols[keep]
-
-
-def _normal_fluxes(hdiv: ngs.FESpace, mesh: ngs.Mesh, labels: list[str]) -> np.ndarray:
-    """int_e psi_e.n ds and int_e n_i psi_e.n ds (i = 1, 2) per RT_0 dof of the edges ``labels``.
-
-    The normal trace of an RT_0 basis function is constant on its edge, so the data moments
-    of :mod:`ngdual.forms` are (flux) x (edge mean of the data), and the edge means follow
-    from the assembled right-hand side exactly, whatever quadrature produced it.
-    """
-    v = hdiv.TestFunction()
-    n = ngs.specialcf.normal(2)
-    ds = ngs.ds(definedon=mesh.Boundaries(boundary_regex(labels)))
-    out = []
-    for f in (ngs.CF(1.0), n[0], n[1]):
-        form = ngs.LinearForm(hdiv)
-        form += f * (v.Trace() * n) * ds
-        form.Assemble()
-        out.append(form.vec.FV().NumPy().copy())
-    return np.array(out)
+SCHUR_CHUNK = 2048  # triangles per batch of _element_schur (PEERS_2: 48 MB of blocks)
 
 
 class HybridSystem:
-    """The hybridised, statically condensed system of (3.62), reduced to H w = r.
-
-    Unknowns w: mu on the interior edges (two rows), eta, the coarse phi, and last the
-    fine contact values zeta = (zeta_n, zeta_t) (``contact_index``). H is symmetric
-    positive definite; with zeta prescribed, the other rows of H w = r are exactly
-    the rows of (3.62) for sigma, u, eta, phi, and t(zeta) = r_z - (H w)_z are the
-    traction moments (int_e sigma_n, int_e sigma_t) on the fine Gamma_C edges.
-
-    The element matrices of a~ + b + s are those the problem assembled once
-    (:class:`ngdual.forms.BrokenPeers`); only the coupling sum_T int_{dT} mu . tau n_T ds is
-    assembled here. The element-local unknowns (the broken sigma rows, the bubbles, u) are
-    eliminated triangle by triangle: with B_T their block, C_T their coupling to the
-    interface unknowns (eta, mu) of T and f_T their load,
-
-        S = K_II - sum_T C_T^T B_T^{-1} C_T,    g = - sum_T C_T^T B_T^{-1} f_T,
-
-    and they are recovered from the interface values x_I as B_T^{-1} (f_T - C_T x_I).
+    """The hybridised system of (3.62) at order k, H x_I = r.
 
     Parameters
     ----------
     problem : DiscreteProblem
-        The assembled problem (its mesh, spaces, prolongations, phi right-hand side and
-        element matrices).
-    model : Model
-        Lamé's constants and the labels of Gamma_D, Gamma_N, Gamma_C.
+        Any assembled problem (every order k, either multiplier family).
+    friction : bool
+        Whether lambda_t is a contact unknown (ordered last with lambda_n) or eliminated
+        with the other multipliers (no friction: t_t = 0).
+
+    Attributes
+    ----------
+    H : scipy.sparse.csr_matrix
+        The symmetric positive definite matrix on the global unknowns x_I (eta, mu_1,
+        mu_2, the other multipliers, the contact ones); :meth:`rhs` is its right-hand side
+        for a right-hand side of ``problem.K``.
+    contact_index : numpy.ndarray
+        The positions of the contact unknowns in x_I (the last ones): lambda_n, then
+        lambda_t with friction, in the order of ``problem.lam_n`` and ``problem.index("lam_t")``.
+    seconds : dict
+        ``broken`` (the edge coupling and the couplings of the multipliers to the broken
+        rows) and ``condense`` (the elimination of the element-local unknowns).
     """
 
-    @staticmethod
-    def takes(spaces) -> bool:
-        """Whether this hybridisation solves a problem on ``spaces``: PEERS_0 with boundary
-        multipliers that pair with the chords' normals (the thesis' P1 hats on h~, whose
-        edge means reproduce d_C exactly against the constant RT_0 traces). Every other
-        space is hybridised by :class:`~ngdual.solvers.hybrid_order.OrderHybridSystem`."""
-        meshes = [m for m in (spaces.neumann, spaces.contact) if m is not None]
-        return spaces.order == 0 and not any(m.curve_normal for m in meshes)
-
-    def __init__(self, problem: DiscreteProblem, model: Model):
+    def __init__(self, problem: DiscreteProblem, friction: bool):
         start = time.perf_counter()
         self.problem = problem
-        mesh = problem.fes.mesh
-        self.mesh = mesh
-        broken = problem.broken
-        facet = ngs.FacetFESpace(mesh, order=0)
-        eta = broken.fes.Range(peers.PEERS.index("eta"))
-        self.n_eta = eta.stop - eta.start
-        self.n_interface = self.n_eta + 2 * facet.ndof
-        broken_rt = broken.fes.components[peers.PEERS.index("r1")]
-        blocks = self._elements(broken, _edge_coupling(broken_rt, facet), facet.ndof)
-        self.assemble_seconds = time.perf_counter() - start
+        # the multipliers' rows of K are those of its boundary part (the PEERS block has none)
+        spaces, boundary = problem.spaces, problem.boundary
+        self.broken = broken = problem.broken
+        fes = broken.fes
+        ranges = {name: fes.Range(i) for i, name in enumerate(peers.PEERS)}
+        n_b, n_p = fes.ndof, len(np.bincount(broken.conforming))
+        # the broken matrix with sorted rows, which _element_dofs and the element blocks read
+        matrix = broken.matrix if broken.matrix.has_sorted_indices else \
+            broken.matrix.sorted_indices()
+        self.local = _element_dofs(matrix, ranges["eta"].start)
+        mu = _edge_coupling(fes.components[peers.PEERS.index("r1")], spaces.order)
+        n_mu = mu.shape[1]
+        contact = problem.lam_n if not friction else np.concatenate(
+            [problem.lam_n, problem.index("lam_t")])
+        others = np.setdiff1d(np.arange(n_p, problem.n), contact)
+        multipliers = np.concatenate([others, contact])
+        # a boundary edge has one triangle: d acts on its broken functions unchanged
+        Q = sp.csr_matrix((np.ones(n_p), (_first_copies(broken.conforming, n_p),
+                                          np.arange(n_p))), shape=(n_b, n_p))
+        # K is symmetric: its multiplier rows are few, its PEERS rows many
+        coupled = (Q @ boundary[multipliers][:, :n_p].T).tocsr()
+        self._Q = Q
+        self.seconds = {"broken": time.perf_counter() - start}
 
         start = time.perf_counter()
-        S, g = self._condense(*blocks, broken.matrix[eta.start:eta.stop][:, eta.start:eta.stop])
-        self._reduction(model, facet, S, g)
-        self.reduce_seconds = time.perf_counter() - start
+        eta = np.arange(ranges["eta"].start, n_b)
+        L = self.local.ravel()
+        n_l, n_m = len(L), len(multipliers)
+        # the global unknowns: eta, mu_1, mu_2, the other multipliers, the contact ones
+        self.interface = np.concatenate([eta, n_b + np.arange(2 * n_mu + n_m)])
+        where = np.empty(n_b, dtype=np.int64)  # the row of every broken unknown of L
+        where[L] = np.arange(n_l)
+        rows = [sp.csr_matrix((np.ones(r.stop - r.start),
+                               (where[r.start:r.stop], np.arange(r.stop - r.start))),
+                              shape=(n_l, r.stop - r.start)) @ mu
+                for r in (ranges["r1"], ranges["r2"])]
+        # the local rows of the broken matrix, triangle by triangle: each row holds its
+        # triangle's local unknowns first (in the order of self.local), then its eta
+        M_L = matrix[L]
+        size = self.local.shape[1]
+        lengths = np.diff(M_L.indptr)
+        place = np.arange(M_L.nnz) - np.repeat(M_L.indptr[:-1], lengths)
+        local = place < size
+        if not (np.array_equal(M_L.indices[local], np.repeat(self.local, size, axis=0).ravel())
+                and np.all(M_L.indices[~local] >= n_l)):
+            raise RuntimeError("the element-local unknowns couple across triangles")
+        self.B_inv = _block_inverse(M_L.data[local].reshape(-1, size, size))
+        K_LI = sp.csr_matrix((M_L.data[~local], M_L.indices[~local] - n_l,
+                              np.concatenate([[0], np.cumsum(lengths - size)])),
+                             shape=(n_l, len(eta)))
+        K_II = matrix[n_l:][:, n_l:]
+        self.A_LI = sp.hstack([K_LI, *rows, coupled[L]], format="csr")
+        A_II = sp.bmat([[K_II, None, coupled[eta]],
+                        [None, sp.csr_matrix((2 * n_mu, 2 * n_mu)), None],
+                        [coupled[eta].T, None, boundary[multipliers][:, multipliers]]],
+                       format="csr")
+        self.H = (_element_schur(self.B_inv, self.A_LI) - A_II).tocsr()
+        self.H = 0.5 * (self.H + self.H.T)
+        n_i = len(self.interface)
+        self.contact_index = np.arange(n_i - len(contact), n_i)
+        self._sizes = (n_b, n_p, n_mu, multipliers)
+        self._contact = contact
+        self.seconds["condense"] = time.perf_counter() - start
 
-    def _elements(self, broken, coupling: sp.csr_matrix, n_facets: int
-                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """B_T, C_T and f_T of every triangle (stacked); its local unknowns (``local``) and
-        its interface unknowns (``interface``: eta, then mu_1, mu_2 after them).
+    @property
+    def contact_unknowns(self) -> np.ndarray:
+        """The positions of the contact multipliers (``contact_index`` of x_I) in the
+        unknown vector of ``problem.K``."""
+        return self._contact
 
-        Read from NGSolve's sparsity pattern: a row of an element-local unknown holds
-        exactly the unknowns of its triangle, sorted, the local ones (the broken sigma rows,
-        the bubbles, u) before eta.
-        """
-        pb, fes = self.problem, broken.fes
-        K = broken.matrix
-        ranges = [fes.Range(i) for i in range(len(peers.PEERS))]
-        eta = ranges[peers.PEERS.index("eta")]
-        u1 = ranges[peers.PEERS.index("u1")]
-        width = int(K.indptr[u1.start + 1] - K.indptr[u1.start])
-        # one row of u1 (P0) per triangle: its columns are the triangle's unknowns
-        dofs = K.indices[K.indptr[u1.start:u1.stop, None] + np.arange(width)]
-        n_local = int(np.count_nonzero(dofs[0] < eta.start))
-        local = dofs[:, :n_local]
-        if not (np.all(np.diff(K.indptr)[:eta.start] == width)
-                and np.all(dofs[:, n_local:] >= eta.start) and np.all(local < eta.start)):
-            raise RuntimeError("the PEERS matrix does not have one block per triangle")
-        at = K.indptr[local][..., None] + np.arange(width)
-        if not np.array_equal(K.indices[at], np.broadcast_to(dofs[:, None, :], at.shape)):
-            raise RuntimeError("the PEERS matrix does not have one block per triangle")
-        values = K.data[at]
-        del at
-        rt_rows = []
-        for name in ("r1", "r2"):
-            rg = ranges[peers.PEERS.index(name)]
-            inside = (dofs[0, :n_local] >= rg.start) & (dofs[0, :n_local] < rg.stop)
-            rt_rows.append((np.flatnonzero(inside), local[:, inside] - rg.start))
-        positions, rt = rt_rows[0]
-        n_edges = len(positions)
-        at = coupling.indptr[rt][..., None] + np.arange(n_edges)
-        if not np.all(np.diff(coupling.indptr) == n_edges):
-            raise RuntimeError("the edge coupling does not have one block per triangle")
-        facets = coupling.indices[at[:, 0, :]]
-        flux = coupling.data[at]
-        n_vertices = width - n_local
-        self.interface = np.concatenate([dofs[:, n_local:] - eta.start,
-                                         self.n_eta + facets,
-                                         self.n_eta + n_facets + facets], axis=1)
-        C = np.zeros((len(local), n_local, n_vertices + 2 * n_edges))
-        C[:, :, :n_vertices] = values[:, :, n_local:]
-        for k, (pos, _) in enumerate(rt_rows):
-            C[:, pos[:, None], n_vertices + k * n_edges + np.arange(n_edges)] = flux
-        load = np.zeros(fes.ndof)
-        for name in ("u1", "u2"):
-            rg = ranges[peers.PEERS.index(name)]
-            load[rg.start:rg.stop] = pb.rhs[pb.blocks[name]]
-        self.local, self._ranges = local, ranges
-        return values[:, :, :n_local], C, load[local]
+    def _load(self, F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The loads (f_L, f_I) of the element-local and the global unknowns for a
+        right-hand side F of ``problem.K``. A load on a conforming function goes to one of
+        its broken copies: where the normal traces are continuous, the copies' rows sum to
+        the conforming row."""
+        n_b, n_p, n_mu, multipliers = self._sizes
+        f = np.concatenate([self._Q @ F[:n_p], np.zeros(2 * n_mu), F[multipliers]])
+        return f[self.local.ravel()], f[self.interface]
 
-    def _condense(self, B: np.ndarray, C: np.ndarray, f: np.ndarray, K_eta: sp.csr_matrix
-                  ) -> tuple[sp.csr_matrix, np.ndarray]:
-        """S and g on the interface unknowns (eta, mu_1, mu_2), K_eta their block K_II;
-        keeps B_T^{-1} C_T and B_T^{-1} f_T for :meth:`unknowns`."""
-        solved = np.linalg.solve(B, np.concatenate([C, f[..., None]], axis=2))
-        self._extension, self._inner = solved[..., :-1], solved[..., -1]
-        schur = -np.einsum("eki,ekj->eij", C, self._extension)
-        iface, n = self.interface, self.n_interface
-        g = -np.bincount(iface.ravel(), np.einsum("eki,ek->ei", C, self._inner).ravel(),
-                         minlength=n)
-        width = iface.shape[1]
-        S = sp.csr_matrix((schur.ravel(), (np.repeat(iface, width, axis=1).ravel(),
-                                           np.tile(iface, (1, width)).ravel())), shape=(n, n))
-        K_eta = K_eta.tocoo()
-        if np.any(K_eta.data):  # a~ + b + s has no eta-eta term; kept for any volume form
-            S = S + sp.csr_matrix((K_eta.data, (K_eta.row, K_eta.col)), shape=(n, n))
-        return S, g
+    def rhs(self, F: np.ndarray) -> np.ndarray:
+        """r = C^T B^{-1} f_L - f_I of H x_I = r for the right-hand side F of ``problem.K``."""
+        f_L, f_I = self._load(F)
+        return self.A_LI.T @ (self.B_inv @ f_L) - f_I
 
-    def _reduction(self, model: Model, facet: ngs.FESpace, S: sp.csr_matrix,
-                   r_cond: np.ndarray) -> None:
-        """Build c = T w + c0 (interface values from the reduced unknowns), H and r."""
-        pb, mesh = self.problem, self.mesh
-        m1, m2 = self.n_eta, self.n_eta + facet.ndof
-        hdiv = pb.spaces.components["r1"]
-        labelled = _boundary_edges(mesh, facet, hdiv)
-        fluxes = _normal_fluxes(hdiv, mesh, model.labels("dirichlet") + model.labels("contact"))
-        F1 = pb.rhs[pb.blocks["r1"]]
-        F2 = pb.rhs[pb.blocks["r2"]]
-
-        def edges_of(role):
-            rows = [labelled[lab] for lab in model.labels(role) if lab in labelled]
-            return np.vstack(rows) if rows else np.zeros((0, 4), dtype=int)
-
-        dirichlet, neumann = edges_of("dirichlet"), edges_of("neumann")
-        on_boundary = np.zeros(facet.ndof, dtype=bool)
-        on_boundary[np.concatenate([e[:, 0] for e in labelled.values()])] = True
-        interior = np.flatnonzero(~on_boundary)
-        self.contact = self._contact_edges(model, labelled, fluxes, F1, F2)
-        n_int, n_v = len(interior), self.n_eta
-        n_phi = pb.spaces.coarse_ndof("phi1") if "phi1" in pb.blocks else 0
-        n_c = len(self.contact)
-        blocks = np.cumsum([0, n_int, n_int, n_v, n_phi, n_phi, n_c, n_c])
-        self.n_w = int(blocks[-1])
-        self.contact_index = np.arange(blocks[5], blocks[7])
-        self.phi_index = np.arange(blocks[3], blocks[5])
-        rows, cols, vals = [], [], []
-
-        def put(r, c, v):
-            rows.append(np.asarray(r)), cols.append(np.asarray(c))
-            vals.append(np.broadcast_to(np.asarray(v, dtype=float), np.shape(r)))
-
-        k = np.arange(n_int)
-        put(m1 + interior, blocks[0] + k, 1.0)
-        put(m2 + interior, blocks[1] + k, 1.0)
-        put(np.arange(n_v), blocks[2] + np.arange(n_v), 1.0)
-        c0 = np.zeros(self.n_interface)
-        if len(dirichlet):  # F = int_e u_D . tau n ds (3.62): minus the mean of u_D
-            rt = dirichlet[:, 1]
-            c0[m1 + dirichlet[:, 0]] = -F1[rt] / fluxes[0][rt]
-            c0[m2 + dirichlet[:, 0]] = -F2[rt] / fluxes[0][rt]
-        if pb.spaces.neumann is not None:  # mu_e = the edge mean of the coarse P1 phi
-            coarse = pb.spaces.neumann
-            facet_of = {frozenset(int(v) for v in row[2:]): row[0] for row in neumann}
-            facets = np.array([facet_of[frozenset((int(a), int(b)))]
-                               for a, b in coarse.fine_edges()[0]])
-            dof = coarse.fine_edge_dofs(pb.spaces.components["phi1"])
-            P = pb.spaces.prolongations["phi1"].tocsr()
-            mean = (0.5 * (P[dof[:, 0]] + P[dof[:, 1]])).tocoo()
-            for comp, start in ((0, m1), (1, m2)):
-                put(start + facets[mean.row], blocks[3 + comp] + mean.col, mean.data)
-                lift_range = pb.fes.Range(pb.names.index(("phi1", "phi2")[comp]))
-                lift = pb.lift[lift_range.start:lift_range.stop]
-                c0[start + facets] = 0.5 * (lift[dof[:, 0]] + lift[dof[:, 1]])
-        ce = self.contact
-        j = np.arange(n_c)
-        for comp, start in ((0, m1), (1, m2)):
-            put(start + ce.edges, blocks[5] + j, ce.normals[:, comp])
-            put(start + ce.edges, blocks[6] + j, ce.tangents[:, comp])
-        T = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                          shape=(self.n_interface, self.n_w))
-        self.T, self.c0 = T, c0
-        self.H = (-(T.T @ (S @ T))).tocsr()
-        self.H.sum_duplicates()
-        r = -(T.T @ (r_cond - S @ c0))
-        if n_phi:
-            r[self.phi_index] -= pb.rhs[pb.index("phi1", "phi2")]
-        self.r = r
-
-    def _contact_edges(self, model: Model, labelled: dict, fluxes: np.ndarray, F1: np.ndarray,
-                       F2: np.ndarray) -> ContactEdges:
-        """Fine Gamma_C edges; mean_e(g) from F = int_e g n.tau n ds, the right-hand side of g."""
-        pb = self.problem
-        contact = pb.spaces.contact
-        if contact is None:
-            return ContactEdges(np.zeros(0, dtype=int), np.zeros(0), np.zeros((0, 2)),
-                                sp.csr_matrix((0, 0)), np.zeros(0), np.zeros(0))
-        edge_of = {}
-        for lab in model.labels("contact"):
-            for row in labelled.get(lab, []):
-                edge_of[frozenset(int(v) for v in row[2:])] = row[:2]
-        gamma_c = pb.spaces.gamma_c
-        edges = np.array([edge_of[frozenset((int(a), int(b)))] for a, b in gamma_c.vertices]
-                         ).reshape(-1, 2)
-        rt = edges[:, 1]
-        flux = fluxes[0][rt]
-        # NGSolve's normal of the assembled forms, read from the RT_0 fluxes, rather than
-        # gamma_c.normals from the vertex coordinates: the two agree to round-off, and these
-        # are the normals with which F's moments below were integrated
-        normals = np.column_stack([fluxes[1][rt], fluxes[2][rt]]) / flux[:, None]
-        normals /= np.linalg.norm(normals, axis=1)[:, None]
-        # the sigma rows of F hold int_e (g - lift_n) tau_n - int_e lift_t tau_t on e
-        gap = (normals[:, 0] * F1[rt] + normals[:, 1] * F2[rt]) / flux
-        offset_t = (normals[:, 1] * F1[rt] - normals[:, 0] * F2[rt]) / flux
-        return ContactEdges(edges[:, 0], gamma_c.lengths, normals,
-                            gamma_c.hat_means(pb.spaces.prolongations["lam_n"]), gap, offset_t)
-
-    def unknowns(self, w: np.ndarray, lam_t: np.ndarray | None = None,
-                 lam_n: np.ndarray | None = None) -> np.ndarray:
-        """The unknown vector of ``problem.K`` from w (and the contact multipliers).
-
-        Recovers the element-local sigma, bubbles and u triangle by triangle and maps the
-        broken Raviart-Thomas rows to the continuous ones.
-        """
-        pb = self.problem
-        interface = self.T @ w + self.c0
-        values = np.zeros(pb.broken.fes.ndof)
-        values[self.local] = self._inner - np.einsum("eij,ej->ei", self._extension,
-                                                     interface[self.interface])
-        eta = self._ranges[peers.PEERS.index("eta")]
-        values[eta.start:eta.stop] = interface[:self.n_eta]
-        x = np.zeros(pb.n)
-        peers_part = pb.broken.to_conforming(values)
-        x[:len(peers_part)] = peers_part
-        if "phi1" in pb.blocks:
-            x[pb.index("phi1", "phi2")] = w[self.phi_index]
-        if lam_t is not None:
-            x[pb.index("lam_t")] = lam_t
-            x[pb.index("lam_n")] = lam_n
+    def unknowns(self, w: np.ndarray, F: np.ndarray) -> np.ndarray:
+        """The unknown vector of ``problem.K`` from the global unknowns x_I = ``w`` of the
+        right-hand side F: the element-local sigma, bubbles and u recovered triangle by
+        triangle, the broken Raviart-Thomas rows mapped to the conforming ones."""
+        n_b, n_p, n_mu, multipliers = self._sizes
+        f_L, _ = self._load(F)
+        z = np.zeros(len(self.interface) + self.local.size)
+        z[self.interface] = w
+        z[self.local.ravel()] = self.B_inv @ (f_L - self.A_LI @ w)
+        x = np.zeros(self.problem.n)
+        x[:n_p] = self.broken.to_conforming(z[:n_b])
+        x[multipliers] = z[n_b + 2 * n_mu:]
         return x
 
+    def solve(self, chol: SchurCholesky, y: np.ndarray, F: np.ndarray, z: np.ndarray
+              ) -> np.ndarray:
+        """The unknowns of ``problem.K`` for the right-hand side F and the contact
+        multipliers z (H factorised by ``chol``, y = ``chol.forward(self.rhs(F))``),
+        refined once against the residual of ``problem.K``: the broken copies of a
+        conforming function agree only to the round-off of the element solves, which the
+        rows of (3.62) amplify on graded meshes (Hertz at k = 1, level 2: the relative
+        residual of the equality rows 1.2e-9 without the step, 3.8e-13 after)."""
+        x = self.unknowns(chol.solve_with_last(y, z), F)
+        R = F - self.problem.apply(x)
+        R[self._contact] = 0.0  # the contact rows carry the tractions t(z)
+        dw = chol.solve_with_last(chol.forward(self.rhs(R)), np.zeros(len(z)))
+        return x + self.unknowns(dw, R)
 
-def _edge_coupling(broken_rt: ngs.FESpace, facet: ngs.FESpace) -> sp.csr_matrix:
-    """D[i, j] = int_{dT} mu_j (psi_i . n_T) ds for the broken RT_0 functions psi_i and the
-    edge multipliers mu_j (constant on every element edge: P0 times the RT_0 normal trace)."""
+
+def _element_dofs(matrix: sp.csr_matrix, n_local: int) -> np.ndarray:
+    """(triangles, local unknowns): the element-local unknowns (those numbered below
+    ``n_local``: the broken sigma rows, the bubbles, u) of every triangle, in increasing
+    order, the triangles by their first unknown.
+
+    Read from NGSolve's sparsity pattern of the broken PEERS matrix, which holds every pair
+    of unknowns of a triangle (explicit zeros included) and couples the local unknowns of
+    different triangles nowhere: the first column of a local unknown's row is the first
+    unknown of its triangle (:class:`HybridSystem` checks that no entry couples two).
+    """
+    if not matrix.has_sorted_indices:
+        matrix = matrix.sorted_indices()
+    first = matrix.indices[matrix.indptr[:n_local]]
+    triangles, label, counts = np.unique(first, return_inverse=True, return_counts=True)
+    if np.any(counts != counts[0]) or np.any(triangles >= n_local):
+        raise RuntimeError("the triangles do not have the same number of local unknowns")
+    return np.argsort(label, kind="stable").reshape(len(triangles), -1)
+
+
+def _first_copies(conforming: np.ndarray, n_p: int) -> np.ndarray:
+    """For every conforming PEERS unknown the first broken unknown that restricts it."""
+    first = np.empty(n_p, dtype=np.int64)
+    first[conforming[::-1]] = np.arange(len(conforming))[::-1]
+    return first
+
+
+def _edge_coupling(broken_rt: ngs.FESpace, order: int) -> sp.csr_matrix:
+    """D[i, j] = sum_T int_{dT} mu_j (psi_i . n_T) ds for the broken RT_k functions psi_i and
+    the P_k multipliers mu_j of the interior edges (``FacetFESpace(order=k)``)."""
+    mesh = broken_rt.mesh
+    facet = ngs.Compress(ngs.FacetFESpace(mesh, order=order))
     n = ngs.specialcf.normal(2)
-    dT = ngs.dx(element_boundary=True, intrules={ngs.SEGM: ngs.IntegrationRule(ngs.SEGM, 2)})
     form = ngs.BilinearForm(trialspace=facet, testspace=broken_rt)
-    form += facet.TrialFunction() * (broken_rt.TestFunction() * n) * dT
+    form += facet.TrialFunction() * (broken_rt.TestFunction() * n) * ngs.dx(
+        element_boundary=True, intrules={ngs.SEGM: ngs.IntegrationRule(ngs.SEGM, 2 * order)})
     form.Assemble()
-    return to_scipy(form.mat)
+    boundary = np.array(facet.GetDofs(mesh.Boundaries(".*")), dtype=bool)
+    return to_scipy(form.mat).tocsc()[:, np.flatnonzero(~boundary)].tocsr()
 
+
+def _block_inverse(blocks: np.ndarray) -> sp.bsr_matrix:
+    """The block-diagonal matrix of the inverses of ``blocks`` (triangles, size, size),
+    inverted in one batched LAPACK call."""
+    n, size, _ = blocks.shape
+    return sp.bsr_matrix((np.linalg.inv(blocks), np.arange(n), np.arange(n + 1)),
+                         shape=(n * size, n * size))
+
+
+def _element_schur(B_inv: sp.bsr_matrix, A_LI: sp.csr_matrix,
+                   chunk: int = SCHUR_CHUNK) -> sp.csr_matrix:
+    """C^T B^{-1} C for the block-diagonal B^{-1} (one block per triangle) and the coupling
+    C = ``A_LI`` of the element-local unknowns (rows, triangle by triangle) to the global
+    ones: the sum over the triangles of C_T^T B_T^{-1} C_T, each C_T the dense block of the
+    few global unknowns its triangle couples to. Computed ``chunk`` triangles at a time by
+    batched dense products (one matrix per triangle), which costs about half the two
+    sparse products B^{-1} C and C^T (B^{-1} C) (PEERS_2, 512 triangles, 25 065 unknowns:
+    0.023 s against 0.045 s); the sum of the element contributions is the same matrix up to
+    round-off."""
+    size = B_inv.blocksize[0]
+    n_tri, n_glob = B_inv.shape[0] // size, A_LI.shape[1]
+    A_LI = A_LI.tocsr()
+    A_LI.sum_duplicates()
+    # the global unknowns of every triangle: the union of its rows' columns, sorted
+    owner = sp.csr_matrix((np.ones(A_LI.shape[0]), (np.arange(A_LI.shape[0]) // size,
+                                                    np.arange(A_LI.shape[0]))),
+                          shape=(n_tri, A_LI.shape[0]))
+    # (ones, not |A_LI|: a product drops the sums that vanish, and NGSolve's pattern holds
+    # explicit zeros)
+    ones = sp.csr_matrix((np.ones(A_LI.nnz), A_LI.indices, A_LI.indptr), shape=A_LI.shape)
+    pattern = (owner @ ones).tocsr()
+    pattern.sort_indices()
+    counts = np.diff(pattern.indptr)
+    width = int(counts.max(initial=0))
+    slot = np.arange(pattern.nnz) - np.repeat(pattern.indptr[:-1], counts)
+    columns = np.full((n_tri, width), -1, dtype=np.int64)
+    columns[np.repeat(np.arange(n_tri), counts), slot] = pattern.indices
+    # the slot of every entry of A_LI in its triangle's list (the lists are sorted, and so
+    # are their keys triangle * n_glob + column over all triangles)
+    rows = np.repeat(np.arange(A_LI.shape[0]), np.diff(A_LI.indptr))
+    keys = np.repeat(np.arange(n_tri), counts) * n_glob + pattern.indices
+    where = np.searchsorted(keys, rows // size * n_glob + A_LI.indices)
+    entry_slot = slot[where]
+    inverse = B_inv.data
+    parts = []
+    for first in range(0, n_tri, chunk):
+        last = min(first + chunk, n_tri)
+        lo, hi = A_LI.indptr[first * size], A_LI.indptr[last * size]
+        C = np.zeros((last - first, size, width))
+        C[rows[lo:hi] // size - first, rows[lo:hi] % size, entry_slot[lo:hi]] = A_LI.data[lo:hi]
+        S = np.matmul(C.transpose(0, 2, 1), np.matmul(inverse[first:last], C))
+        cols = columns[first:last]
+        valid = (cols[:, :, None] >= 0) & (cols[:, None, :] >= 0)
+        parts.append((S[valid], np.broadcast_to(cols[:, :, None], S.shape)[valid],
+                      np.broadcast_to(cols[:, None, :], S.shape)[valid]))
+    data, i, j = (np.concatenate(p) for p in zip(*parts))
+    return sp.csr_matrix((data, (i, j)), shape=(n_glob, n_glob))

@@ -69,7 +69,6 @@ def linear_seconds(problem, backend: str) -> dict:
     from ...solvers.cholesky import SchurCholesky
     from ...solvers.hybrid import HybridSystem
     from ...solvers.linear import Factorization
-    from ...solvers.settings import Model
 
     start = time.perf_counter()
     if backend == "umfpack":
@@ -79,10 +78,10 @@ def linear_seconds(problem, backend: str) -> dict:
         fact.solve(problem.rhs[saddle])
         nnz = None
     elif backend == "hybrid-cholesky":
-        hybrid = HybridSystem(problem, Model.of(problem.scene))
+        hybrid = HybridSystem(problem, friction=problem.scene.has_friction)
         chol = SchurCholesky(hybrid.H, hybrid.contact_index)
         factorized = time.perf_counter()
-        hybrid.unknowns(chol.solve(hybrid.r))
+        hybrid.unknowns(chol.solve(hybrid.rhs(problem.rhs)), problem.rhs)
         nnz = chol.nnz
     else:
         raise ValueError(f"unknown backend {backend!r}")
