@@ -186,21 +186,26 @@ def _solve(problem: DiscreteProblem, settings: ActiveSetSettings, tol: float, or
 def _edge_stress(problem: DiscreteProblem, hybrid: HybridSystem, chol: SchurCholesky,
                  y: np.ndarray, forms, G: np.ndarray, b: np.ndarray) -> EdgeStress:
     """The contact problem whose Coulomb bound (3.123) is made of sigma_n on the fine
-    Gamma_C edges: one back substitution and the element solves give sigma for any z.
+    Gamma_C edges: for any z, the back substitution restricted to what those edges'
+    triangles read (:meth:`SchurCholesky.solver_on`) and their element solves
+    (:meth:`HybridSystem.functional`) give it.
 
     Its round-off is measured once: the stress of z = 0 (u_n = g, the largest) recovered so
     against the one refined on K (:meth:`HybridSystem.solve`); a nearly incompressible
     body amplifies it (cattaneo-mindlin, nu = 0.4999), and the Coulomb fixed point stops
     stagnating there rather than at the round-off of G."""
-    def sigma(z: np.ndarray, part=forms.T_n) -> np.ndarray:
-        return part @ hybrid.unknowns(chol.solve_with_last(y, z), problem.rhs)
+    positions, value = hybrid.functional(forms.T_n, problem.rhs)
+    solve = chol.solver_on(positions)
+
+    def sigma(z: np.ndarray) -> np.ndarray:
+        return value(solve(y, z))
 
     free = np.zeros(len(hybrid.contact_index))
     plain = sigma(free)
-    scale = max(float(np.max(np.abs(plain), initial=0.0)),
-                float(np.max(np.abs(sigma(free, forms.T_t)), initial=0.0)))
-    refined = forms.T_n @ hybrid.solve(chol, y, problem.rhs, free)
-    noise = float(np.max(np.abs(plain - refined), initial=0.0)) / (scale or 1.0)
+    x = hybrid.solve(chol, y, problem.rhs, free)
+    scale = max(float(np.max(np.abs(forms.T_n @ x), initial=0.0)),
+                float(np.max(np.abs(forms.T_t @ x), initial=0.0)))
+    noise = float(np.max(np.abs(plain - forms.T_n @ x), initial=0.0)) / (scale or 1.0)
     return EdgeStress(G, b, sigma, scale, noise)
 
 

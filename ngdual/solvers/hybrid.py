@@ -186,6 +186,38 @@ class HybridSystem:
         x[multipliers] = z[n_b + 2 * n_mu:]
         return x
 
+    def functional(self, T: sp.spmatrix, F: np.ndarray) -> tuple[np.ndarray, object]:
+        """(positions, value): the positions in x_I that ``T @ unknowns(w, F)`` reads, and
+        the affine function of ``w[positions]`` that gives it, for an operator T on the
+        PEERS unknowns of ``problem.K`` (e.g. sigma_n on the fine Gamma_C edges): only the
+        triangles holding T's unknowns are recovered."""
+        n_b, n_p, n_mu, multipliers = self._sizes
+        T = sp.csc_matrix(T)
+        if T[:, n_p:].nnz:
+            raise ValueError("T must act on the PEERS unknowns only")
+        read = np.diff(T.indptr[:n_p + 1]) > 0
+        conforming = self.broken.conforming
+        copies = read[conforming]          # the broken unknowns that restrict T's unknowns
+        triangles = np.flatnonzero(copies[self.local].any(axis=1))
+        local = self.local[triangles].ravel()
+        if np.count_nonzero(copies) != np.count_nonzero(copies[local]):
+            raise ValueError("T reads unknowns that are not element-local")
+        size = self.local.shape[1]
+        rows = (triangles[:, None] * size + np.arange(size)).ravel()
+        coupling = self.A_LI[rows]
+        positions = np.unique(coupling.indices)
+        inverse = sp.bsr_matrix((self.B_inv.data[triangles], np.arange(len(triangles)),
+                                 np.arange(len(triangles) + 1)), shape=(len(rows), len(rows)))
+        count = np.bincount(conforming, minlength=n_p)
+        mean = sp.csr_matrix((1.0 / count[conforming[local]], (conforming[local],
+                                                               np.arange(len(rows)))),
+                             shape=(n_p, len(rows)))
+        recover = (T[:, :n_p] @ mean @ inverse).tocsr()
+        f_L, _ = self._load(F)
+        offset = recover @ f_L[rows]
+        slope = (recover @ coupling[:, positions]).tocsr()
+        return positions, lambda values: offset - slope @ values
+
     def solve(self, chol: SchurCholesky, y: np.ndarray, F: np.ndarray, z: np.ndarray
               ) -> np.ndarray:
         """The unknowns of ``problem.K`` for the right-hand side F and the contact
