@@ -6,12 +6,13 @@ netgen polygon from its area and ``maxh``, plus the graded strips along sides wi
 smaller ``side_maxh``), the unknowns of (3.62) at the order k of PEERS_k
 (:func:`unknowns_per_element`: 7.5 per triangle at k = 0, Table 3.1 has X = 680 + M = 256
 + S = 81 + ... on 128 triangles; 24 at k = 1, 47.5 at k = 2) and the peak memory of a
-solve. The thesis' pairing (k = 0, coarse multipliers) peaks at about 2.5 kB per unknown
-with the active-set solver (Example 3.46 with Coulomb friction on level 8, 3.9e6 unknowns:
-9 GB) and 8.5 kB with the Uzawa algorithms and their saddle-point factorisation (0.6 GB on
-level 5 and 2.2 GB on level 6). Order k >= 1 and the facet multipliers are solved by the
-same hybridised system (:mod:`ngdual.solvers.hybrid`), whose peak per unknown
-:data:`BYTES_PER_UNKNOWN_ORDER` grows with the size of its element blocks.
+solve. Every order and multiplier family is solved by the same hybridised system
+(:mod:`ngdual.solvers.hybrid`), whose peak per unknown :data:`BYTES_PER_UNKNOWN_ORDER`
+grows with the size of its element blocks: about 2.5 kB at k = 0 (Example 3.46 with
+Coulomb friction on level 8, 3.9e6 unknowns: 9 GB; level 6 0.70 GB, the same as the
+thesis' own hybridisation that the solver replaced). The Uzawa algorithms and their
+saddle-point factorisation peak at 8.5 kB per unknown (0.6 GB on level 5 and 2.2 GB on
+level 6).
 :func:`check` refuses a run whose estimate exceeds the memory this process may use
 (:func:`available_memory`: the smallest of the machine's available memory, the address
 space left under ``ulimit -v`` and the room left in the process's cgroup), with the
@@ -33,14 +34,14 @@ from pathlib import Path
 import numpy as np
 
 from . import geometry
-from .forms.spaces import Variant, variant_of
+from .forms.spaces import variant_of
 from .scene import Geometry, Scene, SceneError
 
 UNKNOWNS_PER_ELEMENT = 7.5    # PEERS_0 (3.61): unknowns_per_element(0)
-# peak of a solve per unknown (factorisation, condensation, records), by solver.method
-BYTES_PER_UNKNOWN = {"auto": 2500.0, "active-set": 2500.0, "uzawa": 8500.0}
-# peak of a solve of order k (or with the facet multipliers) per unknown: the hybridised
-# system of order k; measured peaks of nd.solve on Example 3.46 without friction, consistent
+# peak per unknown of the Uzawa algorithms at order 0 (their saddle-point factorisation)
+BYTES_PER_UNKNOWN = {"uzawa": 8500.0}
+# peak of a solve of order k per unknown (either family): the hybridised system;
+# measured peaks of nd.solve on Example 3.46 without friction, consistent
 # ends (tests/test_budget_order.py): k = 0 facet level 5 0.36 GB; k = 1 level 4 0.37 GB,
 # level 5 0.79 GB; k = 2 level 4 0.69 GB, level 5 1.97 GB, level 6 7.9 GB (4.9 kB per
 # unknown); hertz-cylinder k = 2 level 4 3.2-3.4 GB (4.3 kB)
@@ -119,13 +120,15 @@ def estimate(geo: Geometry, level: int | None = None, method: str = "auto", orde
 
 def solve_memory(elements: float, method: str = "auto", order: int = 0,
                  multipliers: str = "coarse") -> float:
-    """Predicted peak bytes of a solve with ``method`` of PEERS_``order`` with the multiplier
-    family ``multipliers`` on a mesh of ``elements`` triangles (either family at order
-    k >= 1 and the facet family at k = 0: the hybridised system of order k)."""
-    if Variant(order, multipliers).hybridised:
-        return BASE_BYTES + BYTES_PER_UNKNOWN_ORDER[order] * unknowns_per_element(order) * elements
-    per_unknown = BYTES_PER_UNKNOWN.get(method, max(BYTES_PER_UNKNOWN.values()))
-    return BASE_BYTES + per_unknown * UNKNOWNS_PER_ELEMENT * elements
+    """Predicted peak bytes of a solve with ``method`` of PEERS_``order`` on a mesh of
+    ``elements`` triangles. Both multiplier families (``multipliers``) are solved by the
+    same hybridised system, whose peak per unknown depends on the order; the Uzawa
+    algorithms factorise the saddle-point system instead (measured at order 0; at least
+    the hybridised system's peak at order k)."""
+    per_unknown = BYTES_PER_UNKNOWN_ORDER[order]
+    if method == "uzawa":
+        per_unknown = max(BYTES_PER_UNKNOWN["uzawa"], per_unknown)
+    return BASE_BYTES + per_unknown * unknowns_per_element(order) * elements
 
 
 CGROUP = Path("/sys/fs/cgroup")  # where the cgroup file system is mounted

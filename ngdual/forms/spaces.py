@@ -25,21 +25,22 @@ class Variant:
     multipliers of ``family`` (``"coarse"``: continuous on the h~ meshes, ``"facet"``: P_k on
     the fine edges of T_h).
 
-    The thesis' pairing (3.61) is order 0 with the coarse family; every other variant is
-    solved through the hybridised system of order k (``hybridised``).
+    The thesis' triple (3.61) is order 0 with the coarse family (``thesis``): its spaces
+    are built by :meth:`Spaces.build` itself, every other variant's by
+    :meth:`Spaces._order_k`. Every variant is solved by the same methods.
 
-    >>> Variant(0, "coarse").hybridised, Variant(0, "facet").hybridised, Variant(1).hybridised
-    (False, True, True)
+    >>> Variant(0, "coarse").thesis, Variant(0, "facet").thesis, Variant(1).thesis
+    (True, False, False)
     """
 
     order: int = 0
     family: str = "coarse"
 
     @property
-    def hybridised(self) -> bool:
-        """Whether the spaces are those of order k (:meth:`Spaces._order_k`): every variant
-        except the thesis' P1 multipliers on h~ at k = 0."""
-        return self.family == "facet" or self.order > 0
+    def thesis(self) -> bool:
+        """Whether this is the thesis' triple (3.61): PEERS_0 with the P1 hats on h~ (and nu
+        on h^ with friction)."""
+        return self.family == "coarse" and self.order == 0
 
 
 def variant_of(scene: Scene) -> Variant:
@@ -90,7 +91,7 @@ class Spaces:
         """Spaces on ``mesh``; ``coarse`` carries coarse meshes over from an adaptive step
         (the facet multipliers live on the fine edges of ``mesh`` and need none)."""
         variant = variant_of(scene)
-        if variant.hybridised:
+        if not variant.thesis:
             return cls._order_k(scene, mesh, coarse, variant)
         comps = peers.peers_spaces(mesh)
         coarse = coarse or BoundaryMeshes.for_scene(scene, mesh)
