@@ -267,8 +267,8 @@ def _roundoff_probe(problem: DiscreteProblem, hybrid: HybridSystem, chol: SchurC
     perturbation[hybrid.contact_index] = 0.0
     dw = chol.solve_with_last(chol.forward(perturbation), np.zeros(len(contact)))
     dx = hybrid.unknowns(dw, np.zeros(problem.n))
-    scales = Scales.of(problem, x)
+    D, S = Scales.sizes(problem, x)
     others = np.ones(problem.n, dtype=bool)
     others[problem.sigma] = False
-    return max(float(np.max(np.abs(dx[problem.sigma]), initial=0.0)) / (scales.stress or 1.0),
-               float(np.max(np.abs(dx[others]), initial=0.0)) / (scales.displacement or 1.0))
+    return max(float(np.max(np.abs(dx[problem.sigma]), initial=0.0)) / (S or 1.0),
+               float(np.max(np.abs(dx[others]), initial=0.0)) / (D or 1.0))

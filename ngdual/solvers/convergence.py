@@ -70,13 +70,20 @@ class Scales:
     stress: float
     rows: np.ndarray
 
+    @staticmethod
+    def sizes(problem: DiscreteProblem, x: np.ndarray) -> tuple[float, float]:
+        """(D, S) of ``problem`` at ``x``, without the row sizes."""
+        D = displacement_scale(problem, x)
+        modulus, L = problem.units
+        S = max(modulus * D / L, float(np.max(np.abs(x[problem.index(*STRESS)]), initial=0.0)))
+        return D, S
+
     @classmethod
     def of(cls, problem: DiscreteProblem, x: np.ndarray) -> Scales:
         """The scales of ``problem`` at its solution ``x``."""
-        D = displacement_scale(problem, x)
+        D, S = cls.sizes(problem, x)
         modulus, L = problem.units
         sigma = problem.index(*STRESS)
-        S = max(modulus * D / L, float(np.max(np.abs(x[sigma]), initial=0.0)))
         reference = np.full(problem.n, D)
         reference[sigma] = S
         reference[problem.index("eta")] = D / L   # a rotation: a strain
