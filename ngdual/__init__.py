@@ -28,8 +28,12 @@ caller's choice, :func:`save_figure`.
 Taking the method apart (the tutorials): :func:`assemble` (the block system of eq. 3.62 on
 a mesh), :func:`friction_forms` (the operators of friction on the fine edges of Gamma_C),
 :func:`mesh_arrays` (the points and triangles the plots take), :class:`Expression` (a scene
-formula in ``x``, ``y`` as a NumPy or NGSolve function), :class:`Lesson` (a tutorial's
-coarse-or-full setting and where its pictures go), :mod:`rates` (the observed order in
+formula in ``x``, ``y`` as a NumPy or NGSolve function), :func:`coefficient` (a formula, or
+a vector or matrix of them, as an NGSolve coefficient function: an exact solution),
+:func:`l2_norm` (of a field or of its error), :func:`solve_primal` (the standard P_k
+displacement method with Nitsche contact, the method PEERS is compared with),
+:class:`Lesson` (a tutorial's coarse-or-full setting and where its pictures go),
+:mod:`rates` (the observed order in
 h_N = N^(-1/2)), :mod:`post` (element values, von Mises stress, the contact summary), and
 three subpackages with their modules: :mod:`scene` (the tables of a scene: ``nd.scene.Geometry``,
 ``nd.scene.Material``, ``nd.scene.Loads``, ``nd.scene.Contact``), :mod:`solvers` (the
@@ -84,6 +88,9 @@ _PUBLIC = {
     "Lesson": ("ngdual.studies.tutorials", "Lesson"),
     "friction_forms": ("ngdual.friction", "build_friction_forms"),
     "mesh_arrays": ("ngdual.mesh", "mesh_arrays"),
+    "coefficient": ("ngdual.expr", "coefficient"),
+    "l2_norm": ("ngdual.quantities", "l2_norm"),
+    "solve_primal": ("ngdual.studies.primal_peer", "primal_solution"),
     # modules, a subpackage with its modules: the scene's tables, the thesis' algorithms
     # one by one, exact solutions and checks, convergence rates
     "scene": ("ngdual.scene", None),

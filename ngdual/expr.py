@@ -245,3 +245,40 @@ class Expression:
             return float(self.text) == 0.0
         except ValueError:
             return False
+
+
+def coefficient(formulas):
+    """The NGSolve coefficient function of a formula, or of a vector or matrix of formulas.
+
+    Parameters
+    ----------
+    formulas : str, float, list of str or list of lists of str
+        A scalar formula in ``x``, ``y`` (:class:`Expression`), a vector ``[f_1, f_2]`` of
+        them (as a scene writes its loads) or a matrix ``[[f_11, f_12], [f_21, f_22]]``.
+
+    Returns
+    -------
+    ngsolve.CoefficientFunction
+        Scalar, of dimension ``len(formulas)``, or of dims (rows, columns).
+
+    Examples
+    --------
+    >>> import ngdual as nd
+    >>> nd.coefficient(["x*y", "-x"]).dim, tuple(nd.coefficient([["1", "x"], ["x", "2"]]).dims)
+    (2, (2, 2))
+    """
+    import ngsolve as ngs
+
+    if isinstance(formulas, (str, int, float)):
+        return Expression(formulas).coefficient()
+    rows = list(formulas)
+    if not rows:
+        raise ExpressionError("a vector or matrix of formulas needs at least one entry")
+    if all(isinstance(row, (str, int, float)) for row in rows):
+        return ngs.CF(tuple(Expression(f).coefficient() for f in rows))
+    rows = [list(row) for row in rows]
+    if len({len(row) for row in rows}) != 1:
+        raise ExpressionError(f"the rows of a matrix of formulas differ in length: "
+                              f"{[len(row) for row in rows]}")
+    return ngs.CF(tuple(Expression(f).coefficient() for row in rows for f in row),
+                  dims=(len(rows), len(rows[0])))

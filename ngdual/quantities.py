@@ -2,7 +2,8 @@
 
 NGSolve views of every unknown on the fine mesh (:func:`fields`) and the norms that the
 thesis tabulates (:func:`norms`): what the estimator, the adaptive loop and the
-post-processing read from a :class:`ngdual.solution.Solution`. The rotation is
+post-processing read from a :class:`ngdual.solution.Solution`; :func:`l2_norm` of any field,
+for an error against an exact solution. The rotation is
 ``eta`` (the thesis' eta in Tables 3.2/3.3); the estimator (4.50) is never called eta in a
 record (:mod:`ngdual.afem`).
 """
@@ -69,6 +70,29 @@ def fields(solution: Solution) -> Fields:
 
 def _boundary_integral(cf, mesh: ngs.Mesh, labels: list[str]) -> float:
     return float(ngs.Integrate(cf, mesh, ngs.BND, definedon=mesh.Boundaries("|".join(labels))))
+
+
+def l2_norm(value, mesh: ngs.Mesh, order: int = 10) -> float:
+    """||value||_{L^2(Omega)} = (int_Omega value : value dx)^(1/2) on ``mesh``.
+
+    Parameters
+    ----------
+    value : ngsolve.CoefficientFunction
+        A scalar, vector or matrix field: a field of :func:`fields`, an exact solution
+        (:func:`ngdual.expr.coefficient`) or their difference, the error.
+    mesh : ngsolve.Mesh
+        The mesh of the fields, e.g. ``solution.problem.fes.mesh``.
+    order : int
+        The degree of polynomials the quadrature integrates exactly on every triangle.
+
+    Examples
+    --------
+    >>> import ngdual as nd
+    >>> mesh = nd.build_mesh(nd.load_scene("thesis-3.46-frictionless").geometry, 1)
+    >>> round(nd.l2_norm(nd.coefficient(["1", "0"]), mesh) ** 2, 10)  # the area 8 x 2
+    16.0
+    """
+    return float(np.sqrt(ngs.Integrate(ngs.InnerProduct(value, value), mesh, order=order)))
 
 
 def norms(solution: Solution) -> dict:

@@ -19,18 +19,6 @@ FILES = sorted(TUTORIALS.glob("[0-9][0-9]_*.py")) + sorted(
     (TUTORIALS / "solutions").glob("[0-9][0-9]_*.py"))
 # NumPy and matplotlib with their submodules, NGSolve's drawing in a notebook
 ALLOWED = ("numpy", "matplotlib", "ngsolve.webgui", "netgen.webgui", "__future__")
-# TODO: the imports these files still need beyond ALLOWED; remove each once its file does
-# without (NGSolve's coefficient functions and forms, math, time, json, subprocess, sys)
-KNOWN_IMPORTS = {
-    "02_locking.py": {"import ngsolve as ngs"},
-    "06_estimator.py": {"import math", "import ngsolve as ngs"},
-    "08_your_own_scene.py": {"import json", "import subprocess", "import sys"},
-    "09_order_against_mesh_size.py": {"import time"},
-    "solutions/02_locking_solutions.py": {"import ngsolve as ngs"},
-    "solutions/06_estimator_solutions.py": {"import math", "import ngsolve as ngs"},
-    "solutions/07_adaptivity_solutions.py": {"import ngsolve as ngs"},
-    "solutions/09_order_against_mesh_size_solutions.py": {"import time"},
-}
 
 
 def allowed(module: str) -> bool:
@@ -76,11 +64,7 @@ def name_of(path: Path) -> str:
 @pytest.mark.parametrize("path", FILES, ids=name_of)
 def test_a_tutorial_imports_only_ngdual_as_nd_numpy_matplotlib_and_ngsolve_drawing(path):
     tree = ast.parse(path.read_text(), filename=str(path))
-    known = KNOWN_IMPORTS.get(name_of(path), set())
-    foreign = foreign_imports(tree)
-    assert [found for found in foreign if found.split(": ", 1)[1] not in known] == [], path.name
-    assert known <= {found.split(": ", 1)[1] for found in foreign}, (
-        f"{path.name} no longer needs some of KNOWN_IMPORTS: remove them")
+    assert foreign_imports(tree) == [], path.name
     assert private_names(tree) == [], path.name
 
 

@@ -44,7 +44,6 @@
 
 # %%
 import matplotlib.pyplot as plt
-import ngsolve as ngs
 import numpy as np
 
 import ngdual as nd
@@ -72,8 +71,8 @@ MAXH = 0.25                                              # netgen mesh size of l
 # exact solution for every $\nu$ when $\mu$ is fixed. A robust method must give the same
 # errors for $\nu = 0.3$ and $\nu = 0.4999$ ($\lambda/\mu \approx 5000$).
 #
-# The primal competitor is the standard $P_1$ method: find $u_h \in$ `VectorH1(order=1)`
-# with
+# The primal competitor is the standard $P_1$ method, `nd.solve_primal(scene, mesh=mesh)`:
+# find continuous piecewise linear $u_h$, zero on the boundary, with
 #
 # $$
 # \int_\Omega 2\mu\,\varepsilon(u_h) : \varepsilon(v)
@@ -85,7 +84,9 @@ MAXH = 0.25                                              # netgen mesh size of l
 # forces $\operatorname{div} u_h \approx 0$, which continuous $P_1$ fields can barely
 # satisfy: the method *locks*.
 #
-# The formulas below are scene expressions in `x` and `y` (see `ngdual.expr`).
+# The formulas below are scene expressions in `x` and `y` (see `nd.Expression`);
+# `nd.coefficient` turns a vector or a matrix of them into an NGSolve field, and
+# `nd.l2_norm` measures a field, or its error, in $L^2(\Omega)$.
 
 # %%
 P = {"p": "(T**2*(1 - T)**2)", "dp": "(2*T - 6*T**2 + 4*T**3)",
@@ -106,12 +107,7 @@ BODY_FORCE = [f"-{mu}*({term('d2p', 'dp')} + {term('p', 'd3p')})",
 SIDES = ["bottom", "right", "top", "left"]
 
 
-def cf(formula: str) -> ngs.CoefficientFunction:
-    return nd.Expression(formula).coefficient()
-
-
-u_exact = ngs.CF(tuple(cf(c) for c in EXACT_U))
-sigma_exact = ngs.CF(tuple(cf(c) for row in EXACT_SIGMA for c in row), dims=(2, 2))
+u_exact, sigma_exact = nd.coefficient(EXACT_U), nd.coefficient(EXACT_SIGMA)
 
 
 def square_scene(nu: float) -> nd.Scene:
@@ -132,25 +128,9 @@ lesson.save(nd.plot_geometry(square_scene(NUS[0]), level=LOCKING_LEVELS[-1],
             "geometry")
 
 
-def relative_l2(error, exact, mesh) -> float:
-    def norm(c):
-        return np.sqrt(ngs.Integrate(ngs.InnerProduct(c, c), mesh, order=10))
-    return float(norm(error) / norm(exact))
-
-
-def solve_p1(mesh, material: nd.scene.Material):
-    """Primal P1 displacement method; returns (u_h, σ_h = C ε(u_h))."""
-    lam, shear_modulus = material.lame
-    space = ngs.VectorH1(mesh, order=1, dirichlet="|".join(SIDES))
-    u, v = space.TnT()
-    a = ngs.BilinearForm(2 * shear_modulus * ngs.InnerProduct(ngs.Sym(ngs.Grad(u)),
-                                                              ngs.Sym(ngs.Grad(v))) * ngs.dx
-                         + lam * ngs.div(u) * ngs.div(v) * ngs.dx).Assemble()
-    force = ngs.CF(tuple(cf(c) for c in BODY_FORCE))
-    rhs = ngs.LinearForm(force * v * ngs.dx(bonus_intorder=4)).Assemble()
-    uh = ngs.GridFunction(space)
-    uh.vec.data = a.mat.Inverse(space.FreeDofs(), inverse="umfpack") * rhs.vec
-    return uh, 2 * shear_modulus * ngs.Sym(ngs.Grad(uh)) + lam * ngs.div(uh) * ngs.Id(2)
+def relative_l2(field, exact, mesh) -> float:
+    """||exact - field|| / ||exact|| in L²(Ω)."""
+    return nd.l2_norm(exact - field, mesh) / nd.l2_norm(exact, mesh)
 
 
 def errors(nu: float, level: int) -> dict:
@@ -159,12 +139,12 @@ def errors(nu: float, level: int) -> dict:
     solution = nd.solve(scene, level)
     mesh = solution.problem.fes.mesh
     f = nd.fields(solution)
-    uh, sigma_h = solve_p1(mesh, scene.material)
+    p1 = nd.solve_primal(scene, mesh=mesh)             # u_h in P1 and σ_h = C ε(u_h)
     return {"nu": nu, "level": level, "triangles": mesh.ne,
-            "peers_u": relative_l2(f.u - u_exact, u_exact, mesh),
-            "peers_sigma": relative_l2(f.sigma - sigma_exact, sigma_exact, mesh),
-            "p1_u": relative_l2(uh - u_exact, u_exact, mesh),
-            "p1_sigma": relative_l2(sigma_h - sigma_exact, sigma_exact, mesh)}
+            "peers_u": relative_l2(f.u, u_exact, mesh),
+            "peers_sigma": relative_l2(f.sigma, sigma_exact, mesh),
+            "p1_u": relative_l2(p1.u, u_exact, mesh),
+            "p1_sigma": relative_l2(p1.sigma, sigma_exact, mesh)}
 
 
 # %% [markdown]
@@ -227,7 +207,7 @@ for row in convergence:
 nu_max, level_max = NUS[-1], LOCKING_LEVELS[-1]
 incompressible = nd.solve(square_scene(nu_max), level_max)
 mesh = incompressible.problem.fes.mesh
-p1_u, p1_sigma = solve_p1(mesh, square_scene(nu_max).material)
+p1_sigma = nd.solve_primal(square_scene(nu_max), mesh=mesh).sigma
 peers_sigma = nd.fields(incompressible).sigma
 top = float(np.max(nd.post.element_values(mesh, nd.post.von_mises(sigma_exact, nu_max))[2]))
 for name, field in (("exact", sigma_exact), ("PEERS", peers_sigma), ("P1", p1_sigma)):
@@ -244,7 +224,7 @@ for name, field in (("exact", sigma_exact), ("PEERS", peers_sigma), ("P1", p1_si
 
 # %%
 mean_stress = {}
-points, triangles, _ = nd.post.element_values(mesh, ngs.CF(0))
+points, triangles = nd.mesh_arrays(mesh)
 for name, field in (("PEERS", peers_sigma), ("P1", p1_sigma)):
     mean_stress[name] = nd.post.element_values(mesh, 0.5 * (field[0, 0] + field[1, 1]))[2]
 scale = float(np.max(np.abs(mean_stress["P1"])))
@@ -278,8 +258,8 @@ lesson.results({"locking_sweep": sweep, "convergence": convergence, "ratios": ra
 # Solutions: `tutorials/solutions/02_locking_solutions.py`.
 #
 # 1. **Higher order does not cure locking by itself.** Replace the $P_1$ method by $P_2$
-#    (`VectorH1(order=2)`). Compute the error ratio between $\nu = 0.4999$ and
-#    $\nu = 0.3$ for the stress. Is $P_2$ locking-free on these meshes?
+#    (`nd.solve_primal(scene, mesh=mesh, order=2)`). Compute the error ratio between
+#    $\nu = 0.4999$ and $\nu = 0.3$ for the stress. Is $P_2$ locking-free on these meshes?
 # 2. **Counting divergence-free fields.** As $\lambda \to \infty$ the $P_1$ solution is
 #    driven into the subspace
 #    $\{v_h \in P_1 : v_h = 0 \text{ on } \partial\Omega,\ \operatorname{div} v_h = 0

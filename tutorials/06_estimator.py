@@ -50,11 +50,8 @@
 # ## Parameters
 
 # %%
-import math
-
 import matplotlib.pyplot as plt
 import matplotlib.tri as mtri
-import ngsolve as ngs
 import numpy as np
 from matplotlib.colors import LogNorm
 
@@ -114,13 +111,13 @@ mesh = solution.problem.fes.mesh
 summed = est.summed()
 print(f"level {THESIS_LEVEL}: {mesh.ne} triangles, eta = {est.total:.4e}")
 for name, value in sorted(summed.items(), key=lambda item: -item[1]):
-    print(f"  {name:15s} {math.sqrt(value):10.3e}   ({100 * value / est.total**2:5.1f} % of eta^2)")
+    print(f"  {name:15s} {np.sqrt(value):10.3e}   ({100 * value / est.total**2:5.1f} % of eta^2)")
 
 
 def plot_terms(mesh, terms: dict, title: str, columns: int = 2):
     """One tripcolor panel per (squared) indicator term, log colour scale, zeros blank."""
     tri = mtri.Triangulation(*nd.mesh_arrays(mesh)[0].T, nd.mesh_arrays(mesh)[1])
-    rows = math.ceil(len(terms) / columns)
+    rows = int(np.ceil(len(terms) / columns))
     largest = max(float(np.max(values)) for values in terms.values())
     fig, axes = plt.subplots(rows, columns, squeeze=False, figsize=(
         6.5 * columns, 6.5 * rows * np.ptp(tri.y) / np.ptp(tri.x) + 1.2))
@@ -185,7 +182,7 @@ div_u = grad[0][0] + grad[1][1]
 sigma = [[(grad[i][j] + grad[j][i]) * mu + (div_u * lam if i == j else 0) for j in range(2)]
          for i in range(2)]
 div_sigma = [sigma[i][0].dx() + sigma[i][1].dy() for i in range(2)]
-roof = [sigma[i][0] / math.sqrt(2) + sigma[i][1] / math.sqrt(2) for i in range(2)]  # n = (1, 1)/√2
+roof = [sigma[i][0] / np.sqrt(2) + sigma[i][1] / np.sqrt(2) for i in range(2)]  # n = (1, 1)/√2
 smooth = nd.Scene(name="pentagon-manufactured",
                   geometry=nd.scene.Geometry(kind="polygon", maxh=MAXH,
                                     points=[(0, 0), (2, 0), (2, 1), (1, 2), (0, 1)],
@@ -199,21 +196,18 @@ smooth = nd.Scene(name="pentagon-manufactured",
 lesson.save(nd.plot_geometry(smooth, level=LEVELS[-1]), "geometry_smooth")
 
 
-def cf(*parts: nd.verification.Piecewise, dims=None) -> ngs.CoefficientFunction:
-    values = tuple(nd.Expression(p.text()).coefficient() for p in parts)
-    return values[0] if len(values) == 1 else ngs.CF(values, dims=dims)
-
-
-EXACT = (cf(*sigma[0], *sigma[1], dims=(2, 2)), cf(*div_sigma), cf(*u),
-         cf((grad[0][1] - grad[1][0]) / 2))
+# σ, div σ, u and η as NGSolve fields: nd.coefficient of their formulas
+EXACT = (nd.coefficient([[c.text() for c in row] for row in sigma]),
+         nd.coefficient([c.text() for c in div_sigma]), nd.coefficient([c.text() for c in u]),
+         nd.coefficient(((grad[0][1] - grad[1][0]) / 2).text()))
 
 
 def exact_error(solution) -> float:
     """e^2 = ||σ - σ_h||^2 + ||div(σ - σ_h)||^2 + ||u - u_h||^2 + ||η - η_h||^2, exactly."""
     f = nd.fields(solution)
-    differences = [exact - h for exact, h in zip(EXACT, (f.sigma, f.div_sigma, f.u, f.eta))]
-    return math.sqrt(sum(ngs.Integrate(ngs.InnerProduct(d, d), solution.problem.fes.mesh,
-                                       order=8) for d in differences))
+    mesh = solution.problem.fes.mesh
+    return float(np.sqrt(sum(nd.l2_norm(exact - h, mesh, order=8) ** 2 for exact, h in
+                             zip(EXACT, (f.sigma, f.div_sigma, f.u, f.eta)))))
 
 
 # %% [markdown]
@@ -230,9 +224,9 @@ for level in LEVELS:
     l2, hdiv = nd.estimate(solution_s), nd.estimate(solution_s, asymmetry="hdiv")
     rows.append({"level": level, "ndof": int(sum(solution_s.problem.spaces.dofs().values())),
                  "error": exact_error(solution_s), "eta": l2.total, "eta_hdiv": hdiv.total,
-                 "terms": {k: math.sqrt(v) for k, v in l2.summed().items()},
-                 "as_l2": math.sqrt(l2.summed()["asymmetry"]),
-                 "as_hdiv": math.sqrt(hdiv.summed()["asymmetry"])})
+                 "terms": {k: float(np.sqrt(v)) for k, v in l2.summed().items()},
+                 "as_l2": float(np.sqrt(l2.summed()["asymmetry"])),
+                 "as_hdiv": float(np.sqrt(hdiv.summed()["asymmetry"]))})
 ndofs = [r["ndof"] for r in rows]
 for key in ("error", "eta"):  # nd.rates: the order in h_N = N^(-1/2)
     for row, rate in zip(rows[1:], nd.rates.observed_rates(ndofs, [r[key] for r in rows])[1:]):

@@ -19,6 +19,9 @@ tables of ``ngdual verify``. :mod:`ngdual.verification.infsup`: the discrete inf
 of the PEERS triple (Lemma 3.28) as the smallest singular value of b + s.
 """
 
+import importlib
+import importlib.util
+
 from .analytic import (
            CattaneoMindlin,
            FlatPunch,
@@ -61,3 +64,11 @@ __all__ = ["CASES", "CattaneoMindlin", "ExactSolution", "FlatPunch", "HertzConta
            "intersection", "manufactured_case", "manufactured_study", "mcewen_approach",
            "pressure_errors", "print_study", "symmetric_difference", "traction_errors",
            "traction_profile", "tresca_case", "volume_errors", "wedge"]
+
+
+def __getattr__(name: str):
+    """A module of this package on first use (``nd.verification.corner``), also when another
+    module imported the package before ``nd.verification`` was first read (PEP 562)."""
+    if name.startswith("__") or importlib.util.find_spec(f"{__name__}.{name}") is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    return importlib.import_module(f"{__name__}.{name}")

@@ -4,9 +4,7 @@
 # Each exercise is one section; all run in seconds with `NGDUAL_QUICK=1`.
 
 # %%
-
 import matplotlib.pyplot as plt
-import ngsolve as ngs
 import numpy as np
 
 import ngdual as nd
@@ -25,7 +23,8 @@ def adapt_until(scene, marking, theta, max_dofs, level=1, indicator="indicators"
     """SOLVE-ESTIMATE-MARK-REFINE until N >= max_dofs, marking with any indicator array.
 
     ``indicator`` names an `Estimate` attribute ("indicators", "eta_sigma", "eta_u").
-    Returns one row (ndof, eta, error or None) per step and the last mesh.
+    Returns one row (ndof, eta, error or None) per step, the last mesh and its boundary
+    meshes (`nd.BoundaryMeshes`: the fine edges of Γ_N and Γ_C grouped under coarse ones).
     """
     mesh = nd.build_mesh(scene.geometry, level)
     coarse = nd.BoundaryMeshes.for_scene(scene, mesh)
@@ -40,7 +39,7 @@ def adapt_until(scene, marking, theta, max_dofs, level=1, indicator="indicators"
             break
         marked = nd.mark(getattr(estimated, indicator), theta, marking)         # MARK
         mesh, coarse = nd.refine_with_boundary(scene, mesh, coarse, marked)  # REFINE
-    return rows, mesh
+    return rows, mesh, coarse
 
 
 # %% [markdown]
@@ -65,7 +64,7 @@ def exact_error(solution) -> float:
 
 dorfler, curves = {}, {}
 for theta in THETAS:
-    rows, _ = adapt_until(l_shape, "dorfler", theta, TARGET_DOFS, error=exact_error)
+    rows, _, _ = adapt_until(l_shape, "dorfler", theta, TARGET_DOFS, error=exact_error)
     ndofs, errors = [r["ndof"] for r in rows], [r["error"] for r in rows]
     curves[theta] = (ndofs, errors)
     dorfler[str(theta)] = {"steps": len(rows), "ndof": ndofs[-1], "error": errors[-1],
@@ -100,18 +99,19 @@ lesson.save(fig, "dorfler_theta")
 
 
 # %%
-def edges_on(mesh: ngs.Mesh, label: str) -> int:
-    return sum(1 for el in mesh.Elements(ngs.BND) if el.mat == label)
+def fine_edges(boundary_mesh) -> int:
+    """The number of fine edges under a coarse boundary mesh (h~ of Γ_N or of Γ_C)."""
+    return len(boundary_mesh.fine_edges()[0])
 
 
-thesis = nd.load_scene("thesis-3.46-coulomb")
+thesis = nd.load_scene("thesis-3.46-coulomb")     # Γ_N is the top, Γ_C the bottom
 by_indicator, meshes = {}, {}
 for indicator in ("indicators", "eta_sigma"):
-    rows, mesh = adapt_until(thesis, "fraction", 0.2, 10**9, level=2, indicator=indicator,
-                             max_steps=THESIS_STEPS)
+    rows, mesh, coarse = adapt_until(thesis, "fraction", 0.2, 10**9, level=2,
+                                     indicator=indicator, max_steps=THESIS_STEPS)
     meshes[indicator] = mesh
-    by_indicator[indicator] = {"elements": mesh.ne, "top_edges": edges_on(mesh, "top"),
-                               "bottom_edges": edges_on(mesh, "bottom"),
+    by_indicator[indicator] = {"elements": mesh.ne, "top_edges": fine_edges(coarse.neumann),
+                               "bottom_edges": fine_edges(coarse.contact),
                                "eta": [r["eta"] for r in rows]}
     row = by_indicator[indicator]
     print(f"marking with {indicator:9s}: {row['elements']} triangles, {row['top_edges']} "

@@ -159,8 +159,10 @@ def solve_primal(mesh: ngs.Mesh, *, E: float, nu: float, dirichlet, neumann=(), 
 
     ``dirichlet``, ``neumann``, ``contact``: lists of boundary labels of ``mesh``
     (``displacement`` prescribed on the first, ``traction`` on the second; sides in none of
-    them are traction free). Loads are pairs of numbers / formulas in x, y / CFs or a
-    2-vector CF; ``gap`` and ``tresca_bound`` scalars of the same kinds. ``gap`` may also be
+    them are traction free). Without ``contact`` labels the problem is linear elasticity,
+    solved in one Newton step, and the contact quantities of the result are zero or empty.
+    Loads are pairs of numbers / formulas in x, y / CFs or a 2-vector CF; ``gap`` and
+    ``tresca_bound`` scalars of the same kinds. ``gap`` may also be
     a function ``gap(x, y, n_x, n_y)`` of the point and the outward unit normal n of
     Gamma_C that takes numpy arrays and NGSolve coefficient functions alike (the distance
     to a foundation line along n, :func:`ngdual.scene.contact.foundation_gap`): on a curved
@@ -198,8 +200,6 @@ def solve_primal(mesh: ngs.Mesh, *, E: float, nu: float, dirichlet, neumann=(), 
     for label in dirichlet + neumann + contact:
         if label not in known:
             raise ValueError(f"unknown boundary label {label!r} (mesh has {sorted(known)})")
-    if not contact:
-        raise ValueError("contact needs at least one boundary label")
 
     mu, lam = lame(E, nu)
     fes = ngs.VectorH1(mesh, order=order, dirichlet="|".join(dirichlet))
@@ -245,7 +245,8 @@ def solve_primal(mesh: ngs.Mesh, *, E: float, nu: float, dirichlet, neumann=(), 
         form += 1 / beta * _project(pt, s) * (theta * st_v - beta * ut_v)
         if theta != 0:
             form += -theta / beta * st_u * st_v
-    a += form * dsc
+    if contact:
+        a += form * dsc
 
     f = ngs.LinearForm(fes)
     f += _vector(body_force) * v * ngs.dx
@@ -329,12 +330,14 @@ def solve_primal(mesh: ngs.Mesh, *, E: float, nu: float, dirichlet, neumann=(), 
     in_contact = ngs.IfPos(p_cf, 1.0, 0.0)
     pt_h = st_h - beta * ut_h
     stick = ngs.IfPos(s_h - ngs.IfPos(pt_h, pt_h, -pt_h), 1.0, 0.0)
-    contact_force, tangential_force, contact_length, stick_length = facet_integral(
-        [p_cf, lt_cf, in_contact, in_contact * stick], mesh, contact, bonus_intorder=12)
+    contact_force = tangential_force = contact_length = stick_length = 0.0
+    if contact:
+        contact_force, tangential_force, contact_length, stick_length = facet_integral(
+            [p_cf, lt_cf, in_contact, in_contact * stick], mesh, contact, bonus_intorder=12)
     if law == "none":
         stick_length = 0.0
 
-    edges = ContactEdges.of(mesh, contact)
+    edges = ContactEdges.of(mesh, contact) if contact else ContactEdges.none()
 
     def pointwise(points: np.ndarray):
         k = edges.locate(points)
@@ -365,7 +368,7 @@ def solve_primal(mesh: ngs.Mesh, *, E: float, nu: float, dirichlet, neumann=(), 
     mid = 0.5 * (edges.p0 + edges.p1)
     order_x = np.argsort(mid[:, 0], kind="stable")
     mid = mid[order_x]
-    p_mid, t_mid = pointwise(mid)
+    p_mid, t_mid = pointwise(mid) if contact else (np.zeros(0), np.zeros(0))
     times["total"] = time.perf_counter() - t_total
     return PrimalResult(u=u_h, sigma=sigma_h, ndof=fes.ndof, newton_iterations=iterations,
                         residuals=residuals, times=times, converged=converged,

@@ -21,6 +21,12 @@ class ContactEdges:
     tangent: np.ndarray
 
     @classmethod
+    def none(cls) -> ContactEdges:
+        """No edges: a problem without Gamma_C."""
+        empty = np.zeros((0, 2))
+        return cls(empty, empty, np.zeros(0), empty, empty)
+
+    @classmethod
     def of(cls, mesh: ngs.Mesh, labels: list[str]) -> ContactEdges:
         mask = mesh.Boundaries("|".join(labels)).Mask()
         pts = np.array([v.point for v in mesh.vertices])

@@ -34,7 +34,7 @@ def primal_arguments(scene) -> dict:
     mesh and the order): material, boundary labels, loads, gap and friction law. Tresca
     bounds and free ends are the scene's; "thesis" end values of Gamma_C (lambda = 0 at a
     clamped end) have no primal counterpart and are refused."""
-    if scene.contact.ends == "thesis":
+    if scene.has_contact and scene.contact.ends == "thesis":
         raise ValueError("the peer solves the consistent problem: set contact.ends = "
                          "\"consistent\" (the thesis' end values contradict u = u_D)")
     law = scene.friction.law
@@ -47,18 +47,64 @@ def primal_arguments(scene) -> dict:
         tresca_bound=scene.friction.bound if law == "tresca" else None)
 
 
+def primal_solution(scene, level: int | None = None, order: int = 1, *, mesh=None,
+                    mixed: bool = False, **settings) -> PrimalResult:
+    """Solve ``scene`` by the primal method: P``order`` Lagrange displacements, Nitsche contact.
+
+    The standard displacement method, the one PEERS is compared with: find u_h in
+    P_order with u_h = u_D on Gamma_D and
+
+        int_Omega 2 mu eps(u_h) : eps(v) + lambda div u_h div v dx + (Nitsche terms on Gamma_C)
+            = int_Omega f . v dx + int_Gamma_N t_0 . v ds
+
+    for all v vanishing on Gamma_D, with sigma_h = 2 mu eps(u_h) + lambda div u_h I
+    (:func:`~.nitsche.solve_primal`, which states the Nitsche terms; without Gamma_C the
+    problem is linear elasticity). The scene's material, loads, gap and friction law are
+    used as they are (:func:`primal_arguments`).
+
+    Parameters
+    ----------
+    scene : ngdual.Scene
+        A valid scene; its ``contact.ends`` must be "consistent" if it has a Gamma_C.
+    level : int, optional
+        The mesh level (default: the scene's level); ignored when ``mesh`` is given.
+    order : int
+        The polynomial degree of the displacement, 1 to 4.
+    mesh : ngsolve.Mesh, optional
+        Solve on this mesh, e.g. the one of a PEERS solution to compare with.
+    mixed : bool
+        The Taylor-Hood displacement-pressure form (order >= 2), which does not lock.
+    **settings
+        The Nitsche parameters and Newton's tolerance of :func:`~.nitsche.solve_primal`
+        (``gamma0``, ``theta``, ``tol``, ``max_newton``).
+
+    Returns
+    -------
+    PrimalResult
+        ``u`` the displacement (an NGSolve GridFunction), ``sigma`` its stress, the contact
+        forces and the pressure on Gamma_C.
+
+    Examples
+    --------
+    >>> import ngdual as nd
+    >>> scene = nd.load_scene("hertz-cylinder")
+    >>> p1 = nd.solve_primal(scene, 2)                                  # doctest: +SKIP
+    >>> p1.contact_force                                                # doctest: +SKIP
+    """
+    from ...mesh import build_mesh
+
+    mesh = build_mesh(scene.geometry, level) if mesh is None else mesh
+    return solve_primal(mesh, **primal_arguments(scene), order=order, mixed=mixed, **settings)
+
+
 def solve_scene_primal(scene, level: int, order: int, **kw) -> tuple[PrimalResult, float]:
-    """Solve an ngdual scene (its mesh on ``level``, :func:`primal_arguments`) by the peer
+    """Solve an ngdual scene (its mesh on ``level``, :func:`primal_solution`) by the peer
     with P``order`` elements, in the Taylor-Hood form (P``order`` - P``order-1``) for
     order >= 2 and nu >= ``NEARLY_INCOMPRESSIBLE``; returns the result and the wall time,
     meshing included."""
-    from ...mesh import build_mesh
-
-    arguments = primal_arguments(scene)
     mixed = order >= 2 and scene.material.nu >= NEARLY_INCOMPRESSIBLE
     start = time.perf_counter()
-    mesh = build_mesh(scene.geometry, level)
-    result = solve_primal(mesh, **arguments, order=order, mixed=mixed, **kw)
+    result = primal_solution(scene, level, order, mixed=mixed, **kw)
     return result, time.perf_counter() - start
 
 
