@@ -84,7 +84,8 @@ def result_record(solution: Solution) -> dict:
     """The result record of ``ngdual solve`` (``result.json``, plain JSON-serialisable data):
     scene, level, method, DOFs, the norms of Tables 3.2/3.3, the contact summary, iterations,
     residuals, timings and versions; ``warnings`` lists the failed physics checks (code,
-    message, value, tolerance; :mod:`ngdual.checks`)."""
+    message, value, tolerance; :mod:`ngdual.checks`); ``accuracy`` the method, estimate,
+    solves and time of a solve to a tolerance (:mod:`ngdual.accuracy`)."""
     pb = solution.problem
     t = solution.timings
     # four phases, assemble, factorize, solve and total: the Gamma_C condensation is part of
@@ -93,7 +94,7 @@ def result_record(solution: Solution) -> dict:
                "factorize": float(t.get("factorize", 0.0)),
                "solve": float(t.get("solve", 0.0) + t.get("condense", 0.0)),
                "total": float(t.get("total", 0.0))}
-    return {
+    record = {
         "scene": pb.scene.name,
         "level": pb.level,
         "converged": bool(solution.converged),
@@ -108,6 +109,9 @@ def result_record(solution: Solution) -> dict:
         "parameters": pb.scene.to_dict(),
         "versions": versions(),
     }
+    if solution.accuracy is not None:  # a solve to a tolerance: how it was reached
+        record["accuracy"] = dict(solution.accuracy)
+    return record
 
 
 def write_vtk(solution: Solution, filename: str) -> list[str]:

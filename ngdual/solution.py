@@ -58,7 +58,9 @@ class Solution:
     ``roundoff`` is the relative round-off level of the computed unknowns where the solver
     measures it (the active-set method, :mod:`ngdual.solvers.active_set`): the accuracy to
     which two solves of the same problem can agree; ``residuals`` hold the convergence
-    test's residuals only (:mod:`ngdual.solvers.convergence`).
+    test's residuals only (:mod:`ngdual.solvers.convergence`). ``accuracy`` describes the
+    adaptive run that produced a solution to a tolerance (:func:`ngdual.solve` with ``tol``,
+    :func:`ngdual.accuracy.solve_to_tolerance`): its method, estimate, solves and time.
     """
 
     problem: DiscreteProblem
@@ -76,6 +78,7 @@ class Solution:
     settings: object | None = None
     warnings: list[CheckWarning] = field(default_factory=list)
     roundoff: float | None = None
+    accuracy: dict | None = None
     trace: object | None = field(default=None, repr=False, compare=False)
 
     def part(self, *names: str) -> np.ndarray:

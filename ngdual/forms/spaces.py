@@ -55,6 +55,16 @@ def variant_of(scene: Scene) -> Variant:
     return Variant(disc.order, disc.family)
 
 
+def declared_variant(scene: Scene) -> Variant | None:
+    """The variant ``scene`` declares (``discretisation.order`` or ``.multipliers`` set in
+    its document or overrides), None where it leaves both to their defaults."""
+    from ..scene import given_keys
+
+    if given_keys(scene, "discretisation") & {"order", "multipliers"}:
+        return variant_of(scene)
+    return None
+
+
 def boundary_regex(labels: list[str]) -> str:
     return "|".join(labels)
 

@@ -49,6 +49,7 @@ from .domain import (
 from .errors import SceneError, SceneTypeError
 from .load import (
     apply_overrides,
+    given_keys,
     load_scene,
     read_toml,
     scene_from_dict,
@@ -99,5 +100,5 @@ __all__ = ["BENCHMARK_KINDS", "Benchmark", "CONTACT_ENDS", "Contact", "DISCRETE_
            "ROLES", "SECTIONS", "SOLVER_METHODS", "STRESS_UNITS", "Scene", "SceneError",
            "SceneTypeError", "Solver", "Units", "apply_overrides", "check_level",
            "contact_junctions", "contact_samples", "ensure_valid", "foundation_line", "gap_at",
-           "load_scene", "read_toml", "role_of", "scene_from_dict", "shipped_scenes", "validate",
-           "validate_geometry"]
+           "given_keys", "load_scene", "read_toml", "role_of", "scene_from_dict",
+           "shipped_scenes", "validate", "validate_geometry"]

@@ -1,0 +1,128 @@
+"""Accuracy on demand: the contact pressure (the stress, without contact) to a tolerance by
+the fastest method ngdual has, in one call: ``nd.solve(scene, tol=0.01)``,
+``ngdual solve SCENE --tol 0.01``.
+
+The method is chosen by a rule (:func:`fastest_method`, docs/theory/order.md, Accuracy on
+demand) derived from the work-precision study of the six problems
+(docs/gallery/work_precision_table.csv, the least wall time to 5, 2 and 1 % true error):
+
+* the goal: the pressure goal where the scene has a contact boundary (what a contact
+  engineer asks for), the stress goal (4.50) otherwise;
+* the multipliers: the facet family (the coarse family of order k never paid: 5 % pressure
+  on Example 3.46 in 13 s at k = 1 against 0.21 s with the facet one);
+* the order: k = 1, the fastest robust order. At 1 % pressure with the pressure goal it
+  is the fastest order on three problems (the flat punch, Hertz, the wedge) and within
+  1.6 times the fastest on the other three (Example 3.46 without friction 0.44 s against
+  0.28 s at k = 2; with Coulomb friction 0.52 against 0.49 s; Cattaneo-Mindlin 1.65 against
+  1.24 s); k = 2 is up to 1.9 times slower than the fastest (the punch) and order 0 2.3
+  to 15 times (Hertz 2.06 s, the punch 1.09 s);
+* the loop: Doerfler marking with the tolerance runs' parameter and least growth of the
+  unknowns per step (:data:`ngdual.loop_defaults.THETA_TOL`, ``GROWTH_TOL``), from the
+  coarsest level (``LEVEL_TOL``), stopping by the goal's estimate.
+
+A scene that declares its ``[discretisation]`` keeps it, and the thesis' scenes (Example
+3.46) keep the thesis' order 0 unless asked (``order=``), so that what they reproduce does
+not change with a tolerance.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import asdict, dataclass
+
+from .forms.spaces import Variant, declared_variant, variant_of
+from .scene import Scene, SceneError, ensure_valid
+from .solution import Solution
+from .solvers.dispatch import with_discretisation
+
+FASTEST_ORDER = 1          # the rule's order beyond the thesis (module docstring)
+FASTEST_FAMILY = "facet"
+
+
+@dataclass(frozen=True)
+class Method:
+    """A method chosen to reach a tolerance: PEERS_``order`` with the ``multipliers``
+    family, adapted by ``goal``'s estimate; ``reason`` says why it was chosen."""
+
+    order: int
+    multipliers: str
+    goal: str
+    reason: str
+
+    def describe(self) -> str:
+        """The method in a few words, e.g. ``"adaptive, pressure goal, k = 1, facet"``."""
+        return f"adaptive, {self.goal} goal, k = {self.order}, {self.multipliers}"
+
+
+def fastest_method(scene: Scene, order: int | None = None,
+                   multipliers: str | None = None) -> Method:
+    """The method :func:`solve_to_tolerance` runs on ``scene`` (module docstring): the
+    order and the family given here, else those the scene declares, else the thesis'
+    order 0 for a thesis scene, else :data:`FASTEST_ORDER` with the facet family."""
+    goal = "pressure" if scene.has_contact else "stress"
+    declared = declared_variant(scene)
+    if order is not None or multipliers is not None:
+        chosen, reason = variant_of(with_discretisation(scene, order, multipliers)), "as asked"
+    elif declared is not None:
+        chosen, reason = declared, "the scene's [discretisation]"
+    elif _thesis(scene):
+        chosen, reason = variant_of(scene), "a thesis scene keeps the thesis' order 0"
+    else:
+        chosen = Variant(FASTEST_ORDER, FASTEST_FAMILY)
+        reason = "the fastest robust order of the work-precision study"
+    return Method(chosen.order, chosen.family, goal, reason)
+
+
+def _thesis(scene: Scene) -> bool:
+    """Whether ``scene`` is one of the thesis' (Example 3.46)."""
+    return scene.geometry.kind == "thesis-3.46"
+
+
+def solve_to_tolerance(scene: Scene, tol: float, *, order: int | None = None,
+                       multipliers: str | None = None, level: int | None = None,
+                       allow_large: bool = False, on_step=None) -> Solution:
+    """The solution whose goal (the contact pressure; the stress without contact) is
+    estimated to ``tol`` relative error, by the method of :func:`fastest_method`.
+
+    The adaptive loop (:func:`ngdual.afem.adapt`) runs from the coarsest level (or from
+    ``level``) and stops by the goal's estimate. The returned solution is that of the last
+    step, and its ``accuracy`` says what was done: the method and why it was chosen, ``tol``, the
+    relative estimate reached, the steps (solves), the unknowns, the loop's wall time and
+    how the loop stopped (``stopped_by``; only ``"tol"`` means the tolerance was reached,
+    otherwise a warning is part of the solution's record). ``on_step`` is passed to the
+    loop.
+
+    Raises
+    ------
+    SceneError
+        For a bad ``tol`` (a number in (0, 1)), ``order`` or ``multipliers``.
+    """
+    from .afem import adapt
+
+    ensure_valid(scene)
+    if isinstance(tol, bool) or not isinstance(tol, (int, float)) or not 0.0 < tol < 1.0:
+        raise SceneError("tol", f"must be a relative error in (0, 1), e.g. 0.01, got {tol!r}")
+    method = fastest_method(scene, order, multipliers)
+    last: dict = {}
+
+    def keep(record, solution, estimated, marked):
+        last["solution"] = solution
+        if on_step is not None:
+            on_step(record, solution, estimated, marked)
+
+    start = time.perf_counter()
+    history = adapt(scene, goal=method.goal, tol=float(tol), order=method.order,
+                    multipliers=method.multipliers, level=level, on_step=keep,
+                    allow_large=allow_large)
+    seconds = time.perf_counter() - start
+    final = history[-1]
+    solution: Solution = last["solution"]
+    solution.accuracy = {
+        "method": method.describe(), **asdict(method), "tol": float(tol),
+        "relative_estimate": final["relative_estimate"],
+        "reached": final.get("stopped_by") == "tol",
+        "stopped_by": final.get("stopped_by"), "solves": len(history),
+        "unknowns": int(final["dofs"]["total"]), "loop_s": seconds,
+        "unknowns_per_step": [int(r["dofs"]["total"]) for r in history],
+    }
+    return solution
