@@ -124,6 +124,37 @@ class FrictionForms:
         w = self.hat_lengths if active is None else self.hat_lengths * active
         return float(np.sqrt(np.sum(w * nu**2)))
 
+    # The friction law as the nested Uzawa algorithm iterates it: nu, |nu_j| <= 1, on the
+    # h^ edges (L_h^ of (3.61)), the bound F per fine edge.
+
+    @property
+    def nu_mass(self) -> np.ndarray:
+        """The (diagonal) mass matrix of the space of nu: the h^ edge lengths (Remark 3.44)."""
+        return self.hat_lengths
+
+    def nu_matrix(self, bound: np.ndarray) -> sp.csr_matrix:
+        """Q_F of (3.95), nu x lambda_t: q(mu_i, kappa_j) for the bound F per fine edge."""
+        return self.q_matrix(bound)
+
+    def given_bound(self, problem: DiscreteProblem) -> np.ndarray:
+        """The Tresca bound of ``problem``'s scene per fine edge (:func:`tresca_bound`)."""
+        return tresca_bound(self, problem)
+
+    def normal_functionals(self, problem: DiscreteProblem) -> tuple[sp.csr_matrix, np.ndarray]:
+        """(N, r): the normal stresses the Coulomb bound is made of, N x - r for the unknowns
+        x: sigma_n on every fine edge (``T_n``)."""
+        return self.T_n, np.zeros(self.T_n.shape[0])
+
+    def bound_of_normal(self, normal: np.ndarray, mu_f: float) -> np.ndarray:
+        """The Coulomb bound F of (3.123) from N x - r of :meth:`normal_functionals`."""
+        return self.coulomb_bound_of(normal, mu_f)
+
+    def reported(self, nu: np.ndarray, bound: np.ndarray, t_t: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray]:
+        """nu and F as a :class:`~ngdual.solution.Solution` reports them (per h^ edge, per fine
+        edge) from those of :meth:`nu_matrix`; ``t_t`` = C_t^T sigma - r_t."""
+        return nu, bound
+
 
 def hat_projection(midpoint_hats: sp.csr_matrix, lengths: np.ndarray,
                    sigma_n: np.ndarray) -> np.ndarray:
@@ -221,6 +252,38 @@ class FacetFrictionForms(FrictionForms):
         of the edge slips the same way."""
         t, F = self.edge_sums(t_t), self.edge_sums(bound)
         return np.divide(t, F, out=np.zeros_like(t), where=F > 0)
+
+    # The friction law on the Bernstein coefficients (MomentFriction) as the nested Uzawa
+    # algorithm iterates it: nu_i, |nu_i| <= 1, and F_i on every coefficient.
+
+    @property
+    def nu_mass(self) -> np.ndarray:
+        """The lumped mass int B_i ds = |e| / (k + 1) of every Bernstein coefficient: the
+        (diagonal) metric of nu, one per coefficient."""
+        per_edge = self.midpoint_hats.shape[1] // self.midpoint_hats.shape[0]
+        return np.repeat(self.lengths / per_edge, per_edge)
+
+    def nu_matrix(self, bound: np.ndarray) -> sp.csr_matrix:
+        """Q_F = diag(F_i) (:class:`MomentFriction`)."""
+        return MomentFriction().q_matrix(bound)
+
+    def given_bound(self, problem: DiscreteProblem) -> np.ndarray:
+        """F_i = int F B_i ds of the scene's Tresca bound (:func:`tresca_moments`)."""
+        return tresca_moments(problem)
+
+    def normal_functionals(self, problem: DiscreteProblem) -> tuple[sp.csr_matrix, np.ndarray]:
+        """(N, r): the normal moments t_n = C_n^T sigma - r_n, the lambda_n rows of (3.62)."""
+        return problem.K[problem.lam_n].tocsr(), problem.rhs[problem.lam_n]
+
+    def bound_of_normal(self, normal: np.ndarray, mu_f: float) -> np.ndarray:
+        """F_i = mu_f max(-t_n,i, 0) (:class:`MomentFriction`)."""
+        return MomentFriction().coulomb_bound_of(normal, mu_f)
+
+    def reported(self, nu: np.ndarray, bound: np.ndarray, t_t: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray]:
+        """nu and F per fine edge (:meth:`edge_nu`, :meth:`edge_bound`), as the active-set
+        method reports them."""
+        return self.edge_nu(t_t, bound), self.edge_bound(bound)
 
 
 @dataclass(frozen=True)

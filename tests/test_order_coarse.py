@@ -127,7 +127,6 @@ def test_both_active_set_solvers_give_the_qp_solution_with_the_coarse_multiplier
 
 @pytest.mark.parametrize("overrides, field", [
     (["friction.law='coulomb'", "friction.mu=0.5"], "friction.law"),
-    (["solver.method='uzawa'"], "solver.method"),
 ])
 def test_what_the_coarse_multipliers_cannot_solve_at_order_k_is_a_scene_error(overrides, field):
     with pytest.raises(SceneError) as err:

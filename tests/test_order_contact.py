@@ -37,7 +37,6 @@ def _scene(order: int, *more: str):
     (["discretisation.order=3"], "discretisation.order"),
     (["discretisation.order=true"], "discretisation.order"),
     (["discretisation.multipliers='hats'"], "discretisation.multipliers"),
-    (["discretisation.order=1", "solver.method='uzawa'"], "solver.method"),
 ])
 def test_a_bad_order_or_family_is_a_scene_error_naming_its_field(overrides, field):
     with pytest.raises(SceneError) as err:

@@ -224,6 +224,17 @@ class CoarseMesh:
         """dim of the coarse P1 space vanishing at the fixed ends of every open chain."""
         return sum(len(self.dof_positions(c)) for c in range(len(self.chains)))
 
+    @property
+    def n_coefficients(self) -> int:
+        """The unknowns of the multiplier space: the nodal values of the P1 hats."""
+        return self.n_p1_dofs
+
+    def mass_stiffness(self) -> tuple[np.ndarray, np.ndarray]:
+        """The mass matrix and the arc-length stiffness of the multiplier space on its
+        unknowns (:meth:`p1_mass_stiffness`): what the H^{1/2} metric of the Uzawa
+        algorithms is made of (:func:`ngdual.solvers.projections.metric_matrix`)."""
+        return self.p1_mass_stiffness()
+
     def node_points(self) -> np.ndarray:
         """Coordinates of the coarse P1 dofs, in dof order."""
         out = []

@@ -32,7 +32,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .coarse import CoarseMesh, WithoutP1
-from .facet import FacetMesh, bernstein_values
+from .facet import FacetMesh, bernstein_matrices, bernstein_values
 
 
 @dataclass(frozen=True)
@@ -89,6 +89,23 @@ class CoarseOrderMesh(WithoutP1, CoarseMesh):
     def n_coefficients(self) -> int:
         """The unknowns: the coefficients of the nodes with a dof and the inner ones."""
         return self.numbering()[1]
+
+    def mass_stiffness(self) -> tuple[np.ndarray, np.ndarray]:
+        """The mass matrix M and the arc-length stiffness L of the continuous Bernstein
+        polynomials on the unknowns (the fixed end coefficients left out, as the thesis'
+        C_h~ leaves out its end hats), dense: they define the H^{1/2} metric of the
+        projection step of the Uzawa algorithms
+        (:func:`ngdual.solvers.projections.metric_matrix`)."""
+        mass_ref, stiff_ref = bernstein_matrices(self.degree)
+        tables, n, _ = self.numbering()
+        mass, stiff = np.zeros((n, n)), np.zeros((n, n))
+        for chain, nodes, table in zip(self.chains, self.nodes, tables):
+            for ell, row in zip(np.diff(chain.arclength[nodes]), table):
+                keep = row < n
+                cells = np.ix_(row[keep], row[keep])
+                np.add.at(mass, cells, ell * mass_ref[np.ix_(keep, keep)])
+                np.add.at(stiff, cells, stiff_ref[np.ix_(keep, keep)] / ell)
+        return mass, stiff
 
     def dof_positions(self, c: int) -> np.ndarray:
         """For every unknown of chain c (unknown order) the chain vertex nearest its control

@@ -64,6 +64,26 @@ def bernstein_values(order: int, t: np.ndarray) -> np.ndarray:
     return np.array([comb(order, j) for j in range(order + 1)]) * (1 - t) ** (order - i) * t ** i
 
 
+def bernstein_derivatives(order: int, t: np.ndarray) -> np.ndarray:
+    """dB_i / dt, i = 0..k, at the parameters ``t``: k (B_{i-1}^{k-1} - B_i^{k-1})."""
+    t = np.asarray(t, dtype=float)
+    if order == 0:
+        return np.zeros((len(t), 1))
+    lower = np.zeros((len(t), order + 2))
+    lower[:, 1:-1] = bernstein_values(order - 1, t)
+    return order * (lower[:, :-1] - lower[:, 1:])
+
+
+def bernstein_matrices(order: int) -> tuple[np.ndarray, np.ndarray]:
+    """The mass int_0^1 B_i B_j dt and the stiffness int_0^1 B_i' B_j' dt of the Bernstein
+    polynomials of degree k on [0, 1] (Gauss-Legendre, exact): on an edge of length l they
+    are l times and 1 / l times these."""
+    points, weights = np.polynomial.legendre.leggauss(order + 1)
+    t, w = (points + 1) / 2, weights / 2
+    values, slopes = bernstein_values(order, t), bernstein_derivatives(order, t)
+    return values.T @ (w[:, None] * values), slopes.T @ (w[:, None] * slopes)
+
+
 @dataclass(frozen=True)
 class FacetMesh(WithoutP1, CoarseMesh):
     """The fine edges of a boundary part as the mesh of the facet P_k multipliers.
@@ -73,26 +93,71 @@ class FacetMesh(WithoutP1, CoarseMesh):
     value is prescribed, so nothing is lifted), with the order k of the multipliers. Its
     "dofs" are the k + 1 Bernstein coefficients of every fine edge, chain by chain and
     edge by edge along the chain; :meth:`node_points` are their control points.
+    ``clamped`` says for the first and the last end of every chain whether the end rule
+    fixes it (where the part meets Gamma_D): the multipliers stay free there, but the body
+    is held, which the metric of :meth:`mass_stiffness` takes into account.
     """
 
     traces: ClassVar[bool] = True   # P_k per fine edge: the normal traces of RT_k
     curve_normal: ClassVar[bool] = True
 
     order: int = 0
+    clamped: tuple[tuple[bool, bool], ...] = ()
 
     @classmethod
     def on_fine(cls, mesh: ngs.Mesh, labels: list[str], order: int,
                 ends: EndRule | None = None) -> FacetMesh:
         """The fine edges of ``labels`` in chains, broken where ``ends`` breaks them."""
-        breaks = (ends or EndRule()).breaks
-        chains = tuple(boundary_chains(mesh, labels, breaks))
+        ends = ends or EndRule()
+        chains = tuple(boundary_chains(mesh, labels, ends.breaks))
+        clamped = tuple((False, False) if c.closed else (not first, not last)
+                        for c, (first, last) in zip(chains, ends.free_ends(chains)))
         return cls(chains, tuple(np.arange(c.n_edges + 1) for c in chains),
-                   tuple((True, True) for _ in chains), breaks, order)
+                   tuple((True, True) for _ in chains), ends.breaks, order, clamped)
 
     @property
     def n_coefficients(self) -> int:
         """k + 1 Bernstein coefficients on every fine edge."""
         return (self.order + 1) * self.n_edges
+
+    def mass_stiffness(self) -> tuple[np.ndarray, np.ndarray]:
+        """The mass matrix M and the broken arc-length stiffness L on the Bernstein
+        coefficients, dense.
+
+        The multipliers are discontinuous, so L is the broken H^1 seminorm with the jumps
+        penalised, |mu|_{1,h}^2 = sum_e |mu|_{1,e}^2 + sum_a [mu]_a^2 / h_a (h_a the mean
+        length of the two edges at the inner chain vertex a; the coefficients at the ends
+        of an edge are its end values): the seminorm of a continuous mu, and for the modes
+        that jump from edge to edge of the size 1 / h^2 that their wave number gives them.
+        At a ``clamped`` chain end the value there counts as a jump to zero, mu(a)^2 / h_a
+        (h_a the length of the end edge): the norm of H^{1/2}_00, in which the coarse
+        family leaves the end coefficient out. A value at a clamped corner moves against
+        the held body; without the term the metric underestimates its stiffness by a
+        factor that grows like log(1 / h) (6 to 13 on Example 3.46, levels 1-3).
+        (M, L) define the H^{1/2} metric of the projection step of the Uzawa algorithms
+        (:func:`ngdual.solvers.projections.metric_matrix`).
+        """
+        k = self.order
+        mass_ref, stiff_ref = bernstein_matrices(k)
+        lengths = self.edge_lengths()
+        mass = np.kron(np.diag(lengths), mass_ref)
+        stiff = np.kron(np.diag(1.0 / lengths), stiff_ref)
+        clamped = self.clamped or tuple((False, False) for _ in self.chains)
+        offset = 0
+        for chain, held in zip(self.chains, clamped):
+            m = chain.n_edges
+            h = lengths[offset:offset + m]
+            for e in range(m - 1 if not chain.closed else m):
+                after = (e + 1) % m
+                a, b = (offset + e) * (k + 1) + k, (offset + after) * (k + 1)
+                weight = 2.0 / (h[e] + h[after])
+                stiff[[a, b, a, b], [a, b, b, a]] += [weight, weight, -weight, -weight]
+            for end, edge, coefficient in zip(held, (0, m - 1), (0, k)):
+                if end:
+                    at = (offset + edge) * (k + 1) + coefficient
+                    stiff[at, at] += 1.0 / h[edge]
+            offset += m
+        return mass, stiff
 
     def node_points(self) -> np.ndarray:
         """The Bernstein control points a + (i / k)(b - a) of every fine edge, in unknown order."""

@@ -188,20 +188,12 @@ def _validate_discretisation(scene: Scene) -> None:
                          "multipliers of degree k + 1 have no friction bound nu on the h^ mesh "
                          "of that degree: use discretisation.multipliers = \"facet\" (or "
                          "\"auto\") for friction at order k")
-        if scene.solver.method == "uzawa":
-            problems.add("solver.method", "the Uzawa algorithms iterate in the P1 metrics of "
-                         "the h~ mesh; the coarse multipliers of order k are solved by "
-                         "\"active-set\" (or \"auto\")")
     if disc.family == "facet":
         if scene.friction.law == "coulomb" and "normal_stress" in _given(scene, "friction"):
             problems.add("friction.normal_stress", "chooses the |sigma_n| of the thesis' "
                          "Coulomb bound on the h^ edges; the facet multipliers bound every "
                          "Bernstein coefficient by mu_f times its own normal moment, so it "
                          "does nothing with discretisation.multipliers = \"facet\"; remove it")
-        if scene.solver.method == "uzawa":
-            problems.add("solver.method", "the Uzawa algorithms iterate in the metrics of the "
-                         "coarse h~ mesh; the facet multipliers are solved by \"active-set\" "
-                         "(or \"auto\")")
         for f, m in _facet_contact_settings(scene.contact):
             problems.add(f, m)
     if scene.contact.ends == "thesis" and (disc.order > 0 or disc.family == "facet"):

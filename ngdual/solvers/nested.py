@@ -11,7 +11,13 @@ loop updates nu for fixed lambda_n, the outer loop updates lambda_n.
 
 P^Lambda uses the mass matrix of L_h^ (Remark 3.44). It is diagonal (nu is
 piecewise constant), so the projection is the closed form clip(., -1, 1); the
-same projection as a cvxpy QP is :func:`box_projection_qp`.
+same projection as a cvxpy QP is :func:`box_projection_qp`. The friction forms say what
+nu is (:class:`~ngdual.friction.FrictionForms`: ``nu_mass``, ``nu_matrix``, ``given_bound``,
+``bound_of_normal``): with the facet multipliers of order k the law holds on every
+Bernstein coefficient (:class:`~ngdual.friction.MomentFriction`), nu_i and F_i per
+coefficient, Q_F = diag(F_i), the metric the lumped mass int B_i ds, and the box
+projection clips every coefficient; nu and F are reported per fine edge, as the active-set
+method reports them.
 
 Stopping (honest): the iteration stops only when the increments of nu (and,
 for Coulomb, of F) and the residual of nu lambda_t = |lambda_t| are below eps2
@@ -38,7 +44,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..forms import DiscreteProblem
-from ..friction import FrictionForms, build_friction_forms, tresca_bound
+from ..friction import FrictionForms, build_friction_forms
 from ..solution import ConvergenceError, Solution
 from ..tolerances import CLARABEL_TOLERANCES, DIVERGENCE_FACTOR, friction_vanishes
 from .condensed import CondensedResponse
@@ -100,11 +106,11 @@ def friction_residuals(forms: FrictionForms, problem: DiscreteProblem, x: np.nda
     only the hat moments of sigma_t are constrained, and sigma_t oscillates at the fine
     scale, also where F = 0.)
     """
-    Q = forms.q_matrix(bound)
+    Q = forms.nu_matrix(bound)
     sigma, lam_t = x[problem.sigma], x[problem.index("lam_t")]
     tangential = problem.block(problem.sigma, problem.index("lam_t")).T @ sigma
     normal = problem.block(problem.sigma, problem.lam_n).T @ sigma
-    hat_bound = Q.T @ np.ones(forms.n_nu)
+    hat_bound = Q.T @ np.ones(Q.shape[0])
     scale = max(np.max(np.abs(tangential), initial=0.0), np.max(np.abs(normal), initial=0.0),
                 np.max(hat_bound, initial=0.0), traction_scale) or 1.0
     return {
@@ -134,12 +140,13 @@ class FrictionStep:
 
     def __init__(self, forms: FrictionForms, S_t: np.ndarray, rho2: float, metric: str):
         self.forms, self.S_t, self.rho2, self.metric = forms, S_t, rho2, metric
-        self.mass = forms.hat_lengths
+        self.mass = forms.nu_mass
         self.bound = None
 
     def set_bound(self, bound: np.ndarray) -> None:
-        """Take the friction bound F (per fine edge): Q_F, the metric and the step."""
-        self.bound, self.Q = bound, self.forms.q_matrix(bound)
+        """Take the friction bound F (:meth:`FrictionForms.nu_matrix`): Q_F, the metric and
+        the step."""
+        self.bound, self.Q = bound, self.forms.nu_matrix(bound)
         if self.metric == "jacobi":
             diag = np.einsum("ij,jk,ik->i", self.Q.toarray(), self.S_t, self.Q.toarray())
             # the diagonal is quadratic in F: the edges without friction (tolerances
@@ -213,8 +220,9 @@ def nested_uzawa(problem: DiscreteProblem, settings: NestedUzawaSettings,
         raise ValueError(f"unknown loop_order {s.loop_order!r}")
     start_all = time.perf_counter()
     forms = build_friction_forms(problem)
+    normal, normal_rhs = forms.normal_functionals(problem)
     loop = ContactLoop(problem, s.metric, model.plane_strain_modulus, s.condensed,
-                       extra_outputs=forms.T_n[:, problem.saddle])
+                       extra_outputs=normal[:, problem.saddle])
     n_c = loop.n_c
     if loop.response is not None:
         S_t = -loop.response.G[n_c:2 * n_c, n_c:]
@@ -224,23 +232,26 @@ def nested_uzawa(problem: DiscreteProblem, settings: NestedUzawaSettings,
     start = time.perf_counter()
 
     lam = np.zeros(n_c)
-    nu = np.zeros(forms.n_nu)
+    nu = np.zeros(len(forms.nu_mass))
     inner_total = 0
     if law == "tresca":
-        friction.set_bound(tresca_bound(forms, problem))
+        friction.set_bound(forms.given_bound(problem))
     else:  # F^0 from the frictionless solution (Remark 3.45: F^0(sigma^0))
         state, inner_total, _, _ = loop.run(lam, rho1, eps1, max_iter)
         lam = state.lam
-        friction.set_bound(forms.coulomb_bound_of(state.extra, mu_f))
+        friction.set_bound(forms.bound_of_normal(state.extra - normal_rhs, mu_f))
 
     def coulomb_update(state) -> float:                                       # step 8'
         if law != "coulomb":
             return 0.0
-        bound = forms.coulomb_bound_of(state.extra, mu_f)
+        bound = forms.bound_of_normal(state.extra - normal_rhs, mu_f)
         change = _relative(bound, friction.bound)
         friction.set_bound(bound)
         return change
 
+    if s.loop_order == "contact-outer":   # one plain step of Algorithm 3.38 per outer step
+        contact_step = loop.plain_step(rho1, "solver.loop_order = \"friction-outer\", whose "
+                                             "inner loop takes the step relative to that bound")
     history, converged, best, best_at = [], False, np.inf, 0
     for outer in range(1, max_iter + 1):
         if s.loop_order == "friction-outer":
@@ -261,7 +272,8 @@ def nested_uzawa(problem: DiscreteProblem, settings: NestedUzawaSettings,
                 nu_new = friction(nu, state.lam_t)
                 inner_ok = max(_relative(nu_new, nu), change_F) <= eps1
                 nu = nu_new
-            lam_new = loop.projection(loop.projection.matvec(lam) + rho1 * state.traction)
+            lam_new = loop.projection(loop.projection.matvec(lam)
+                                      + contact_step * state.traction)
             change = max(_relative(lam_new, lam), change_F, sign)
             lam = lam_new
         inner_total += inner
@@ -292,6 +304,8 @@ def nested_uzawa(problem: DiscreteProblem, settings: NestedUzawaSettings,
     x = np.zeros(problem.n)
     x[problem.saddle], x[problem.lam_n] = loop.solution(state), state.lam
     bound = friction.bound
+    t_t = (problem.apply(x) - problem.rhs)[problem.index("lam_t")]
+    nu_reported, bound_reported = forms.reported(nu, bound, t_t)
     return Solution(problem, x, converged, f"nested-uzawa-{law}-{s.metric}-{s.loop_order}",
                     iterations={"outer": outer, "inner": inner_total},
                     residuals={"outer_increment": history[-1], **loop.residuals(state),
@@ -302,5 +316,6 @@ def nested_uzawa(problem: DiscreteProblem, settings: NestedUzawaSettings,
                              "condense": loop.condense_seconds,
                              "solve": time.perf_counter() - start,
                              "total_solver": time.perf_counter() - start_all},
-                    nu=nu, friction_bound=bound, friction_forms=forms,
-                    nu_l2=forms.l2_norm_nu(nu, forms.per_hat_edge(bound) > 0))
+                    nu=nu_reported, friction_bound=bound_reported, friction_forms=forms,
+                    nu_l2=forms.l2_norm_nu(nu_reported,
+                                           forms.per_hat_edge(bound_reported) > 0))

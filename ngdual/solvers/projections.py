@@ -5,19 +5,25 @@ Remark 3.40: step 4 of Algorithm 3.38 is the convex QP
     lambda_n = argmin_{chi >= 0} 1/2 chi^T W chi - chi^T c,
     c = W lambda_n^{i-1} + rho C_n^T sigma^i,
 
-with W the matrix of the metric. Two metrics are offered:
+with W the matrix of the metric on the unknowns of lambda_n. Every multiplier space has its
+unknowns in a positive basis -- the thesis' P1 hats, the Bernstein polynomials of the
+coarse family of degree k + 1 and of the facet family of degree k -- so that C_h^+ is
+chi >= 0 coefficient by coefficient at every order, and W is made of the space's own mass
+matrix M and arc-length stiffness L (``mass_stiffness()`` of the classes of
+:mod:`ngdual.boundary`; broken, with its jumps penalised, for the discontinuous facet
+family). Two metrics are offered:
 
 ``h12``
     W = (E*/2) M (M^{-1} L)^{1/2}: the discrete H^{1/2}_{00}(Gamma_C)
-    interpolation norm of the coarse P1 space (M mass, L arc-length
-    stiffness), scaled like the Steklov-Poincare operator of a plane-strain
-    half-plane (normal stress (E*/2)|k| per unit normal displacement of wave
-    number k). Spectrally equivalent to the hypersingular operator the thesis
+    interpolation norm of the multiplier space, scaled like the Steklov-Poincare operator
+    of a plane-strain half-plane (normal stress (E*/2)|k| per unit normal displacement of
+    wave number k). Spectrally equivalent to the hypersingular operator the thesis
     uses, so the iteration count does not grow with the level. The QP is posed
     by SciPy's NNLS (or as a cvxpy QP, Clarabel, polished on its active set).
 ``euclidean``
     W = (E*/2) I: a diagonal metric with the closed-form projection
-    max(0, c / w). Cheap per step, but the number of steps grows with 1/h.
+    max(0, c / w), the clip of every coefficient. Cheap per step, but the number of steps
+    grows with 1/h.
 
 The factor E* = E/(1 - nu^2) makes rho dimensionless: the same rho works for
 E = 2e5 and E = 2e11.
@@ -34,12 +40,12 @@ from ..tolerances import CLARABEL_TOLERANCES
 
 
 def metric_matrix(contact: CoarseMesh, modulus: float, kind: str) -> np.ndarray:
-    """The metric W on the coarse P1 space of Gamma_C (dense, or a 1-D diagonal)."""
-    n = contact.n_p1_dofs
+    """The metric W on the unknowns of the multiplier space ``contact`` of Gamma_C (dense, or
+    a 1-D diagonal)."""
     if kind == "euclidean":
-        return np.full(n, modulus / 2)
+        return np.full(contact.n_coefficients, modulus / 2)
     if kind == "h12":
-        mass, stiff = contact.p1_mass_stiffness()
+        mass, stiff = contact.mass_stiffness()
         vals, vecs = sla.eigh(stiff, mass)
         mv = mass @ vecs
         # with a free end the constants (or, between two free ends, also the linears

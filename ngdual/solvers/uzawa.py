@@ -8,6 +8,11 @@ with one factorisation made before the loop, then updates
 lambda_n^i = P^+(lambda_n^{i-1} + rho Phi(sigma^i)) (step 4, as the QP of
 Remark 3.40). It stops on the thesis' relative increment (step 5); the
 residual of the discrete variational inequality is reported alongside.
+
+lambda_n is whatever the multiplier space of Gamma_C makes it -- the thesis' P1 hats, or
+Bernstein coefficients at order k (:mod:`ngdual.boundary`) -- and P^+ is the projection
+onto lambda_n >= 0 coefficient by coefficient in the metric of that space
+(:func:`~ngdual.solvers.projections.metric_matrix`).
 """
 
 from __future__ import annotations
@@ -36,7 +41,8 @@ def contact_residuals(lam: np.ndarray, traction: np.ndarray,
                       load_scale: float = 0.0) -> dict:
     """Residuals of the discrete VI (3.103): lambda_n >= 0, C_n^T sigma <= 0, complementarity.
 
-    ``traction`` is C_n^T sigma (the normal stress tested with the coarse hats).
+    ``traction`` is C_n^T sigma (the normal stress tested with the multipliers' basis
+    functions, the hats or the Bernstein polynomials, less the right-hand side of their rows).
     ``lam_scale`` is the displacement scale on Gamma_C that lambda_n is measured
     against (default max |lambda_n|; pass max(|lambda_n|, |lambda_t|) when
     lambda_n may vanish, e.g. full contact at g = 0, where lambda_n itself is
@@ -61,7 +67,8 @@ class LoopState:
     """Where the inner loop stands: the Gamma_C unknowns and what the iteration observes.
 
     ``z = (lambda_n, tau)`` determines y through the linear solve of step 3, tau the
-    load of the lambda_t rows (Q_F^T nu of Algorithm 3.41). ``traction`` = C_n^T sigma,
+    load of the lambda_t rows (Q_F^T nu of Algorithm 3.41). ``traction`` = C_n^T sigma - r_n
+    (the moments t_n of the lambda_n rows of (3.62); r_n = 0 where the gap enters g),
     ``lam_t`` = lambda_t, ``extra`` = the caller's additional functionals of y.
     """
 
@@ -105,6 +112,7 @@ class ContactLoop:
             metric_matrix(problem.spaces.contact, modulus, metric))
         self.g = problem.rhs[problem.sigma]
         self.b0 = problem.rhs[problem.mult]
+        self.r_n = problem.rhs[problem.lam_n]   # t_n = C_n^T sigma - r_n, the lambda_n rows
         i_t = problem.index("lam_t")  # the saddle unknowns are a prefix of x: also positions in y
         n_c, n_t = self.C_n.shape[1], len(i_t)
         self.E_t = sp.csr_matrix((np.ones(n_t), (i_t, np.arange(n_t))), shape=(n, n_t))
@@ -150,6 +158,39 @@ class ContactLoop:
         return float(sla_sparse.eigsh(op, k=1, which="LA", tol=1e-3,
                                       v0=np.ones(n))[0][0])
 
+    def step(self, rho: float) -> float:
+        """The step of step 4 for the dimensionless ``rho``, as :meth:`run` takes it.
+
+        In the H^{1/2} metric rho / max(1, lambda_max), lambda_max the
+        :attr:`stability_bound`; in the Euclidean metric the plain step (:meth:`plain_step`).
+        """
+        if not self.projection.diagonal:
+            return rho / max(1.0, self.stability_bound)
+        return self.plain_step(rho, "solver.metric = \"h12\", whose step is relative to "
+                                    "that bound")
+
+    def plain_step(self, rho: float, remedy: str) -> float:
+        """``rho`` itself, which contracts only for rho lambda_max < 2: a step that would not
+        is refused before the iteration starts, naming the ``remedy`` besides a smaller step.
+        lambda_max is near 1 for the thesis' hats in either metric; in the Euclidean metric it
+        reaches 2.1 for the facet multipliers of order 0 (Example 3.46, level 3), whose edge
+        indicators feel the stiffness of the jumps between them.
+
+        Raises
+        ------
+        ConvergenceError
+            If rho lambda_max >= 2.
+        """
+        bound = self.stability_bound
+        if rho * bound >= 2.0:
+            raise ConvergenceError(
+                f"the Uzawa step rho = {rho:g} does not contract here: the bound of the "
+                f"contact iteration in the {'Euclidean' if self.projection.diagonal else 'H^1/2'}"
+                f" metric is lambda_max = {bound:.3g}, and rho lambda_max must stay below 2; "
+                f"choose a step below {2.0 / bound:.3g} (solver.rho, or solver.rho1 with "
+                f"friction) or {remedy}", [])
+        return rho
+
     def respond(self, lam: np.ndarray, tau: np.ndarray) -> LoopState:
         """Step 3 for lambda_n = ``lam`` and the lambda_t-row load ``tau``."""
         z = np.concatenate([lam, tau])
@@ -158,7 +199,8 @@ class ContactLoop:
         else:
             y = self.fact.solve(self.r0 + self.inputs @ z)
             observed = self.outputs @ y
-        return LoopState(lam, tau, *np.split(observed, self._split), y=y)
+        traction, lam_t, extra = np.split(observed, self._split)
+        return LoopState(lam, tau, traction - self.r_n, lam_t, extra, y=y)
 
     def _distance(self, state: LoopState, prev: LoopState | None) -> tuple[float, float]:
         """(||y - y_prev||, ||y||), y_prev = 0 at the start of a run."""
@@ -179,17 +221,17 @@ class ContactLoop:
             progress: Callable[[int, float], None] | None = None):
         """Iterate until the relative increment is <= eps (step 5).
 
-        ``rho`` is the dimensionless step. In the H^{1/2} metric, where the metric
-        underestimates the body's stiffness (:attr:`stability_bound` > 1), it is taken
+        ``rho`` is the dimensionless step (:meth:`step`). In the H^{1/2} metric, where the
+        metric underestimates the body's stiffness (:attr:`stability_bound` > 1), it is taken
         relative to that bound, rho / lambda_max, so that rho in (0, 2) always contracts
-        (where the bound is <= 1, e.g. on Example 3.46, the step is rho itself, as in the
-        thesis). In the Euclidean metric the bound grows like 1/h and rho is the plain
-        step of the thesis, to be chosen by the user.
+        (where the bound is <= 1, e.g. on Example 3.46 with the thesis' hats, the step is
+        rho itself, as in the thesis). In the Euclidean metric the bound stays near 1 while
+        the smallest eigenvalue falls like h, and rho is the plain step of the thesis, to be
+        chosen by the user (refused where it would not contract).
         Returns ``(state, iterations, history, converged)``; the state's y solves
         the linear system with the state's lambda_n exactly.
         """
-        if not self.projection.diagonal:
-            rho = rho / max(1.0, self.stability_bound)
+        rho = self.step(rho)
         tau = np.zeros(self.E_t.shape[1]) if tau is None else tau
         prev, history, converged = None, [], False
         for it in range(1, max_iter + 1):
