@@ -62,7 +62,7 @@ _PUBLIC = {
     "shipped_scenes": ("ngdual.scene", "shipped_scenes"),
     "Scene": ("ngdual.scene", "Scene"),
     "SceneError": ("ngdual.scene", "SceneError"),
-    "solve": ("ngdual.solvers", "solve_scene"),
+    "solve": ("ngdual.accuracy", "solve"),
     "Solution": ("ngdual.solution", "Solution"),
     "adapt": ("ngdual.afem", "adapt"),
     "build_mesh": ("ngdual.mesh", "build_mesh"),

@@ -28,12 +28,15 @@ not change with a tolerance.
 from __future__ import annotations
 
 import time
+import warnings
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
 
+from .afem import adapt
 from .forms.spaces import Variant, declared_variant, variant_of
-from .scene import Scene, SceneError, ensure_valid
-from .solution import Solution
-from .solvers.dispatch import with_discretisation
+from .scene import Scene, SceneError, check_level, ensure_valid
+from .solution import PhysicsWarning, Solution
+from .solvers.dispatch import solve_scene, with_discretisation
 
 FASTEST_ORDER = 1          # the rule's order beyond the thesis (module docstring)
 FASTEST_FAMILY = "facet"
@@ -78,6 +81,34 @@ def _thesis(scene: Scene) -> bool:
     return scene.geometry.kind == "thesis-3.46"
 
 
+def solve(scene: Scene, level: int | None = None,
+          progress: Callable[[int, float], None] | None = None, allow_large: bool = False,
+          status: Callable[[str], None] | None = None, *, order: int | None = None,
+          multipliers: str | None = None, tol: float | None = None) -> Solution:
+    """Solve ``scene`` on ``level`` (:func:`ngdual.solvers.solve_scene`, whose arguments
+    these are), or, with ``tol``, to that relative error of its contact pressure (of its
+    stress, without contact) by the fastest method (:func:`solve_to_tolerance`: adaptive
+    from the coarsest level, or from ``level``, stopping by the estimate;
+    ``solution.accuracy`` says which method it chose and why, the estimate, the solves,
+    the unknowns and the time). Every failed physics check is issued as a
+    :class:`~ngdual.solution.PhysicsWarning`.
+
+    >>> import ngdual as nd
+    >>> solution = nd.solve(nd.load_scene("hertz-cylinder"), tol=0.05)  # doctest: +SKIP
+    >>> solution.accuracy["method"]                                     # doctest: +SKIP
+    'adaptive, pressure goal, k = 1, facet'
+    """
+    if tol is None:
+        return solve_scene(scene, level, progress, allow_large, status, order=order,
+                           multipliers=multipliers)
+    level = check_level(level, "level", optional=True)
+    solution = solve_to_tolerance(scene, tol, order=order, multipliers=multipliers,
+                                  level=level, allow_large=allow_large)
+    for found in solution.warnings:
+        warnings.warn(found.message, PhysicsWarning, stacklevel=2)
+    return solution
+
+
 def solve_to_tolerance(scene: Scene, tol: float, *, order: int | None = None,
                        multipliers: str | None = None, level: int | None = None,
                        allow_large: bool = False, on_step=None) -> Solution:
@@ -97,8 +128,6 @@ def solve_to_tolerance(scene: Scene, tol: float, *, order: int | None = None,
     SceneError
         For a bad ``tol`` (a number in (0, 1)), ``order`` or ``multipliers``.
     """
-    from .afem import adapt
-
     ensure_valid(scene)
     if isinstance(tol, bool) or not isinstance(tol, (int, float)) or not 0.0 < tol < 1.0:
         raise SceneError("tol", f"must be a relative error in (0, 1), e.g. 0.01, got {tol!r}")
@@ -117,6 +146,7 @@ def solve_to_tolerance(scene: Scene, tol: float, *, order: int | None = None,
     seconds = time.perf_counter() - start
     final = history[-1]
     solution: Solution = last["solution"]
+    solution.timings["total"] = seconds   # the whole loop: what this solution cost
     solution.accuracy = {
         "method": method.describe(), **asdict(method), "tol": float(tol),
         "relative_estimate": final["relative_estimate"],

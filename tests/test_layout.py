@@ -31,7 +31,7 @@ STAGES = [
     ("quantities", ["quantities", "trace"]),
     ("estimator", ["estimator", "goal"]),
     ("marking", ["marking"]),
-    ("afem", ["afem"]),
+    ("afem", ["afem", "accuracy"]),
     ("post", ["post", "summary", "plot"]),
     ("verification", ["verification"]),
     ("run machinery", ["studies", "cli", "__main__"]),

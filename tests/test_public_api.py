@@ -26,9 +26,20 @@ def test_every_public_name_resolves_and_has_a_docstring():
 
 
 def test_public_names_are_the_pipeline_functions():
-    from ngdual import afem, boundary, estimator, marking, mesh, quantities, scene, solvers, trace
+    from ngdual import (
+        accuracy,
+        afem,
+        boundary,
+        estimator,
+        marking,
+        mesh,
+        quantities,
+        scene,
+        solvers,
+        trace,
+    )
 
-    assert nd.solve is solvers.solve_scene
+    assert nd.solve is accuracy.solve
     assert nd.load_scene is scene.load_scene and nd.Scene is scene.Scene
     assert nd.adapt is afem.adapt and nd.estimate is estimator.estimate
     assert nd.mark is marking.mark and nd.contact_traces is trace.contact_traces

@@ -108,7 +108,8 @@ def summary_table(summary: dict) -> str:
     method, then one row per quantity with the analytic value of the scene's benchmark
     beside it and the relative difference; stick and slip zones only where friction acts."""
     m = summary["method"]
-    lines = [f"{m['scene']}, level {m['level']}: PEERS order {m['order']}, {m['multipliers']} "
+    where = "an adapted mesh" if m["level"] is None else f"level {m['level']}"
+    lines = [f"{m['scene']}, {where}: PEERS order {m['order']}, {m['multipliers']} "
              f"multipliers, {m['solver']}" + ("" if m["converged"] else " (NOT converged)")]
     if not summary["contact"]:
         return "\n".join(lines + ["no contact boundary: no contact quantities"])
@@ -163,7 +164,23 @@ def result_table(record: dict) -> str:
                                               for k, v in record["residuals"].items()))
     lines.append("time [s]  " + "  ".join(f"{k}={v:.3f}"
                                           for k, v in record["timings_s"].items()))
+    if "accuracy" in record:
+        lines.append(accuracy_line(record["accuracy"]))
     return "\n".join(lines)
+
+
+def accuracy_line(accuracy: dict) -> str:
+    """How a solve to a tolerance went: the method and why, the estimate against the
+    tolerance, the solves, the unknowns and the loop's time; and, where the loop stopped
+    before the tolerance, by what."""
+    line = (f"accuracy  {accuracy['method']} ({accuracy['reason']})  estimate "
+            f"{100 * accuracy['relative_estimate']:.3g} % of tol {100 * accuracy['tol']:.3g} %  "
+            f"solves={accuracy['solves']}  unknowns={accuracy['unknowns']}  "
+            f"loop={accuracy['loop_s']:.2f} s")
+    if not accuracy["reached"]:
+        line += (f"\n          NOT REACHED: the loop stopped by {accuracy['stopped_by']} at "
+                 f"{100 * accuracy['relative_estimate']:.3g} %")
+    return line
 
 
 def _value(value) -> str:

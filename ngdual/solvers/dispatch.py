@@ -55,14 +55,8 @@ def solve_scene(scene: Scene, level: int | None = None,
                 progress: Callable[[int, float], None] | None = None,
                 allow_large: bool = False,
                 status: Callable[[str], None] | None = None, *,
-                order: int | None = None, multipliers: str | None = None,
-                tol: float | None = None) -> Solution:
-    """Mesh ``scene`` on ``level`` (default: the scene's level) and solve it there; or,
-    with ``tol``, solve it to that relative error of its contact pressure (of its stress,
-    without contact) by the fastest method (:func:`ngdual.accuracy.solve_to_tolerance`:
-    adaptive from the coarsest level, or from ``level``, stopping by the estimate;
-    ``solution.accuracy`` says which method it chose and why, the estimate, the solves,
-    the unknowns and the time).
+                order: int | None = None, multipliers: str | None = None) -> Solution:
+    """Mesh ``scene`` on ``level`` (default: the scene's level) and solve it there.
 
     The scene is validated (once: a scene from :func:`ngdual.scene.load_scene` is not
     checked again unless it was changed) and the size of the mesh is estimated and refused
@@ -86,15 +80,6 @@ def solve_scene(scene: Scene, level: int | None = None,
     >>> nd.solve(scene, order=1).problem.scene.discretisation.family   # doctest: +SKIP
     'facet'
     """
-    if tol is not None:
-        from ..accuracy import solve_to_tolerance
-
-        level = check_level(level, "level", optional=True)
-        solution = solve_to_tolerance(scene, tol, order=order, multipliers=multipliers,
-                                      level=level, allow_large=allow_large)
-        for found in solution.warnings:
-            warnings.warn(found.message, PhysicsWarning, stacklevel=2)
-        return solution
     start = time.perf_counter()
     scene = with_discretisation(scene, order, multipliers)
     level = check_level(level, "level", optional=True)
