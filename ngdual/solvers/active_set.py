@@ -132,7 +132,7 @@ def _solve(problem: DiscreteProblem, settings: ActiveSetSettings, tol: float, or
     hybrid = HybridSystem(problem, friction=law != "none")                     # step 1
     try:
         chol = SchurCholesky(hybrid.H, hybrid.contact_index, ordering)         # step 2
-    except ArithmeticError:
+    except np.linalg.LinAlgError:   # SchurCholesky: H is not positive definite
         if problem.spaces.friction is not None:
             raise ConvergenceError("the hybridised system is singular (the body is not held "
                                    "where nothing touches): hold it by Gamma_D or Gamma_N",
