@@ -154,7 +154,7 @@ def solve_contact(cond: Condensed, law: str, mu_f: float, bound: np.ndarray | No
     floor = SAFETY * cond.roundoff
     if law == "coulomb":
         # a normal stress below the round-off of the stress scale bounds nothing
-        noise = floor * mu_f * cond.stress_scale
+        noise = SAFETY * cond.stress_roundoff * mu_f * cond.stress_scale
         on_sets = functools.partial(coulomb_on_sets, cond, mu_f) if cond.moments else None
         return coulomb_fixed_point(cond, friction, mu_f, tol, max_iter, progress, noise,
                                    start_state(first, cond.J, True, 0), on_sets)
