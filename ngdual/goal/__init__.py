@@ -21,6 +21,7 @@ from .indicators import (
     CALIBRATION,
     CALIBRATION_ORDER_K,
     CALIBRATION_WINDOW_ORDER_K,
+    END_CONSTANT,
     TERMS,
     PressureEstimate,
     calibration,
@@ -30,10 +31,10 @@ from .indicators import (
 from .pressure import KINK_EFFECTIVITY, PressureGoal, contact_vertices, singular_free_ends
 from .stress import StressGoal
 
-__all__ = ["CALIBRATION", "CALIBRATION_ORDER_K", "CALIBRATION_WINDOW_ORDER_K", "GOALS",
-           "KINK_EFFECTIVITY", "TERMS", "Goal", "Measure", "PressureEstimate", "PressureGoal",
-           "StressGoal", "calibration", "contact_vertices", "goal_estimate", "goal_for",
-           "in_window", "singular_free_ends"]
+__all__ = ["CALIBRATION", "CALIBRATION_ORDER_K", "CALIBRATION_WINDOW_ORDER_K", "END_CONSTANT",
+           "GOALS", "KINK_EFFECTIVITY", "TERMS", "Goal", "Measure", "PressureEstimate",
+           "PressureGoal", "StressGoal", "calibration", "contact_vertices", "goal_estimate",
+           "goal_for", "in_window", "singular_free_ends"]
 
 # every goal by its name (the CLI's --goal)
 GOALS = {"stress": StressGoal, "pressure": PressureGoal}

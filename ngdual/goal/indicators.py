@@ -13,6 +13,11 @@ units of pressure^2 x length, per fine edge e of Gamma_C (its element T)::
                          (at most |e| p_h^2 where lambda_n is a fixed end's data)
     ``kink``             (E* [d(g_h - lambda_n)/dt])^2 h~ / 2    at the last contact node,
                                                                  on each of its two edges
+                                                                 (order 0)
+    ``end``              ||p* - p_h||_e^2                        on the patch of every end
+                                                                 of the contact zone, p*
+                                                                 the closest square-root
+                                                                 profile (order k)
     ``jump``             JUMP_WEIGHT |e| [p_h]^2 / 2             at every interior vertex
                                                                  of a chain, on each of its
                                                                  two edges (order k only)
@@ -28,9 +33,9 @@ the contact pressure") derives each power of h~ and says what is proven and what
 heuristic. The estimate is the root of the sum, each term weighted by the square of its
 constant (:func:`calibration`), each constant calibrated where its terms are the estimate:
 ``CALIBRATION`` for every term at order 0 and for the far field on all of Gamma_C; at
-order k with the facet multipliers ``CALIBRATION_ORDER_K[k]`` for the edge terms (on
-hertz-cylinder, where the jumps and the kink dominate) and ``CALIBRATION_WINDOW_ORDER_K``
-for a window's far field (on the flat punch's core, where the edge terms vanish).
+order k with the facet multipliers ``CALIBRATION_ORDER_K[k]`` for the other edge terms (on
+hertz-cylinder, where the jumps dominate), ``CALIBRATION_WINDOW_ORDER_K`` for a window's far
+field (on the flat punch's core, where the edge terms vanish) and none for ``end``.
 
 At order k with the facet multipliers (:mod:`ngdual.boundary.facet`) the multipliers are
 the normal traces of RT_k, so p_h is the trace -sigma_n^h itself (P_k on every fine edge,
@@ -39,7 +44,12 @@ moments are signed, and the exact pressure is >= 0 (:func:`_trace_pressure`). Th
 discontinuous from edge to edge while the exact pressure is continuous: ``jump`` carries its
 jumps at the fine vertices, the error of p_h inside the contact zone, which no other term
 of order k sees (:func:`_vertex_jumps`). The thesis' p_h (the hat projection) is continuous
-along a chain: there ``jump`` is zero.
+along a chain: there ``jump`` is zero. At the ends of the contact zone ``end`` takes the
+place of ``kink`` and of the jumps on its patches: the distance of p_h to the closest
+square-root profile (:mod:`ngdual.goal.contact_ends`), an estimate of the error there with
+no constant (END_CONSTANT = 1). The kink's slope jump grows as the end moves away from the
+last contact node while the error there falls, so it overestimated 3-4 times where the end
+falls near a vertex and underestimated where it falls mid-edge (docs/theory/effectivity.md).
 
 A pressure that is not in L2 (the flat punch's, p^2 ~ 1/(a - |x|)) has no finite L2 error;
 its goal is the error on a window W of Gamma_C away from the singular points (``window``,
@@ -59,15 +69,16 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..estimator import BoundaryEdges, Estimate
-from ..mesh import boundary_segments, mesh_arrays
+from ..mesh import mesh_arrays
 from ..scene import SceneError
 from ..solution import Solution
 from ..trace import contact_traces, pressure_field
+from .contact_ends import edge_values, end_distances
 
-__all__ = ["CALIBRATION", "CALIBRATION_ORDER_K", "CALIBRATION_WINDOW_ORDER_K", "TERMS",
-           "PressureEstimate", "calibration", "goal_estimate", "in_window"]
+__all__ = ["CALIBRATION", "CALIBRATION_ORDER_K", "CALIBRATION_WINDOW_ORDER_K", "END_CONSTANT",
+           "TERMS", "PressureEstimate", "calibration", "goal_estimate", "in_window"]
 
-TERMS = ("residual", "complementarity", "kink", "jump", "far")
+TERMS = ("residual", "complementarity", "kink", "end", "jump", "far")
 # terms of (4.15) in units of stress x length, and those of w_h ~ grad u (strain x length);
 # not jump_contact: on Gamma_C the contact-zone terms stand for it, and where the body
 # separates it measures the gap's curvature against lambda_n, not a pressure error
@@ -99,6 +110,9 @@ CALIBRATION_ORDER_K = {1: 0.15, 2: 0.11}
 # error per unknown of hertz-cylinder falls as the weight grows from 1 to 16, and from 4 on
 # the jumps carry the largest share of its estimate.
 JUMP_WEIGHT = 4.0
+# The ends of the contact zone at order k: the distance of p_h to the square-root profiles
+# is the error there, with no constant (:mod:`ngdual.goal.contact_ends`).
+END_CONSTANT = 1.0
 # lambda_n below this share of its largest value on Gamma_C is contact
 CONTACT_SHARE = 1e-6
 
@@ -138,12 +152,13 @@ def calibration(traces: bool, order: int, window: bool = False) -> dict[str, flo
     sigma_h, with a ``window`` or on all of Gamma_C: CALIBRATION for all with the coarse
     multipliers; with the facet multipliers CALIBRATION_ORDER_K[k] for the edge terms (k = 1
     at order 0, k = 2 above 2) and CALIBRATION for the far field, but
-    CALIBRATION_WINDOW_ORDER_K for a window's far field from order 1 on."""
+    CALIBRATION_WINDOW_ORDER_K for a window's far field from order 1 on; END_CONSTANT for
+    the ends of the contact zone (a distance, zero with the coarse multipliers)."""
     if not traces:
-        return dict.fromkeys(TERMS, CALIBRATION)
+        return {**dict.fromkeys(TERMS, CALIBRATION), "end": END_CONSTANT}
     edge = CALIBRATION_ORDER_K[min(max(order, 1), 2)]
     far = CALIBRATION_WINDOW_ORDER_K if window and order >= 1 else CALIBRATION
-    return {**dict.fromkeys(TERMS, edge), "far": far}
+    return {**dict.fromkeys(TERMS, edge), "end": END_CONSTANT, "far": far}
 
 
 def goal_estimate(solution: Solution, estimated: Estimate,
@@ -222,11 +237,21 @@ def goal_estimate(solution: Solution, estimated: Estimate,
         lam_mean = np.maximum(
             gamma_c.hat_means(spaces.prolongations["lam_n"]) @ solution.x[pb.lam_n], 0.0)
 
+    if spaces.contact.traces:
+        # the ends of the contact zone by the distance of p_h to the square-root profiles;
+        # the jumps on their patches are part of that distance
+        end, in_patch = end_distances(pressure, mesh, gamma_c, spaces.order,
+                                      _in_contact(lam_n))
+        kink, jumps = np.zeros(len(length)), np.where(in_patch, 0.0, jumps)
+    else:
+        end = np.zeros(len(length))
+        kink = _kinks(gamma_c, gap - lam_n, lam_n, starts, e_star * e_star * htilde)
     on_edges = {
         "residual": residual,   # the tension of p_h at order k
         "complementarity": _complementarity(length, np.maximum(p_mean, 0), lam_mean,
                                             e_star / htilde, fixed),
-        "kink": _kinks(gamma_c, gap - lam_n, lam_n, starts, e_star * e_star * htilde),
+        "kink": kink,
+        "end": end,
         "jump": JUMP_WEIGHT * jumps,
     }
     terms = {k: np.bincount(element, inside * values, mesh.ne)
@@ -313,27 +338,9 @@ def _trace_pressure(p: ngs.CoefficientFunction, solution: Solution, edges: Bound
 def _vertex_jumps(p: ngs.CoefficientFunction, mesh: ngs.Mesh, gamma_c) -> np.ndarray:
     """|e| [p_h]_v^2 / 2 on both fine edges of Gamma_C at every interior vertex v of a chain,
     [p_h]_v the jump of the pressure ``p`` (:func:`ngdual.trace.pressure_field`) between the
-    two edges.
-
-    p_h is read at both ends of every boundary segment (the points 0 and 1 of its reference
-    interval, each mapped into the segment's own triangle: no point search).
-    """
-    rule = ngs.IntegrationRule([(0.0,), (1.0,)], [0.5, 0.5])
-    points = mesh.MapToAllElements(rule, ngs.BND)
-    values = np.asarray(p(points)).reshape(-1, 2)
-    at = np.column_stack([np.asarray(ngs.x(points)).ravel(),
-                          np.asarray(ngs.y(points)).ravel()]).reshape(-1, 2, 2)
-    _, number = boundary_segments(mesh)
-    nr = np.array([number[frozenset(pair)] for pair in gamma_c.vertices.tolist()])
-    start = np.vstack([chain.path_points[:-1] for chain in gamma_c.coarse.chains])
-    # which end of a segment's reference interval is its fine edge's start
-    off = np.linalg.norm(at[nr] - start[:, None, :], axis=2)
-    if np.any(off.min(axis=1) > 1e-8 * gamma_c.lengths):
-        raise RuntimeError("NGSolve's boundary elements are not netgen's segments")
-    first = off[:, 0] < off[:, 1]
-    p_start = np.where(first, values[nr, 0], values[nr, 1])
-    p_end = np.where(first, values[nr, 1], values[nr, 0])
-    out, offset = np.zeros(len(nr)), 0
+    two edges, read at both ends of every edge (:func:`~.contact_ends.edge_values`)."""
+    p_start, p_end = edge_values(p, mesh, gamma_c, (0.0, 1.0)).T
+    out, offset = np.zeros(len(gamma_c.lengths)), 0
     for chain in gamma_c.coarse.chains:
         after = np.arange(offset + 1, offset + chain.n_edges)   # the edge after each vertex
         jump2 = (p_start[after] - p_end[after - 1])**2
@@ -368,15 +375,20 @@ def _edge_starts(gamma_c) -> np.ndarray:
     return np.concatenate(out)
 
 
+def _in_contact(lam_n: np.ndarray) -> np.ndarray:
+    """Which vertices are in contact: lambda_n at most CONTACT_SHARE of its largest value."""
+    return lam_n <= CONTACT_SHARE * np.max(np.abs(lam_n), initial=0.0)
+
+
 def _kinks(gamma_c, opening: np.ndarray, lam_n: np.ndarray, starts: np.ndarray,
            weight: np.ndarray) -> np.ndarray:
     """weight_e [d(opening)/dt]^2 / 2 on both fine edges at every last contact node.
 
     ``opening`` = g_h - lambda_n = u_n^h at the vertices; a last contact node is an interior
-    vertex of a chain where lambda_n vanishes (``CONTACT_SHARE``) and a neighbour separates.
+    vertex of a chain in contact (:func:`_in_contact`) next to one that separates.
     """
     slope = (opening[starts + 1] - opening[starts]) / gamma_c.lengths
-    contact = lam_n <= CONTACT_SHARE * np.max(np.abs(lam_n), initial=0.0)
+    contact = _in_contact(lam_n)
     out = np.zeros(len(starts))
     first = 0
     for chain in gamma_c.coarse.chains:
