@@ -20,7 +20,10 @@ uniform refinement of PEERS_k with the thesis' coarse multipliers of degree k + 
 coarse"; they solve frictionless contact only). A method that fails on a problem is a row
 "failed: <reason>" of the table. The primal peer
 ngdual.studies.primal_peer (P1 and P2 displacements, Nitsche contact, semismooth Newton)
-on the uniform meshes. Left out, as they add run time and change no verdict: the thesis'
+on the uniform meshes, and adapting as a primal user would: Kelly's indicator (the jumps of
+sigma(u_h) n, h-weighted, as deal.II's step-42) driving the same Doerfler marking (theta =
+0.9) and netgen bisection from level 1 ("primal P2, adaptive"); "primal P2" in the verdicts
+is the faster of the two. Left out, as they add run time and change no verdict: the thesis'
 Uzawa iterations (the same discrete problems as the active set, slower: README, "Solvers")
 and max marking or Doerfler theta = 0.5 (the unknowns grow by 1.3-1.5x per step, so more
 steps pay for the same mesh: ngdual.afem.THETA_TOL).
@@ -83,22 +86,16 @@ import os
 
 from ngdual import plot
 from ngdual.io import versions
+from ngdual.studies.cost.methods import is_peer, method_base, method_order, order_method
+from ngdual.studies.cost.output import curve_style, seconds_and_unknowns
+from ngdual.studies.cost.table import MEASURES, TARGETS, accuracy_rows
 from ngdual.studies.figures import TRUTH_PROBLEMS, markdown_table, script_main, true_error_study
-from ngdual.studies.figures.plan import (
-    COARSE_ORDERS,
-    ORDERS,
-    method_base,
-    method_order,
-    order_method,
-)
+from ngdual.studies.figures.plan import COARSE_ORDERS, ORDERS
 from ngdual.studies.figures.tasks import paired_timing, truth_tasks
 from ngdual.studies.sweep.timing import REPEAT_BELOW_S
 
 THESIS = "Work-precision (beyond the thesis)"
 STUDIES = ("truth",)
-TARGETS = (0.05, 0.02, 0.01)
-MEASURES = {"pressure": "pressure error on $\\Gamma_C$ (rel. $L^2$) [-]",
-            "sigma_energy": "error of $\\sigma$ (rel. compliance norm) [-]"}
 UNIFORM, P2 = "uniform", "primal P2"
 # A verdict whose adaptive and uniform times lie within this factor of each other (both
 # under REPEAT_BELOW_S) is timed again in pairs, the two methods in turn (paired_timing):
@@ -108,48 +105,18 @@ CLOSE = 1.3
 SUMMARY_NAMES = {"frictionless": "3.46, μ_f = 0", "coulomb": "3.46, μ_f = 0.5",
                  "flat-punch": "punch core", "hertz-cylinder": "Hertz",
                  "cattaneo-mindlin": "Cattaneo–Mindlin", "wedge": "wedge"}
-# the figure's curves: a colour per order (the peers: grey P1, black P2), a line style and
-# a marker per method
-ORDER_COLOURS = {0: "C0", 1: "C1", 2: "C2"}
-PEER_COLOURS = {"primal P1": "0.55", P2: "k"}
-METHOD_STYLES = {UNIFORM: ("-", "o"), "adaptive, stress goal": ("--", "s"),
-                 "adaptive, pressure goal": ("-.", "D"), "primal": (":", "^")}
-
-
-def is_peer(method: str) -> bool:
-    return method.startswith("primal")
-
-
-def time_to_accuracy(points: list[dict], measure: str, target: float) -> dict | None:
-    """The point of least time whose error ``measure`` is at most ``target``."""
-    hits = [p for p in points if p.get(measure) is not None and p[measure] <= target]
-    return min(hits, key=lambda p: p["time_s"]) if hits else None
-
-
 def accuracy_table(rows: list[dict], references: dict) -> list[dict]:
-    """Least time (and its unknowns) to each target per problem, measure and method, with
-    the method's order k and multiplier family; ``resolved`` whether the reference of the
-    measure resolves the target; ``failed`` the first failure of the method's solves."""
-    table = []
-    for problem in TRUTH_PROBLEMS:
-        mine = [r for r in rows if r["problem"] == problem]
-        for measure in MEASURES:
-            resolves = references[problem][measure]["resolves"]
-            for target in TARGETS:
-                for method in dict.fromkeys(r["method"] for r in mine):
-                    solves = [r for r in mine if r["method"] == method]
-                    hit = time_to_accuracy([r for r in solves if r["status"] == "ok"],
-                                           measure, target)
-                    failed = next((f"{r['status']}: {r.get('message', '')}" for r in solves
-                                   if r["status"] != "ok"), None)
-                    table.append({"problem": problem, "measure": measure, "target": target,
-                                  "method": method, "order": solves[0]["order"],
-                                  "multipliers": solves[0]["multipliers"],
-                                  "time_s": hit and hit["time_s"],
-                                  "ndof": hit and hit["ndof"],
-                                  "level_or_step": hit and hit["level_or_step"],
-                                  "resolved": target in resolves, "failed": failed})
-    return table
+    """Least time (and its unknowns) to each target per problem, measure and method
+    (:func:`ngdual.studies.cost.table.accuracy_rows` of each problem, the table of
+    ``ngdual cost``)."""
+    return [{"problem": problem, **r} for problem in TRUTH_PROBLEMS
+            for r in accuracy_rows([r for r in rows if r["problem"] == problem],
+                                   references[problem])]
+
+
+def is_p2(method: str) -> bool:
+    """Whether ``method`` is the primal P2 peer, uniform or adaptive."""
+    return method.startswith(P2)
 
 
 def _fastest(table: list[dict], problem: str, measure: str, target: float, which
@@ -189,7 +156,8 @@ def verdicts(table: list[dict]) -> list[dict]:
     refinement of order 0 (``adaptive_wins``: it reaches the target first, or uniform does
     not within its budget), the fastest adaptive run of any order against the fastest
     uniform refinement of any order (``adaptive_any_wins``), and the fastest ngdual method
-    against the primal P2 peer (``ratio`` = ngdual time / P2 time), also among the methods
+    against the primal P2 peer, uniform or adaptive (``ratio`` = ngdual time / P2 time), also
+    among the methods
     of order k >= 1 (``ratio_order_p2``)."""
     out = []
     for problem in TRUTH_PROBLEMS:
@@ -204,7 +172,7 @@ def verdicts(table: list[dict]) -> list[dict]:
                 ngdual = _fastest(table, *key, lambda m: not is_peer(m))
                 higher = _fastest(table, *key,
                                   lambda m: not is_peer(m) and method_order(m)[0] >= 1)
-                p2 = _fastest(table, *key, lambda m: m == P2)
+                p2 = _fastest(table, *key, is_p2)
                 resolved = next(r["resolved"] for r in table if (r["problem"], r["measure"],
                                                                  r["target"]) == key)
                 out.append({
@@ -331,24 +299,17 @@ def pivot(table: list[dict], verdict: list[dict]) -> list[dict]:
     return out
 
 
-def seconds_and_unknowns(time_s: float, ndof: int) -> str:
-    """A cell of the summary: the time to two digits (one decimal from 10 s on) and the
-    unknowns in groups of three.
-
-    >>> seconds_and_unknowns(0.0987, 12721), seconds_and_unknowns(24.93, 592390)
-    ('0.099 s (12 721)', '24.9 s (592 390)')
-    """
-    time = f"{time_s:.1f}" if time_s >= 10 else f"{time_s:.2g}"
-    return f"{time} s ({ndof:,})".replace(",", " ")
-
-
 def method_letters(method: str) -> str:
     """u (uniform), s / p (adaptive, stress / pressure goal), with c for the coarse
-    multipliers of order k.
+    multipliers of order k; a peer: none uniform, a adaptive.
 
     >>> method_letters("adaptive, pressure goal, k = 2"), method_letters("uniform, k = 1, coarse")
     ('p', 'uc')
+    >>> method_letters("primal P2"), method_letters("primal P2, adaptive")
+    ('', 'a')
     """
+    if is_peer(method):
+        return "a" if method.endswith("adaptive") else ""
     base = {UNIFORM: "u", "adaptive, stress goal": "s", "adaptive, pressure goal": "p"}
     order, family = method_order(method)
     return base[method_base(method)] + ("c" if order and family == "coarse" else "")
@@ -384,7 +345,7 @@ def summary_rows(table: list[dict], verdict: list[dict], measure: str) -> list[d
             return None
         best = min(hits, key=lambda r: r["time_s"])
         text = seconds_and_unknowns(best["time_s"], best["ndof"])
-        return f"{text} {method_letters(best['method'])}" if letters else text
+        return f"{text} {method_letters(best['method'])}".rstrip() if letters else text
 
     def ratio(value: float | None) -> str | None:
         return None if value is None else f"{value:.2g}"
@@ -401,7 +362,7 @@ def summary_rows(table: list[dict], verdict: list[dict], measure: str) -> list[d
                "adaptive": cell([r for r in ngdual if r["method"].startswith("adaptive")
                                  and r["order"] == 0]),
                **{f"k{k}": cell([r for r in ngdual if r["order"] == k]) for k in ORDERS},
-               "p2": cell([r for r in mine if r["method"] == P2], letters=False),
+               "p2": cell([r for r in mine if is_p2(r["method"])]),
                "ratio": ratio(v["ratio_ngdual_p2"]), "ratio_order": ratio(v["ratio_order_p2"]),
                "first": first_cell(v),
                "resolved": "yes" if v["resolved"] else "no"}
@@ -418,25 +379,6 @@ def summary_markdown(table: list[dict], verdict: list[dict]) -> str:
          **{f"k{k}": f"k = {k}" for k in ORDERS}, "p2": "primal P2", "ratio": "ngdual / P2",
          "ratio_order": "k ≥ 1 / P2", "first": "adaptive first", "resolved": "resolved"},
         missing="–") for measure, header in what.items()) + "\n"
-
-
-def curve_style(method: str) -> dict:
-    """The colour of the method's order (:data:`ORDER_COLOURS`; the peers
-    :data:`PEER_COLOURS`), the line style and marker of the method (:data:`METHOD_STYLES`);
-    at order k >= 1 the coarse multipliers' markers are hollow.
-
-    >>> curve_style("adaptive, pressure goal, k = 2")
-    {'color': 'C2', 'ls': '-.', 'marker': 'D', 'ms': 4}
-    >>> curve_style("uniform, k = 1, coarse")["mfc"]
-    'none'
-    """
-    if is_peer(method):
-        ls, marker = METHOD_STYLES["primal"]
-        return {"color": PEER_COLOURS[method], "ls": ls, "marker": marker, "ms": 4}
-    ls, marker = METHOD_STYLES[method_base(method)]
-    order, family = method_order(method)
-    hollow = {"mfc": "none"} if order and family == "coarse" else {}
-    return {"color": ORDER_COLOURS[order], "ls": ls, "marker": marker, "ms": 4, **hollow}
 
 
 # the figures' file names per measure (work_precision_pressure.png, ..._sigma.png)
@@ -541,7 +483,7 @@ SUMMARY_KINDS = {  # the summary's markers: which methods each takes the fastest
                         "C0", "D"),
     "fastest ngdual, k ≥ 1": (lambda r: not is_peer(r["method"]) and r["order"] >= 1,
                               "C2", "s"),
-    "primal P2": (lambda r: r["method"] == P2, "k", "^")}
+    "primal P2": (lambda r: is_p2(r["method"]), "k", "^")}
 
 
 def plot_summary(table: list[dict]):
@@ -717,7 +659,9 @@ def run(ctx):
                                 "adaptive, pressure goal")},
                    **{order_method(UNIFORM, k, "coarse"): f"uniform, k = {k} (coarse)"
                       for k in COARSE_ORDERS},
-                   "primal P1": "primal P1", P2: "primal P2", "ratio": "fastest ngdual / P2",
+                   **{f"primal P{k}{a}": f"primal P{k}{a}" for k in (1, 2)
+                      for a in ("", ", adaptive")},
+                   "ratio": "fastest ngdual / P2",
                    "ratio_order": "fastest k >= 1 / P2", "resolved": "reference resolves"}),
               notes=f"Machine: {machine['cpus']} cores, load average "
                     f"{machine['load_average'][0]:.1f} at the end; sweep tasks run side by "

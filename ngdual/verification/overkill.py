@@ -174,13 +174,30 @@ def gauss_samples(x0, x1, subdivisions: int = 1) -> tuple[np.ndarray, np.ndarray
     return x.ravel(), np.broadcast_to(h[..., None] * w, x.shape).ravel()
 
 
-def pressure_error(x, w, p, reference: dict, window: float | None = None) -> dict:
-    """||p_h - p_ref||_L2 and ||p_ref||_L2 on Gamma_C (or on its part |x| <= ``window``),
-    from Gauss samples of the candidate (points x, arc-length weights w) on pieces where the
-    reference (P1 in x, ``x`` and ``p``) is linear; ``rel`` their ratio, ``max`` the largest
-    difference at the samples relative to max |p_ref|."""
+def in_window(x: np.ndarray, window) -> np.ndarray:
+    """Which abscissae ``x`` lie in ``window``: |x| <= window for a number, lo <= x <= hi
+    for a pair (lo, hi), all for None.
+
+    >>> in_window(np.array([-2.0, 0.5, 1.5]), 1.0), in_window(np.array([0.5, 1.5]), (1, 2))
+    (array([False,  True, False]), array([False,  True]))
+    """
+    x = np.asarray(x)
+    if window is None:
+        return np.ones(x.shape, bool)
+    if np.ndim(window) == 0:
+        return np.abs(x) <= window
+    lo, hi = window
+    return (x >= lo) & (x <= hi)
+
+
+def pressure_error(x, w, p, reference: dict, window=None) -> dict:
+    """||p_h - p_ref||_L2 and ||p_ref||_L2 on Gamma_C (or on its part ``window``: |x| <= window
+    for a number, lo <= x <= hi for a pair, :func:`in_window`), from Gauss samples of the
+    candidate (points x, arc-length weights w) on pieces where the reference (P1 in x, ``x``
+    and ``p``) is linear; ``rel`` their ratio, ``max`` the largest difference at the samples
+    relative to max |p_ref|."""
     x, w, p = map(np.asarray, (x, w, p))
-    keep = np.ones(len(x), bool) if window is None else np.abs(x) <= window
+    keep = in_window(x, window)
     ref = _interp(reference, x[keep])
     diff = p[keep] - ref
     l2 = math.sqrt(float(np.sum(w[keep] * diff**2)))

@@ -8,8 +8,8 @@ from __future__ import annotations
 import functools
 import math
 
+from ..cost.methods import method_base, method_order
 from .own_errors import TRUE_MEASURES, measures
-from .plan import method_base, method_order
 
 # a Richardson estimate that bounds a three-cornered hat (hat_bound) counts at this many
 # times its value: it assumes the asymptotic ratio, and where a run has both, it lies up

@@ -227,48 +227,6 @@ COARSE_ORDERS = (1, 2)
 COARSE_ORDER_PROBLEMS = ("frictionless", "flat-punch", "hertz-cylinder", "wedge")
 
 
-def order_overrides(order: int, family: str = "facet") -> tuple[str, ...]:
-    """The settings of PEERS_``order`` with the multipliers ``family`` ("facet" or
-    "coarse"; none at order 0: the thesis' method with its coarse multipliers)."""
-    if order == 0:
-        return ()
-    return (setting("discretisation.order", order),
-            setting("discretisation.multipliers", family))
-
-
-def order_method(method: str, order: int, family: str = "facet") -> str:
-    """The name of ``method`` ("uniform", "adaptive, pressure goal") at ``order`` with the
-    multipliers ``family``.
-
-    >>> order_method("uniform", 2), order_method("uniform", 1, "coarse")
-    ('uniform, k = 2', 'uniform, k = 1, coarse')
-    """
-    if order == 0:
-        return method
-    return f"{method}, k = {order}" + (", coarse" if family == "coarse" else "")
-
-
-def method_order(method: str) -> tuple[int, str]:
-    """The order k and the multiplier family of a method named by :func:`order_method`;
-    a primal peer: the degree of its displacements and its Nitsche contact.
-
-    >>> method_order("uniform"), method_order("uniform, k = 1, coarse")
-    ((0, 'coarse'), (1, 'coarse'))
-    """
-    if method.startswith("primal P"):
-        return int(method.removeprefix("primal P")), "Nitsche"
-    _, _, tail = method.partition(", k = ")
-    if not tail:
-        return 0, "coarse"
-    order, _, family = tail.partition(", ")
-    return int(order), family or "facet"
-
-
-def method_base(method: str) -> str:
-    """The method without its order and multipliers ("adaptive, stress goal")."""
-    return method.partition(", k = ")[0]
-
-
 GAP_CASES = {
     # key: (scene, overrides); solved with the default solver on Plan.gap_level and with the
     # thesis' nested Uzawa on Plan.uzawa_gap_level ("uzawa-" + key)

@@ -8,6 +8,7 @@ for, so the tables and the figures share it.
 
 from __future__ import annotations
 
+from ..cost.methods import order_method, order_overrides
 from ..sweep import Task
 from ..sweep.adaptive_tasks import LOOP_KEYS
 from ..sweep.timing import PAIRED_ROUNDS
@@ -27,8 +28,6 @@ from .plan import (
     TRUTH_GOALS,
     TRUTH_PROBLEMS,
     Plan,
-    order_method,
-    order_overrides,
 )
 
 
@@ -159,6 +158,18 @@ def peer_solve(plan: Plan, problem: str, level: int, order: int) -> Task:
                 f"{tp.scene} L{level} peer P{order}", _cost(level, False))
 
 
+def peer_adapt(plan: Plan, problem: str, order: int) -> Task:
+    """The primal peer of degree ``order`` adapting on a :data:`TRUTH_PROBLEMS` scene
+    (Kelly's indicator, :func:`~ngdual.studies.sweep.adaptive_tasks.peer_adapt_task`) to the
+    budget :meth:`Plan.reference_elements` of ngdual's adaptive runs at order 0."""
+    tp = TRUTH_PROBLEMS[problem]
+    return Task("peer_adapt", {"scene": tp.scene, "order": order,
+                               "overrides": list(tp.overrides), "subdivisions": 4,
+                               "max_elements": plan.reference_elements(problem),
+                               **_repeats(plan)},
+                f"{tp.scene} peer P{order} adaptive", 2.0 * plan.truth_levels(problem)[-1])
+
+
 def paired_timing(plan: Plan, uniform: Task, adaptive: Task, unknowns: list[int]) -> Task:
     """The uniform solve ``uniform`` and the adaptive run ``adaptive`` to the solution of
     its step of ``unknowns[-1]`` unknowns (``unknowns``: its steps' up to that one), timed
@@ -180,7 +191,7 @@ def truth_tasks(plan: Plan, problem: str) -> dict[str, list[Task]]:
     refinement and both goals' runs, on the frictionless problems
     :data:`~.plan.COARSE_ORDER_PROBLEMS` uniform refinement at the orders
     :data:`~.plan.COARSE_ORDERS` with the coarse multipliers, the primal peers on the
-    uniform levels."""
+    uniform levels and adapting (:func:`peer_adapt`)."""
     levels = plan.truth_levels(problem)
     out = {"uniform": [truth_solve(plan, problem, lv) for lv in levels]}
     for goal in TRUTH_GOALS:
@@ -197,6 +208,7 @@ def truth_tasks(plan: Plan, problem: str) -> dict[str, list[Task]]:
             for lv in plan.order_levels(problem, order)]
     for order in PEER_ORDERS:
         out[f"primal P{order}"] = [peer_solve(plan, problem, lv, order) for lv in levels]
+        out[f"primal P{order}, adaptive"] = [peer_adapt(plan, problem, order)]
     return out
 
 

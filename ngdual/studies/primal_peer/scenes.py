@@ -97,14 +97,18 @@ def primal_solution(scene, level: int | None = None, order: int = 1, *, mesh=Non
     return solve_primal(mesh, **primal_arguments(scene), order=order, mixed=mixed, **settings)
 
 
+def taylor_hood(scene, order: int) -> bool:
+    """Whether the peer of degree ``order`` solves ``scene`` in the Taylor-Hood form
+    (P``order`` - P``order-1``): for order >= 2 and nu >= :data:`NEARLY_INCOMPRESSIBLE`."""
+    return order >= 2 and scene.material.nu >= NEARLY_INCOMPRESSIBLE
+
+
 def solve_scene_primal(scene, level: int, order: int, **kw) -> tuple[PrimalResult, float]:
     """Solve an ngdual scene (its mesh on ``level``, :func:`primal_solution`) by the peer
-    with P``order`` elements, in the Taylor-Hood form (P``order`` - P``order-1``) for
-    order >= 2 and nu >= ``NEARLY_INCOMPRESSIBLE``; returns the result and the wall time,
-    meshing included."""
-    mixed = order >= 2 and scene.material.nu >= NEARLY_INCOMPRESSIBLE
+    with P``order`` elements, in the Taylor-Hood form where :func:`taylor_hood` asks for it;
+    returns the result and the wall time, meshing included."""
     start = time.perf_counter()
-    result = primal_solution(scene, level, order, mixed=mixed, **kw)
+    result = primal_solution(scene, level, order, mixed=taylor_hood(scene, order), **kw)
     return result, time.perf_counter() - start
 
 

@@ -1,6 +1,7 @@
 """The sweep tasks of an adaptive run: ``adapt`` (a run of :func:`ngdual.afem.adapt` with the
-extras of Section 4.2, :func:`adapt_task`) and ``paired`` (a uniform solve and an adaptive
-run timed in turn, :func:`paired_task`), each returning a record and arrays."""
+extras of Section 4.2, :func:`adapt_task`), ``peer_adapt`` (the primal peer adapting,
+:func:`peer_adapt_task`) and ``paired`` (a uniform solve and an adaptive run timed in turn,
+:func:`paired_task`), each returning a record and arrays."""
 
 from __future__ import annotations
 
@@ -10,10 +11,12 @@ import warnings
 import numpy as np
 
 from .solve_tasks import load_scene_with, solve_quietly
-from .timing import PAIRED_ROUNDS, REPEAT_BELOW_S, median_steps
+from .timing import PAIRED_ROUNDS, REPEAT_BELOW_S, Share, median_steps
 
 # the keyword arguments of ngdual.afem.adapt that an adaptive task carries
 LOOP_KEYS = ("marking", "theta", "steps", "level", "goal", "tol", "window")
+# the growth of an adaptive run's first step, before a second one measures it
+ADAPTIVE_GROWTH = 2.0
 
 
 def loop_arguments(params: dict) -> dict:
@@ -34,7 +37,7 @@ def adapt_task(scene: str, marking: str, theta: float, steps: int, level: int,
                max_elements: int | None = None, goal: str = "stress",
                tol: float | None = None, window: list[float] | None = None,
                reference_order: int | None = None, reference_dofs: int = 0,
-               repeat: int = 1) -> tuple[dict, dict]:
+               repeat: int = 1, share_s: float | None = None) -> tuple[dict, dict]:
     """An adaptive run (:func:`ngdual.afem.adapt` with its ``goal``, ``tol`` and ``window``):
     its history, with extras for Section 4.2.
 
@@ -59,6 +62,9 @@ def adapt_task(scene: str, marking: str, theta: float, steps: int, level: int,
     (:func:`_loop_times`); ``cumulative_runs_s`` holds every run's time to the step, and
     ``cumulative_s`` is the sum of the steps' median times (a step's time is its cumulative time
     less the step before's), so it grows with the steps as one run's does.
+
+    With ``share_s`` the run also stops after the first step whose successor would end past
+    ``share_s`` seconds of the task's wall time (:class:`~ngdual.studies.sweep.timing.Share`).
     """
     from ...afem import adapt
     from ...estimator import estimate
@@ -66,6 +72,7 @@ def adapt_task(scene: str, marking: str, theta: float, steps: int, level: int,
     from ...solution import ConvergenceError
 
     history, arrays = [], {}
+    share = None if share_s is None else Share(share_s)
     run = {"scene": scene, "marking": marking, "theta": theta, "steps": steps, "level": level,
            "overrides": list(overrides), "goal": goal, "tol": tol, "window": window,
            "reference_order": reference_order}
@@ -97,6 +104,8 @@ def adapt_task(scene: str, marking: str, theta: float, steps: int, level: int,
                     run["reference_order_failed"] = f"step {k}: {err}"
         history.append(dict(record))
         if max_elements is not None and record["elements"] >= max_elements:
+            raise _Budget
+        if share is not None and not share.next_fits(record["dofs"]["total"], ADAPTIVE_GROWTH):
             raise _Budget
 
     loop = loop_arguments({"marking": marking, "theta": theta, "steps": steps, "level": level,
@@ -162,6 +171,81 @@ def _tolerance_kept_quiet():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ToleranceWarning)
         yield
+
+
+def peer_adapt_task(scene: str, order: int, share_s: float | None = None,
+                    overrides: list[str] = (), subdivisions: int = 1,
+                    max_elements: int | None = None, repeat: int = 1) -> tuple[dict, dict]:
+    """The primal peer of degree ``order`` adapting on ``scene``
+    (:func:`~ngdual.studies.primal_peer.adapt_primal`: Kelly's indicator, Dörfler marking,
+    netgen's bisection, as a tolerance run of :func:`ngdual.adapt`) until the next step would
+    end past ``share_s`` seconds of wall time (:class:`~ngdual.studies.sweep.timing.Share`),
+    after the first step of ``max_elements`` triangles, or when Newton fails
+    (``stopped_by``). The record's ``history`` holds per step the records of
+    :func:`~ngdual.studies.primal_peer.adapt_primal` and ``cumulative_s``, its
+    ``solved_s``; the arrays every step's :func:`~ngdual.studies.primal_peer.primal_samples`
+    (the edges of Gamma_C split into ``subdivisions`` parts), prefixed ``s<step>_``. With
+    ``repeat`` > 1 the loop alone runs again as :func:`adapt_task`'s does, and
+    ``cumulative_s`` is the sum of the steps' median times."""
+    from ..primal_peer import primal_samples
+
+    sc = load_scene_with(scene, overrides)
+    share = None if share_s is None else Share(share_s)
+    history, arrays = [], {}
+
+    def on_step(record, result):
+        record["cumulative_s"] = record["solved_s"]
+        arrays.update({f"s{record['step']}_{k}": v
+                       for k, v in primal_samples(sc, result, subdivisions).items()})
+        history.append(dict(record))
+        if max_elements is not None and record["elements"] >= max_elements:
+            raise _Budget
+        if share is not None and not share.next_fits(record["ndof"], ADAPTIVE_GROWTH):
+            raise _Budget
+
+    stopped = _peer_loop(sc, order, on_step)
+    if not history:
+        return {"status": "failed", "message": stopped}, {}
+    runs = [[r["cumulative_s"] for r in history]]
+    while len(runs) < repeat and runs[0][0] < REPEAT_BELOW_S:
+        runs.append(_peer_loop_times(sc, order, [r["ndof"] for r in history]))
+    for r, cumulative in zip(history, median_steps(runs)):
+        r["cumulative_runs_s"] = [t[r["step"]] for t in runs if len(t) > r["step"]]
+        r["cumulative_s"] = cumulative
+    return {"status": "ok", "scene": scene, "order": order, "history": history,
+            "stopped_by": stopped}, arrays
+
+
+def _peer_loop(scene, order: int, on_step) -> str:
+    """Run :func:`~ngdual.studies.primal_peer.adapt_primal` with ``on_step``; what stopped
+    it: "steps", "budget" (``on_step`` raised :class:`_Budget`) or Newton's failure."""
+    from ..primal_peer import NewtonError, adapt_primal
+
+    try:
+        adapt_primal(scene, order, on_step=on_step)
+    except _Budget:
+        return "budget"
+    except NewtonError as err:
+        return f"Newton failed: {err}"
+    return "steps"
+
+
+def _peer_loop_times(scene, order: int, unknowns: list[int]) -> list[float]:
+    """The wall time to every step's solution of the adaptive peer (``solved_s``) up to the
+    step of the last of ``unknowns`` or the first past
+    :data:`~ngdual.studies.sweep.timing.REPEAT_BELOW_S`; the steps from the first whose
+    unknowns differ are left out."""
+    times = []
+
+    def on_step(record, result):
+        if record["step"] >= len(unknowns) or record["ndof"] != unknowns[record["step"]]:
+            raise _Budget
+        times.append(record["solved_s"])
+        if record["step"] == len(unknowns) - 1 or times[-1] >= REPEAT_BELOW_S:
+            raise _Budget
+
+    _peer_loop(scene, order, on_step)
+    return times
 
 
 def paired_task(uniform: dict, adaptive: dict, unknowns: list[int],

@@ -98,8 +98,19 @@ class Runner:
         self.workers = workers or os.cpu_count() or 1
         self.progress = progress
         self._client = self._cluster = None
+        self._warm = False
         self.failed: dict[str, dict] = {}
         self.computed = 0
+
+    def start(self) -> None:
+        """Start the workers and warm them up (:func:`warm_up`), or warm up this process when
+        the tasks run here: what the first timed task should not pay for."""
+        if self.in_process:
+            if not self._warm:
+                warm_up()
+                self._warm = True
+        else:
+            self.client()
 
     def client(self):
         if self._client is None:
@@ -182,8 +193,7 @@ class Runner:
     def _outcomes(self, todo: list[Task], folder: Path):
         """(task, a function returning its (record, arrays) or raising) as tasks finish."""
         if self.in_process:
-            if not self.computed:
-                warm_up()
+            self.start()
             for task in todo:
                 yield task, (lambda t=task: run_task(t, str(folder)))
             return

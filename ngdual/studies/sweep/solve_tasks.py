@@ -1,7 +1,8 @@
 """The sweep tasks of one solve: ``solve`` (one scene on one level, with the estimator and
 optionally the field arrays or the solution samples of the true-error studies), ``dofs``
-(Table 3.1), ``peer`` (the primal peer, :mod:`ngdual.studies.primal_peer`) and
-``manufactured`` (exact errors and the estimator), each returning a record and arrays."""
+(Table 3.1), ``peer`` (the primal peer, :mod:`ngdual.studies.primal_peer`),
+``manufactured`` (exact errors and the estimator) and ``uniform`` (the levels of uniform
+refinement within a wall-time share), each returning a record and arrays."""
 
 from __future__ import annotations
 
@@ -10,7 +11,13 @@ import warnings
 import numpy as np
 
 from .fields import field_arrays
-from .timing import repeated
+from .timing import Share, repeated
+
+# a uniform refinement multiplies the unknowns by about four, and the time by at least that
+UNIFORM_GROWTH = 4.0
+# the peer's pressure samples on a level L split every Gamma_C edge into 2^(K - L) parts,
+# K = SUBDIVIDED_LEVEL (as :func:`peer_task` does with the finest level of the study)
+SUBDIVIDED_LEVEL = 5
 
 
 def load_scene_with(scene: str, overrides):
@@ -105,6 +112,58 @@ def peer_task(scene: str, level: int, order: int, overrides: list[str] = (),
     runs = repeated(seconds, lambda: solve_scene_primal(sc, level, order)[1], repeat)
     record.update(time_s=float(np.median(runs)), time_runs_s=runs)
     return record, primal_samples(sc, result, subdivisions)
+
+
+def uniform_task(scene: str, share_s: float, overrides: list[str] = (),
+                 peer_order: int | None = None) -> tuple[dict, dict]:
+    """Uniform refinement of ``scene`` within ``share_s`` seconds of wall time: its levels
+    1, 2, ... solved by ngdual (by the primal peer of degree ``peer_order``), each timed as
+    :func:`solve_task` (:func:`peer_task`) times one solve, until the next level would end
+    past the share (:class:`~ngdual.studies.sweep.timing.Share`), would not fit in memory
+    (:func:`ngdual.budget.check_scene`) or a solve fails (``stopped_by`` of the record:
+    ``"share"``, ``"memory"`` or the failure).
+
+    The record's ``history`` holds per level ``level``, ``ndof``, ``elements`` and
+    ``time_s``; the arrays every level's samples (:func:`ngdual.verification.overkill.
+    solution_samples`, :func:`~ngdual.studies.primal_peer.primal_samples` with the edges of
+    Gamma_C split as finely as those of level :data:`SUBDIVIDED_LEVEL`), prefixed
+    ``s<level>_``."""
+    from ...budget import check_scene
+    from ...scene import SceneError
+    from ...solution import ConvergenceError
+    from ...verification.overkill import solution_samples
+    from ..primal_peer import NewtonError, primal_samples, solve_scene_primal
+
+    sc = load_scene_with(scene, overrides)
+    share = Share(share_s)
+    history, arrays, stopped = [], {}, "share"
+    for level in range(1, 100):
+        try:
+            if peer_order is None:
+                solution = solve_quietly(sc, level)
+                seconds, mesh = solution.timings["total"], solution.problem.fes.mesh
+                ndof = int(sum(solution.problem.spaces.dofs().values()))
+                samples = solution_samples(solution)
+            else:
+                result, seconds = solve_scene_primal(sc, level, peer_order)
+                mesh, ndof = result.u.space.mesh, int(result.ndof)
+                samples = primal_samples(sc, result, 2 ** max(SUBDIVIDED_LEVEL - level, 0))
+        except (ConvergenceError, NewtonError) as err:
+            stopped = f"failed on level {level}: {err}"
+            break
+        history.append({"level": level, "ndof": ndof, "elements": mesh.ne, "time_s": seconds})
+        arrays.update({f"s{level}_{k}": v for k, v in samples.items()})
+        if not share.next_fits(ndof, UNIFORM_GROWTH):
+            break
+        try:
+            check_scene(sc, level + 1)
+        except SceneError:
+            stopped = "memory"
+            break
+    if not history:
+        return {"status": "failed", "message": stopped}, {}
+    return {"status": "ok", "scene": scene, "peer_order": peer_order, "history": history,
+            "stopped_by": stopped}, arrays
 
 
 def manufactured_task(case: str, level: int, marking: str | None = None, theta: float = 0.5,

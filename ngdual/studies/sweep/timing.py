@@ -1,10 +1,11 @@
 """How a sweep task is timed: the median of repeated runs (:func:`repeated`,
-:func:`median_steps`), the rounds of a paired timing, and one thread per task
-(:func:`one_thread`)."""
+:func:`median_steps`), the rounds of a paired timing, one thread per task
+(:func:`one_thread`) and the wall time a task may spend (:class:`Share`)."""
 
 from __future__ import annotations
 
 import contextlib
+import time
 from collections.abc import Callable
 
 import numpy as np
@@ -78,3 +79,31 @@ def one_thread():
             yield _ngsolve_threads()
     finally:
         ngs.SetNumThreads(before)
+
+
+class Share:
+    """The wall time a task of steps (the levels of uniform refinement, an adaptive run) may
+    spend, from its creation: :meth:`next_fits` after each step says whether the next one
+    ends within it, predicted as the last step's wall time times its growth (the larger of
+    the growth of the unknowns and of the step's time; ``growth`` before the second step).
+    A step may still overrun it by what the prediction misses.
+
+    >>> share = Share(0.0)
+    >>> share.next_fits(100, 4.0)
+    False
+    """
+
+    def __init__(self, seconds: float):
+        self.seconds = float(seconds)
+        self.start = self.last = time.perf_counter()
+        self.steps: list[tuple[int, float]] = []
+
+    def next_fits(self, unknowns: int, growth: float) -> bool:
+        now = time.perf_counter()
+        step = now - self.last
+        if self.steps:
+            before_n, before_s = self.steps[-1]
+            growth = max(unknowns / before_n, step / before_s if before_s > 0 else 1.0, 1.0)
+        self.steps.append((unknowns, step))
+        self.last = now
+        return now - self.start + step * growth <= self.seconds

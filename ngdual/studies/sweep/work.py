@@ -3,8 +3,10 @@
 ``solve`` (one scene on one level, with the estimator and optionally the field arrays or
 the solution samples of the true-error studies), ``dofs`` (Table 3.1), ``adapt`` (an
 adaptive run with the extras of Section 4.2), ``peer`` (the primal peer,
-:mod:`ngdual.studies.primal_peer`), ``manufactured`` (exact errors and the estimator) and
-``paired`` (a uniform solve and an adaptive run timed in turn).
+:mod:`ngdual.studies.primal_peer`), ``manufactured`` (exact errors and the estimator),
+``paired`` (a uniform solve and an adaptive run timed in turn), and the methods of
+``ngdual cost`` within a wall-time share: ``uniform`` (uniform refinement, ngdual or the
+peer) and ``peer_adapt`` (the peer adapting).
 :func:`execute` runs one task and adds the header every record carries; writing it is
 :mod:`~ngdual.studies.sweep.records`' business, scheduling :mod:`~ngdual.studies.sweep.runner`'s.
 The tasks live in :mod:`~ngdual.studies.sweep.solve_tasks` and
@@ -22,14 +24,15 @@ import traceback
 from collections.abc import Callable
 
 from ...io import versions
-from .adaptive_tasks import adapt_task, paired_task
+from .adaptive_tasks import adapt_task, paired_task, peer_adapt_task
 from .records import Task
-from .solve_tasks import dofs_task, manufactured_task, peer_task, solve_task
+from .solve_tasks import dofs_task, manufactured_task, peer_task, solve_task, uniform_task
 from .timing import one_thread
 
 TASKS: dict[str, Callable[..., tuple[dict, dict]]] = {
     "solve": solve_task, "dofs": dofs_task, "adapt": adapt_task, "peer": peer_task,
-    "manufactured": manufactured_task, "paired": paired_task}
+    "manufactured": manufactured_task, "paired": paired_task, "uniform": uniform_task,
+    "peer_adapt": peer_adapt_task}
 
 
 def execute(task: Task) -> tuple[dict, dict]:
