@@ -137,7 +137,7 @@ def truth_adapt(plan: Plan, problem: str, goal: str, order: int = 0) -> Task:
                           "max_elements": (plan.order_elements(problem, order) if order
                                            else plan.reference_elements(problem)),
                           "goal": goal, "tol": tp.reference_tol,
-                          "window": ([-window, window] if window and goal == "pressure"
+                          "window": (list(window) if window and goal == "pressure"
                                      else None),
                           **({"reference_order": REFERENCE_ORDER,
                               "reference_dofs": REFERENCE_ORDER_DOFS}
