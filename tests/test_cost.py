@@ -115,6 +115,7 @@ def test_cost_rejects_bad_input_naming_the_field(tmp_path, capsys):
              (["cost", "hertz-cylinder", "--orders", "3"], "--orders"),
              (["cost", "hertz-cylinder", "--window", "0.5", "-0.5"], "--window"),
              (["cost", "hertz-cylinder", "--workers", "0"], "--workers"),
+             (["cost", "hertz-cylinder", "--workers", "2", "--threads"], "--workers"),
              (["cost", "thesis-3.46-frictionless"], "contact.ends"),
              (["cost", "hertz-cylinder", "--set", "material.nu=0.7"], "material.nu")]
     for argv, field in cases:

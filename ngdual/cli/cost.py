@@ -9,7 +9,7 @@ import time
 from pathlib import Path
 
 from ..scene import ORDERS, SceneError
-from .output import number_flag
+from .output import EXIT_NOT_CONVERGED, number_flag
 
 
 def add_cost(sub, common: argparse.ArgumentParser) -> None:
@@ -47,15 +47,16 @@ def add_cost(sub, common: argparse.ArgumentParser) -> None:
 
 def cmd_cost(args) -> int:
     """Run :func:`ngdual.studies.cost.cost`; print the references' own errors and the
-    time-to-accuracy tables; write DIR/cost.json and DIR/work_precision.png."""
+    time-to-accuracy tables; write DIR/cost.json and DIR/work_precision.png. Exit status 1
+    when no reference run finished a step."""
     from .. import plot
     from ..extras import MissingExtraError, require
     from ..io import check_output_dir, write_json
     from ..scene import load_scene
-    from ..studies.cost import cost
+    from ..studies.cost import NoReference, cost
     from ..studies.cost.budget import MIN_BUDGET_S
     from ..studies.cost.output import reference_line, table_text, work_precision_figure
-    from ..studies.cost.run import check_scene
+    from ..studies.cost.run import check_measurable
 
     start = time.perf_counter()
     number_flag(args.budget, "--budget", MIN_BUDGET_S, 1e6)
@@ -66,9 +67,12 @@ def cmd_cost(args) -> int:
                                      f"{', '.join(map(str, wrong))}")
     if args.workers is not None:
         number_flag(args.workers, "--workers", 1, 256, integer=True)
+        if args.threads:
+            raise SceneError("--workers", "with --threads the methods run one after another "
+                                          "in this process: give one of the two")
     if args.window is not None and not args.window[0] < args.window[1]:
         raise SceneError("--window", f"must be LO < HI, got {args.window}")
-    check_scene(load_scene(args.scene, args.set))
+    check_measurable(load_scene(args.scene, args.set))
     out = check_output_dir(args.out, "--out")
     in_process = args.threads
     if args.workers is not None:
@@ -80,8 +84,12 @@ def cmd_cost(args) -> int:
             print("ngdual: dask (the studies extra) is not installed: the methods run one "
                   "after another in this process (--threads)", file=sys.stderr)
             in_process = True
-    result = cost(args.scene, args.budget, out, sorted(set(args.orders)), args.set,
-                  args.window, args.workers, not in_process)
+    try:
+        result = cost(args.scene, args.budget, out, sorted(set(args.orders)), args.set,
+                      args.window, args.workers, not in_process)
+    except NoReference as err:
+        print(f"ngdual: not converged: {err}", file=sys.stderr)
+        return EXIT_NOT_CONVERGED
     for measure in result.measures:
         print(reference_line(measure, result.references[measure], result.window))
         print(table_text(result.table, measure))

@@ -10,6 +10,6 @@ study of ``ngdual figures`` measures with too), :mod:`~.table` (time to accuracy
 :mod:`~.output` (the text table and the figure), :mod:`~.run` (:func:`cost`).
 """
 
-from .run import DEFAULT_BUDGET_S, CostResult, cost
+from .run import DEFAULT_BUDGET_S, CostResult, NoReference, cost
 
-__all__ = ["DEFAULT_BUDGET_S", "CostResult", "cost"]
+__all__ = ["DEFAULT_BUDGET_S", "CostResult", "NoReference", "cost"]

@@ -26,6 +26,11 @@ from .table import MEASURES, accuracy_rows
 DEFAULT_BUDGET_S = 120.0
 
 
+class NoReference(RuntimeError):
+    """None of the runs the references come from finished a step: nothing to measure
+    against."""
+
+
 @dataclass
 class CostResult:
     """What :func:`cost` measured on one scene.
@@ -78,7 +83,7 @@ def records_folder(out: Path, source: str, overrides) -> Path:
     return out / "records" / digest
 
 
-def check_scene(scene) -> None:
+def check_measurable(scene) -> None:
     """A SceneError naming the field when no error of the scene is finite or it has nothing
     to measure: the thesis' ends of Gamma_C (sigma ~ 1/r at a clamped end, not in L2), no
     Gamma_C (no pressure)."""
@@ -108,8 +113,7 @@ def cost(scene: str, budget_s: float = DEFAULT_BUDGET_S, out: str | Path = "cost
         The wall time of the whole study: start-up, the methods' runs (each stops before a
         step that would end past its share), the true errors and the outputs.
     out : str or Path
-        The folder of the sweep records (``out/records``); a second run with the same
-        scene, budget and workers reuses them.
+        The folder of the sweep records (``out/records/<digest of the scene>``).
     orders : sequence of int
         The orders k of PEERS_k.
     window : (float, float), optional
@@ -126,10 +130,15 @@ def cost(scene: str, budget_s: float = DEFAULT_BUDGET_S, out: str | Path = "cost
     Returns
     -------
     CostResult
+
+    Raises
+    ------
+    NoReference
+        When none of the adaptive runs of the highest order finished a step.
     """
     start = time.perf_counter()
     sc = load_scene(scene, list(overrides))
-    check_scene(sc)
+    check_measurable(sc)
     window = pressure_window(sc) if window is None else tuple(window)
     source = scene_source(scene)
     folder = records_folder(Path(out), source, overrides)
@@ -148,8 +157,13 @@ def cost(scene: str, budget_s: float = DEFAULT_BUDGET_S, out: str | Path = "cost
     computed = time.perf_counter() - start
     found = candidates(tasks, lambda t: load_record(folder, t),
                        lambda t: load_arrays(folder, t) if load_record(folder, t) else {})
+    names = [m.name for m in references]
+    if not any(row["method"] in names and arrays for row, arrays in found):
+        failed = "; ".join(f"{row['method']}: {row.get('message') or row['status']}"
+                           for row, _ in found if row["method"] in names)
+        raise NoReference(f"no reference to measure against: {failed}")
     measured = true_errors_of(sc, found, window, quadrature=False, progress=progress,
-                              references_from=[m.name for m in references])
+                              references_from=names)
     table = accuracy_rows(measured["rows"], measured["reference"])
     summary = []
     for m in chosen:
