@@ -12,6 +12,9 @@ at least :data:`~ngdual.studies.effectivity.RESOLVES` times that accuracy.
 
 from __future__ import annotations
 
+import re
+from pathlib import Path
+
 import pytest
 
 from ngdual.studies.effectivity import (
@@ -70,3 +73,21 @@ def test_the_pressure_estimate_is_within_a_factor_2_on_ten_unseen_scenes(tmp_pat
     for row in data["rows"]:
         if row["resolved"]:
             assert _in_band(row), row
+
+
+def test_the_theory_page_lists_every_unseen_scene_and_keeps_the_band_where_it_claims_it():
+    """docs/theory/effectivity.md has a row per scene of the study; at orders 1 and 2 the
+    range of a scene without ``outside`` lies in [0.5, 2], and a scene with one shows the
+    value that leaves it in bold."""
+    page = (Path(__file__).parents[1] / "docs" / "theory" / "effectivity.md").read_text()
+    rows = {line.split("|")[1].strip().strip("`"): line.split("|")
+            for line in page.splitlines() if line.startswith("| `")}
+    for unseen in UNSEEN:
+        cells = rows[unseen.name]
+        for cell in cells[5:7]:   # orders 1 and 2: "min–max (counted/run)" or "value (1/1)"
+            values = [float(v) for v in re.findall(r"\d+\.\d+", cell.split("(")[0])]
+            assert values, cell
+            if unseen.outside:
+                continue
+            assert BAND[0] <= min(values) and max(values) <= BAND[1], (unseen.name, cell)
+        assert ("**" in "".join(cells[5:7])) is bool(unseen.outside), unseen.name

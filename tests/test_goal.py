@@ -324,9 +324,11 @@ def test_ngdual_adapt_that_misses_its_tol_says_why_with_exit_status_1(tmp_path, 
 
 
 def test_a_pressure_tolerance_reached_at_a_kink_of_gamma_c_warns_that_it_is_no_bound():
-    """On the wedge the pressure goal's estimate is 0.11-0.65 of the true error (its apex, a
-    kink of Gamma_C): a run that reaches its tol there says so, in its last record and as a
-    ToleranceWarning; the stress goal, and a window away from the kink, do not."""
+    """On the wedge the pressure goal's estimate with the thesis' multipliers is 0.10-0.49 of
+    the true error (its apex, a kink of Gamma_C): a run that reaches its tol there says so,
+    in its last record and as a ToleranceWarning; the stress goal, a window away from the
+    kink and the facet multipliers of order 1, whose estimate has a term for the kink, do
+    not."""
     wedge = load_scene("wedge")
     with pytest.warns(ToleranceWarning, match=r"below tol = 0.3, but Gamma_C has a kink at "
                                               r"\(0, 0\)"):
@@ -336,7 +338,8 @@ def test_a_pressure_tolerance_reached_at_a_kink_of_gamma_c_warns_that_it_is_no_b
     with warnings.catch_warnings():
         warnings.simplefilter("error", ToleranceWarning)
         quiet = [adapt(wedge, goal="stress", tol=0.5),
-                 adapt(wedge, goal="pressure", tol=0.5, window=(0.05, 0.5))]
+                 adapt(wedge, goal="pressure", tol=0.5, window=(0.05, 0.5)),
+                 adapt(wedge, goal="pressure", tol=0.3, order=1)]
     assert all(h[-1]["stopped_by"] == "tol" and "stop_message" not in h[-1] for h in quiet)
 
 
@@ -350,13 +353,16 @@ def test_ngdual_adapt_prints_the_kink_caution_with_exit_status_0(tmp_path, capsy
 
 @pytest.mark.slow
 def test_the_wedge_apex_stops_a_tight_tolerance_run_instead_of_breaking_it():
-    """The pressure goal of order 1 on the wedge falls to a relative estimate of 7.8e-4 and
-    then marks the apex alone while its estimate rises, towards Gamma_C edges at the
-    geometry's round-off: it stops when its marking reaches RESOLUTION, or stalls."""
+    """The pressure goal of order 1 on the wedge falls to a relative estimate of 8.3e-3 and
+    then marks the apex alone while its estimate rises with the true error (0.96 %, 1.29 %,
+    1.88 %: the discrete pressure at the apex grows faster than the log-singular one as its
+    edges shrink; effectivity 0.87, 1.17, 1.16, the apex term of goal.contact_ends), towards
+    Gamma_C edges at the geometry's round-off: it stops when its marking reaches RESOLUTION,
+    or stalls."""
     with pytest.warns(ToleranceWarning):
         history = adapt(load_scene("wedge"), goal="pressure", tol=3e-4, order=1)
     assert history[-1]["stopped_by"] in ("resolution", "stall")
-    assert min(r["relative_estimate"] for r in history) < 1e-3
+    assert min(r["relative_estimate"] for r in history) < 0.01
 
 
 @pytest.mark.parametrize("flag, value", [("--tol", "0"), ("--tol", "inf"), ("--theta", "2")])
@@ -585,8 +591,9 @@ def test_the_pressure_goal_has_no_jump_term_at_order_0_and_one_at_order_1(hertz)
 def test_the_far_field_and_the_edge_terms_have_their_own_constants_at_order_k(hertz):
     """goal.calibration: at k = 0 one constant for every term; at k = 1, 2 the edge terms
     take CALIBRATION_ORDER_K[k], the far field on all of Gamma_C CALIBRATION and a window's
-    far field CALIBRATION_WINDOW_ORDER_K; the ends of the contact zone (zero at k = 0) take
-    none (END_CONSTANT = 1: their term is a distance to the square-root profiles). The
+    far field CALIBRATION_WINDOW_ORDER_K; the ends of the contact zone and the kinks of
+    Gamma_C (zero at k = 0) take none (END_CONSTANT = 1: their terms are distances to the
+    square-root and logarithmic profiles). The
     estimate is the root of sum_k C_k^2 terms[k] and its indicators drive the marking: their
     squares sum to the squares of the summed terms."""
     from ngdual.goal import (
@@ -609,9 +616,37 @@ def test_the_far_field_and_the_edge_terms_have_their_own_constants_at_order_k(he
                              else CALIBRATION_WINDOW_ORDER_K)):
             pressure = goal_estimate(solution, estimated, window)
             assert pressure.calibration == {**dict.fromkeys(TERMS, edge), "end": END_CONSTANT,
-                                            "far": far}
+                                            "apex": END_CONSTANT, "far": far}
             summed = pressure.summed()
             assert (summed["end"] > 0) is (order > 0 and window is None)
+            assert summed["apex"] == 0.0   # Gamma_C has no kink
             assert (summed["kink"] > 0) is (order == 0 and window is None)
             assert summed["far"] == pytest.approx(far * np.sqrt(pressure.terms["far"].sum()))
             assert pressure.total == pytest.approx(np.sqrt(sum(v**2 for v in summed.values())))
+
+
+@pytest.mark.parametrize("order", [1, 2])
+def test_the_end_term_is_at_most_the_error_where_the_pressure_is_a_square_root_profile(order):
+    """goal.contact_ends.closest_profile: where the exact pressure on a patch is a profile
+    A s_+^(1/2), the distance of p_h to the closest profile is at most ||p - p_h|| (the
+    minimum over a set that holds p), and for the best P_k approximation of the profile,
+    edge by edge, at least half of it (two parameters cannot follow the P_k error; measured
+    0.85 and 0.96 of it)."""
+    from numpy.polynomial.legendre import leggauss
+
+    from ngdual.goal.contact_ends import closest_profile
+
+    t0, lengths, t_end = np.array([0.0, 1.0, 2.0]), np.ones(3), 0.63
+    exact = lambda t: 800.0 * np.sqrt(np.maximum(t_end - t, 0.0))   # noqa: E731
+    x, w = leggauss(200)
+    coefficients, error2 = [], 0.0
+    for a in t0:   # the L2 projection of degree k on every edge (split at the end)
+        pieces = [(a, a + 1)] if not a < t_end < a + 1 else [(a, t_end), (t_end, a + 1)]
+        t = np.concatenate([lo + (hi - lo) * (x + 1) / 2 for lo, hi in pieces])
+        wt = np.concatenate([(hi - lo) * w / 2 for lo, hi in pieces])
+        basis = np.vander(t - a, order + 1, increasing=True)
+        c = np.linalg.solve(basis.T @ (wt[:, None] * basis), basis.T @ (wt * exact(t)))
+        coefficients.append(c)
+        error2 += wt @ (basis @ c - exact(t)) ** 2
+    distance2 = closest_profile(np.array(coefficients), t0, lengths, [(-1, (0.0, 2.0))]).sum()
+    assert 0.25 * error2 <= distance2 <= 1.0001 * error2

@@ -22,6 +22,11 @@ p* = A s_+^(1/2) closest to p_h in L2 over A and the position of the end, and re
 patch with both ends, p* = A ((t - t_l)_+ (t_r - t)_+)^(1/2), Hertz's ellipse. The exact
 pressure is such a profile to O(s^(3/2)), so the distance is the error of p_h on the patch
 less the part of it that two parameters can follow: no constant is fitted.
+
+At a kink of Gamma_C (the wedge's apex, where two contact sides meet at an angle) the
+pressure is log-singular, p = b + c ln(1/r) + O(r) (c = E* tan(alpha) / pi for flanks of
+slope tan(alpha)): :func:`kink_distances` takes the closest such profile on KINK_EDGES edges
+either side of it in the same way.
 """
 
 from __future__ import annotations
@@ -96,10 +101,7 @@ def end_distances(p: ngs.CoefficientFunction, mesh: ngs.Mesh, gamma_c, order: in
     found = patches(gamma_c, contact)
     if not found:
         return out, in_patch
-    # p_h on every edge as a polynomial of degree k in the local parameter (exact)
-    nodes = 0.5 - 0.5 * np.cos(np.pi * (np.arange(order + 1) + 0.5) / (order + 1))
-    coefficients = np.linalg.solve(np.vander(nodes, order + 1, increasing=True),
-                                   edge_values(p, mesh, gamma_c, nodes).T).T
+    coefficients = _edge_polynomials(p, mesh, gamma_c, order)
     for edges, ends in found:
         lengths = gamma_c.lengths[edges]
         t0 = np.concatenate([[0.0], np.cumsum(lengths)[:-1]])
@@ -238,3 +240,81 @@ def _quadrature(t0: np.ndarray, lengths: np.ndarray, positions) -> tuple:
             ws.append(w)
             es.append(np.full(len(t), e))
     return np.concatenate(ts), np.concatenate(ws), np.concatenate(es)
+
+
+# the edges of the patch of a kink of Gamma_C on either chain that meets there
+KINK_EDGES = 2
+
+
+def kink_distances(p: ngs.CoefficientFunction, mesh: ngs.Mesh, gamma_c, order: int,
+                   kinks: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """||p* - p_h||^2 per fine edge of Gamma_C on the patches of the ``kinks`` of Gamma_C
+    (points (n, 2) where two chains meet at an angle), and which edges lie in a patch.
+
+    The patch of a kink is KINK_EDGES edges of either chain that meets there, and p* =
+    b + c ln(1/r) the profile closest to p_h on it in L2 over (b, c)
+    (:func:`closest_log_profile`), r the distance to the kink along Gamma_C.
+    """
+    n = len(gamma_c.lengths)
+    out, in_patch = np.zeros(n), np.zeros(n, bool)
+    if not len(kinks):
+        return out, in_patch
+    coefficients = _edge_polynomials(p, mesh, gamma_c, order)
+    starts = np.cumsum([0] + [chain.n_edges for chain in gamma_c.coarse.chains])
+    for point in np.asarray(kinks, float).reshape(-1, 2):
+        edges, near, far, forward = [], [], [], []
+        for c, chain in enumerate(gamma_c.coarse.chains):
+            scale = gamma_c.lengths[starts[c]:starts[c + 1]].min()
+            for at_start in (True, False):
+                if np.linalg.norm(chain.path_points[0 if at_start else -1] - point) > 1e-6 * scale:
+                    continue
+                m = min(KINK_EDGES, chain.n_edges)
+                idx = (starts[c] + np.arange(m) if at_start
+                       else starts[c + 1] - 1 - np.arange(m))
+                r = np.concatenate([[0.0], np.cumsum(gamma_c.lengths[idx])])
+                edges += idx.tolist()
+                near += r[:-1].tolist()
+                far += r[1:].tolist()
+                forward += [at_start] * m
+        if not edges:
+            continue
+        edges = np.array(edges)
+        out[edges] += closest_log_profile(coefficients[edges], np.array(near), np.array(far),
+                                          np.array(forward))
+        in_patch[edges] = True
+    return out, in_patch
+
+
+def closest_log_profile(coefficients: np.ndarray, near: np.ndarray, far: np.ndarray,
+                        forward: np.ndarray) -> np.ndarray:
+    """||p* - p_h||_e^2 on every edge e of a kink's patch, e at the distances [``near``,
+    ``far``] from the kink (``forward``: its local parameter runs away from the kink; p_h
+    on it a polynomial with ``coefficients``), p* = b + c ln(1/r) closest to p_h in
+    L2(patch): b and c solve 2 x 2 normal equations."""
+    rs, ws, es = [], [], []
+    for e, (a, b) in enumerate(zip(near, far)):
+        if a == 0.0:   # graded towards the kink, where ln r is singular
+            r, w = b * _X**3, _W * 3 * b * _X**2
+        else:
+            r, w = a + (b - a) * _X, (b - a) * _W
+        rs.append(r)
+        ws.append(w)
+        es.append(np.full(len(r), e))
+    r, w, e = np.concatenate(rs), np.concatenate(ws), np.concatenate(es)
+    xi = np.where(forward[e], (r - near[e]) / (far[e] - near[e]),
+                  (far[e] - r) / (far[e] - near[e]))
+    ph = np.sum(coefficients[e] * xi[:, None] ** np.arange(coefficients.shape[1]), axis=1)
+    basis = np.column_stack([np.ones_like(r), -np.log(r)])
+    gram = basis.T @ (w[:, None] * basis)
+    fit = np.linalg.solve(gram, basis.T @ (w * ph))
+    return np.bincount(e, w * (basis @ fit - ph) ** 2, len(near))
+
+
+def _edge_polynomials(p: ngs.CoefficientFunction, mesh: ngs.Mesh, gamma_c, order: int
+                      ) -> np.ndarray:
+    """p_h on every fine edge of Gamma_C as the coefficients (n_edges, k + 1) of a
+    polynomial of degree k = ``order`` in the local parameter (exact: p_h is P_k there),
+    from its values at the k + 1 Chebyshev points (:func:`edge_values`)."""
+    nodes = 0.5 - 0.5 * np.cos(np.pi * (np.arange(order + 1) + 0.5) / (order + 1))
+    return np.linalg.solve(np.vander(nodes, order + 1, increasing=True),
+                           edge_values(p, mesh, gamma_c, nodes).T).T

@@ -18,6 +18,9 @@ units of pressure^2 x length, per fine edge e of Gamma_C (its element T)::
                                                                  of the contact zone, p*
                                                                  the closest square-root
                                                                  profile (order k)
+    ``apex``             ||p* - p_h||_e^2                        on the patch of a kink of
+                                                                 Gamma_C, p* the closest
+                                                                 b + c ln(1/r) (order k)
     ``jump``             JUMP_WEIGHT |e| [p_h]^2 / 2             at every interior vertex
                                                                  of a chain, on each of its
                                                                  two edges (order k only)
@@ -47,7 +50,8 @@ of order k sees (:func:`_vertex_jumps`). The thesis' p_h (the hat projection) is
 along a chain: there ``jump`` is zero. At the ends of the contact zone ``end`` takes the
 place of ``kink`` and of the jumps on its patches: the distance of p_h to the closest
 square-root profile (:mod:`ngdual.goal.contact_ends`), an estimate of the error there with
-no constant (END_CONSTANT = 1). The kink's slope jump grows as the end moves away from the
+no constant (END_CONSTANT = 1), and ``apex`` at a kink of Gamma_C the distance to the
+closest logarithmic one. The kink's slope jump grows as the end moves away from the
 last contact node while the error there falls, so it overestimated 3-4 times where the end
 falls near a vertex and underestimated where it falls mid-edge (docs/theory/effectivity.md).
 
@@ -70,15 +74,15 @@ from scipy.spatial import cKDTree
 
 from ..estimator import BoundaryEdges, Estimate
 from ..mesh import mesh_arrays
-from ..scene import SceneError
+from ..scene import SceneError, contact_junctions
 from ..solution import Solution
 from ..trace import contact_traces, pressure_field
-from .contact_ends import edge_values, end_distances
+from .contact_ends import edge_values, end_distances, kink_distances
 
 __all__ = ["CALIBRATION", "CALIBRATION_ORDER_K", "CALIBRATION_WINDOW_ORDER_K", "END_CONSTANT",
            "TERMS", "PressureEstimate", "calibration", "goal_estimate", "in_window"]
 
-TERMS = ("residual", "complementarity", "kink", "end", "jump", "far")
+TERMS = ("residual", "complementarity", "kink", "end", "apex", "jump", "far")
 # terms of (4.15) in units of stress x length, and those of w_h ~ grad u (strain x length);
 # not jump_contact: on Gamma_C the contact-zone terms stand for it, and where the body
 # separates it measures the gap's curvature against lambda_n, not a pressure error
@@ -110,8 +114,9 @@ CALIBRATION_ORDER_K = {1: 0.15, 2: 0.11}
 # error per unknown of hertz-cylinder falls as the weight grows from 1 to 16, and from 4 on
 # the jumps carry the largest share of its estimate.
 JUMP_WEIGHT = 4.0
-# The ends of the contact zone at order k: the distance of p_h to the square-root profiles
-# is the error there, with no constant (:mod:`ngdual.goal.contact_ends`).
+# The ends of the contact zone and the kinks of Gamma_C at order k: the distance of p_h to the
+# square-root and logarithmic profiles is the error there, with no constant
+# (:mod:`ngdual.goal.contact_ends`).
 END_CONSTANT = 1.0
 # lambda_n below this share of its largest value on Gamma_C is contact
 CONTACT_SHARE = 1e-6
@@ -153,12 +158,13 @@ def calibration(traces: bool, order: int, window: bool = False) -> dict[str, flo
     multipliers; with the facet multipliers CALIBRATION_ORDER_K[k] for the edge terms (k = 1
     at order 0, k = 2 above 2) and CALIBRATION for the far field, but
     CALIBRATION_WINDOW_ORDER_K for a window's far field from order 1 on; END_CONSTANT for
-    the ends of the contact zone (a distance, zero with the coarse multipliers)."""
+    the ends of the contact zone and the kinks of Gamma_C (distances, zero with the coarse
+    multipliers)."""
     if not traces:
-        return {**dict.fromkeys(TERMS, CALIBRATION), "end": END_CONSTANT}
+        return {**dict.fromkeys(TERMS, CALIBRATION), "end": END_CONSTANT, "apex": END_CONSTANT}
     edge = CALIBRATION_ORDER_K[min(max(order, 1), 2)]
     far = CALIBRATION_WINDOW_ORDER_K if window and order >= 1 else CALIBRATION
-    return {**dict.fromkeys(TERMS, edge), "end": END_CONSTANT, "far": far}
+    return {**dict.fromkeys(TERMS, edge), "end": END_CONSTANT, "apex": END_CONSTANT, "far": far}
 
 
 def goal_estimate(solution: Solution, estimated: Estimate,
@@ -242,9 +248,11 @@ def goal_estimate(solution: Solution, estimated: Estimate,
         # the jumps on their patches are part of that distance
         end, in_patch = end_distances(pressure, mesh, gamma_c, spaces.order,
                                       _in_contact(lam_n))
-        kink, jumps = np.zeros(len(length)), np.where(in_patch, 0.0, jumps)
+        apex, at_apex = kink_distances(pressure, mesh, gamma_c, spaces.order,
+                                       _kink_points(scene))
+        kink, jumps = np.zeros(len(length)), np.where(in_patch | at_apex, 0.0, jumps)
     else:
-        end = np.zeros(len(length))
+        end = apex = np.zeros(len(length))
         kink = _kinks(gamma_c, gap - lam_n, lam_n, starts, e_star * e_star * htilde)
     on_edges = {
         "residual": residual,   # the tension of p_h at order k
@@ -252,6 +260,7 @@ def goal_estimate(solution: Solution, estimated: Estimate,
                                             e_star / htilde, fixed),
         "kink": kink,
         "end": end,
+        "apex": apex,
         "jump": JUMP_WEIGHT * jumps,
     }
     terms = {k: np.bincount(element, inside * values, mesh.ne)
@@ -373,6 +382,12 @@ def _edge_starts(gamma_c) -> np.ndarray:
         out.append(np.arange(first, first + chain.n_edges))
         first += chain.n_edges + 1
     return np.concatenate(out)
+
+
+def _kink_points(scene) -> np.ndarray:
+    """The kinks of Gamma_C, where two contact sides meet at an angle: points (n, 2)."""
+    return np.array([point for point, kind, _ in contact_junctions(scene) if kind == "kink"],
+                    dtype=float).reshape(-1, 2)
 
 
 def _in_contact(lam_n: np.ndarray) -> np.ndarray:
