@@ -14,8 +14,11 @@ upper bound of its error when the last step at least halves the error). :func:`t
 runs ``nd.adapt(scene, goal="pressure", tol=..., order=k)`` and measures on every solve
 the goal's estimate, the true error ||p_ref - p_h||_{L2(W)} against the reference
 (:func:`ngdual.verification.overkill.pressure_errors`) and the effectivity, estimate /
-true error. A tolerance run's steps are the first steps of every run of a looser
-tolerance: the run to the finest of :data:`TOLS` holds them all.
+true error, with the range the reference's accuracy leaves it (:func:`effectivity_range`).
+The steps of a run to a looser tolerance are the first steps of a run to a tighter one: the
+run to the finest of :data:`TOLS` holds them all. A scene whose effectivity at orders 1
+and 2 leaves :data:`BAND` says why (``Unseen.outside``); the others are the claim of
+docs/theory/effectivity.md.
 
 ``python -m ngdual.studies.effectivity --out DIR`` runs the study, writes ``DIR/effectivity
 .json`` and ``DIR/effectivity.csv`` (one row per solve) and prints the range of the
@@ -160,10 +163,11 @@ def reference(unseen: Unseen, tol: float = REFERENCE_TOL, order: int = REFERENCE
     """The overkill pressure of ``unseen`` and its own accuracy.
 
     The pressure goal of ``order`` run to ``tol`` in at most ``solves`` solves
-    (:func:`ngdual.adapt`). Returns its last
-    solve's pressure (``p_nodes``, ``p``: :func:`ngdual.verification.overkill.solution_samples`),
-    ``accuracy``, the distance of the last solve's pressure to the one before relative to
-    its norm on the goal's window, and the run's ``ndof``, ``solves`` and ``seconds``.
+    (:func:`ngdual.adapt`). Returns its last solve's pressure (``p_nodes``, ``p``:
+    :func:`ngdual.verification.overkill.solution_samples`), ``accuracy``, the distance of
+    the last solve's pressure to the one before relative to its norm on the goal's window,
+    and the run's ``ndof``, ``solves``, ``relative_estimate``, ``stopped_by`` and
+    ``seconds``.
     """
     from ..afem import adapt
     from ..verification.overkill import pressure_errors, solution_samples
@@ -178,6 +182,9 @@ def reference(unseen: Unseen, tol: float = REFERENCE_TOL, order: int = REFERENCE
         warnings.simplefilter("ignore")
         history = adapt(unseen.load(), goal="pressure", tol=tol, order=order,
                         window=unseen.window, on_step=keep, steps=solves)
+    if len(held) < 2:
+        raise ValueError(f"the reference of {unseen.name} stopped after one solve: it has no "
+                         f"accuracy; lower its tol ({tol:g})")
     last, before = (solution_samples(s) for s in held[::-1])
     distance = pressure_errors(before, last, _half_window(unseen.window))["pressure_rel"]
     return {"p_nodes": last["p_nodes"], "p": last["p"], "accuracy": distance,
