@@ -103,7 +103,8 @@ def test_adaptive_splits_every_step_into_phases_that_add_up_to_its_wall_time(tmp
     from ngdual.scene import load_scene
 
     study = run_bench(tmp_path, "adaptive", "--scene", "thesis-3.46-frictionless", "--set",
-                      "contact.ends=consistent", "--level", "1", "--steps", "3")
+                      "contact.ends=consistent", "--orders", "0", "--goal", "stress", "--tol", "0",
+                      "--level", "1", "--steps", "3", "--theta", "0.5")
     records = study["records"]
     history = adapt(load_scene("thesis-3.46-frictionless", ["contact.ends=consistent"]),
                     marking="dorfler", theta=0.5, steps=3, level=1)
@@ -111,7 +112,8 @@ def test_adaptive_splits_every_step_into_phases_that_add_up_to_its_wall_time(tmp
     assert records[0]["seconds"]["refine"] == 0 < records[1]["seconds"]["refine"]
     for r in records:
         seconds = r["seconds"]
-        phases = sum(v for k, v in seconds.items() if not k.startswith(("step", "unit")))
+        phases = sum(v for k, v in seconds.items()
+                     if v is not None and not k.startswith(("step", "unit")))
         assert phases == pytest.approx(seconds["step"], rel=1e-12)
         assert 0 < seconds["unit_cholesky"] < seconds["unit_factorize"] < seconds["unit"]
         assert seconds["unit"] < seconds["step"]
@@ -121,3 +123,31 @@ def test_adaptive_splits_every_step_into_phases_that_add_up_to_its_wall_time(tmp
             seconds["assemble"])
         assert r["ratio"] == pytest.approx(seconds["step"] / seconds["unit"])
         assert r["ratio_factorize"] == pytest.approx(seconds["step"] / seconds["unit_factorize"])
+
+
+def test_adaptive_shows_every_order_s_steps_growth_solve_and_fixed_cost(tmp_path, capsys):
+    study = run_bench(tmp_path, "adaptive", "--orders", "0", "1", "--tol", "0.05")
+    assert (study["goal"], study["tol"], study["growth"]) == ("pressure", 0.05, 1.5)
+    records = study["records"]
+    assert {r["order"] for r in records} == {0, 1}
+    for order in (0, 1):
+        steps = [r for r in records if r["order"] == order]
+        assert [r["step"] for r in steps] == list(range(len(steps)))
+        assert steps[0]["growth"] is None
+        for before, r in zip(steps, steps[1:]):
+            assert r["growth"] == pytest.approx(r["ndof"] / before["ndof"], rel=1e-12)
+        assert steps[-1]["stopped_by"] == "tol"
+        for r in steps:
+            assert r["solve_s"] == pytest.approx(r["timings_s"]["factorize"]
+                                                 + r["timings_s"]["solve"], rel=1e-12)
+            assert r["fixed_s"] == pytest.approx(r["seconds"]["step"] - r["solve_s"], rel=1e-12)
+            assert r["fixed_ratio"] == pytest.approx(r["fixed_s"] / r["solve_s"], rel=1e-12)
+    header = capsys.readouterr().out.splitlines()[0].split()
+    assert {"k", "unknowns", "growth", "solve", "fixed", "fixed/solve"} <= set(header)
+
+
+def test_adaptive_rejects_an_order_and_a_growth_it_does_not_have(capsys):
+    assert main(["bench", "adaptive", "--orders", "3"]) == 2
+    assert main(["bench", "adaptive", "--growth", "5"]) == 2
+    err = capsys.readouterr().err
+    assert "--orders" in err and "--growth" in err

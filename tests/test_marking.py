@@ -1,9 +1,10 @@
-"""Marking strategies select exactly the sets their definitions describe (ties, theta = 0, 1)."""
+"""Marking strategies select exactly the sets their definitions describe (ties, theta = 0, 1),
+and the peaks of a marked estimate are the vertices where it adds up most."""
 
 import numpy as np
 import pytest
 
-from ngdual.marking import mark, mark_dorfler, mark_fraction, mark_max
+from ngdual.marking import mark, mark_dorfler, mark_fraction, mark_max, peak_vertices
 from ngdual.scene import SceneError
 
 INDICATORS = np.array([1.0, 3.0, 2.0, 3.0, 0.5, 0.0])
@@ -92,3 +93,48 @@ def test_invalid_input_is_rejected_naming_the_argument():
 def test_the_indicators_are_passed_by_their_name():
     np.testing.assert_array_equal(mark(indicators=INDICATORS, theta=1.0, strategy="max"),
                                   INDICATORS == INDICATORS.max())
+
+
+
+# a fan of six triangles around vertex 0 (a corner singularity) and two more away from it
+FAN = np.array([[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 5], [0, 5, 6], [0, 6, 1],
+                [1, 2, 7], [4, 5, 8]])
+
+
+def test_the_peak_of_a_corner_singularity_is_its_vertex_and_by_default_its_ring():
+    indicators = np.array([4.0, 4.0, 4.0, 4.0, 4.0, 4.0, 1.0, 1.0])
+    marked = mark_dorfler(indicators, 0.9)
+    np.testing.assert_array_equal(marked, indicators == 4.0)
+    # vertex 0 carries the six marked triangles, each vertex of the ring two: a third of it
+    np.testing.assert_array_equal(np.flatnonzero(peak_vertices(FAN, indicators, marked, 0.5)),
+                                  [0])
+    np.testing.assert_array_equal(np.flatnonzero(peak_vertices(FAN, indicators, marked)),
+                                  [0, 1, 2, 3, 4, 5, 6])
+
+
+def test_the_peaks_are_the_vertices_carrying_their_share_of_the_largest_weight():
+    rng = np.random.default_rng(7)
+    indicators = rng.pareto(1.0, size=len(FAN))
+    marked = mark_dorfler(indicators, 0.9)
+    weight = np.zeros(9)
+    for triangle, eta in zip(FAN[marked], indicators[marked]):
+        weight[triangle] += eta**2
+    for share in (0.0, 0.25, 0.5, 1.0):
+        np.testing.assert_array_equal(peak_vertices(FAN, indicators, marked, share),
+                                      weight >= share * weight.max())
+    # the unmarked triangles' indicators do not count
+    quiet = np.where(marked, indicators, 100.0)
+    np.testing.assert_array_equal(peak_vertices(FAN, quiet, marked),
+                                  peak_vertices(FAN, indicators, marked))
+
+
+def test_nothing_marked_has_no_peaks():
+    assert not peak_vertices(FAN, np.ones(len(FAN)), np.zeros(len(FAN), bool)).any()
+    assert not peak_vertices(FAN, np.zeros(len(FAN)), np.ones(len(FAN), bool)).any()
+
+
+def test_peaks_reject_arrays_of_other_lengths():
+    with pytest.raises(ValueError, match="one of each per triangle"):
+        peak_vertices(FAN, np.ones(3), np.ones(3, bool))
+    with pytest.raises(ValueError, match="share"):
+        peak_vertices(FAN, np.ones(len(FAN)), np.ones(len(FAN), bool), 1.5)

@@ -3,8 +3,9 @@
 :func:`adapt` solves the scene on its initial mesh (:func:`ngdual.solve_on_mesh`), computes
 the indicators eta_{tot,T} of (4.50) (:mod:`ngdual.estimator`), measures them by its goal
 (:mod:`ngdual.goal`: the stress goal, the thesis' (4.50), or the pressure goal on Gamma_C or
-a window of it), marks with one of the strategies of :mod:`ngdual.marking`, refines the
-marked triangles with netgen's bisection (plus its conforming closure) and carries the coarse
+a window of it), marks with one of the strategies of :mod:`ngdual.marking` (with a ``tol``, at
+least the triangles that grow the unknowns by :data:`GROWTH_TOL`), refines the marked
+triangles with netgen's bisection (plus its conforming closure) and carries the coarse
 boundary meshes h~, h^ over to the new mesh (:func:`refine_with_boundary`). Each step adds
 one plain record to the returned history (:func:`step_record`). Uniform refinement is
 ``marking="max", theta=0``.
@@ -24,6 +25,8 @@ Modules: :mod:`~ngdual.afem.loop` (the loop), :mod:`~ngdual.afem.stops` (its sto
 from __future__ import annotations
 
 from .loop import (
+    GROWTH,
+    GROWTH_TOL,
     LEVEL_TOL,
     MARKING,
     STEPS,
@@ -33,13 +36,15 @@ from .loop import (
     AdaptWarning,
     ToleranceWarning,
     adapt,
+    growth_default,
     loop_defaults,
 )
 from .records import reference_norms, relative_estimate, step_record
-from .refinement import RESOLUTION, refine, refine_towards, refine_with_boundary
+from .refinement import RESOLUTION, refine, refine_graded, refine_towards, refine_with_boundary
 from .stops import STALL_STEPS
 
-__all__ = ["LEVEL_TOL", "MARKING", "RESOLUTION", "STALL_STEPS", "STEPS", "STEPS_TOL", "THETA",
-           "THETA_TOL", "AdaptWarning", "ToleranceWarning", "adapt", "loop_defaults",
-           "reference_norms", "refine", "refine_towards", "refine_with_boundary",
+__all__ = ["GROWTH", "GROWTH_TOL", "LEVEL_TOL", "MARKING", "RESOLUTION", "STALL_STEPS", "STEPS",
+           "STEPS_TOL", "THETA", "THETA_TOL", "AdaptWarning", "ToleranceWarning", "adapt",
+           "growth_default", "loop_defaults",
+           "reference_norms", "refine", "refine_graded", "refine_towards", "refine_with_boundary",
            "relative_estimate", "step_record"]

@@ -8,11 +8,11 @@ from ..estimator import ASYMMETRY_NORMS
 from ..goal import GOALS
 from ..marking import STRATEGIES
 from ..scene import SceneError, SceneTypeError, check_level, ensure_valid
+from .refinement import check_growth
 
 
 def check_adapt_arguments(scene, marking, theta, steps, level, asymmetry, reference, on_step,
-                          allow_large, goal, tol, window) -> None:
-    """A SceneError (SceneTypeError for a wrong type) naming the first bad argument."""
+                          allow_large, goal, tol, window, growth) -> None:
     """A SceneError (SceneTypeError for a wrong type) naming the first bad argument."""
     ensure_valid(scene)
     check_level(level, "level", optional=True)
@@ -45,6 +45,8 @@ def check_adapt_arguments(scene, marking, theta, steps, level, asymmetry, refere
         raise SceneTypeError("theta", f"must be a number in [0, 1], got {theta!r}")
     if theta is not None and not 0 <= theta <= 1:
         raise SceneError("theta", f"must lie in [0, 1], got {theta!r}")
+    if growth is not None:
+        check_growth(growth)
     if steps is not None and (isinstance(steps, bool)
                               or not isinstance(steps, (int, np.integer))):
         raise SceneTypeError("steps", f"must be an integer >= 1, got {steps!r}")
@@ -60,5 +62,3 @@ def check_adapt_arguments(scene, marking, theta, steps, level, asymmetry, refere
         raise SceneTypeError("on_step", f"must be callable, got {type(on_step).__name__}")
     if not isinstance(allow_large, bool):
         raise SceneTypeError("allow_large", f"must be True or False, got {allow_large!r}")
-
-

@@ -18,7 +18,16 @@ from .. import budget
 from ..boundary import BoundaryMeshes
 from ..estimator import Estimate, estimate
 from ..goal import Goal, goal_for
-from ..loop_defaults import LEVEL_TOL, MARKING, STEPS, STEPS_TOL, THETA, THETA_TOL
+from ..loop_defaults import (
+    GROWTH,
+    GROWTH_TOL,
+    LEVEL_TOL,
+    MARKING,
+    STEPS,
+    STEPS_TOL,
+    THETA,
+    THETA_TOL,
+)
 from ..marking import mark
 from ..mesh import build_mesh
 from ..scene import Scene
@@ -44,12 +53,20 @@ def loop_defaults(tol: float | None, theta: float | None, steps: int | None,
     return theta, steps, level
 
 
+def growth_default(tol: float | None, growth: float | None) -> float:
+    """The least growth of the unknowns per step of :func:`adapt`, ``growth`` unless None:
+    GROWTH (none, the thesis' runs) or with a ``tol`` GROWTH_TOL."""
+    if growth is not None:
+        return growth
+    return GROWTH if tol is None else GROWTH_TOL
+
+
 def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
           steps: int | None = None, level: int | None = None, asymmetry: str = "l2",
           reference: dict | None = None, on_step: StepCallback | None = None,
           allow_large: bool = False, goal: str = "stress", tol: float | None = None,
           window: tuple[float, float] | None = None, order: int | None = None,
-          multipliers: str | None = None) -> list[dict]:
+          multipliers: str | None = None, growth: float | None = None) -> list[dict]:
     """Run ``steps`` adaptive steps on ``scene`` from its mesh on ``level``, or fewer when
     the goal's relative estimate falls below ``tol``.
 
@@ -62,6 +79,14 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
     theta : float, optional
         Marking parameter in [0, 1]; default :data:`THETA` = 0.5 (the thesis'), with a
         ``tol`` :data:`THETA_TOL` (faster growth of the unknowns).
+    growth : float, optional
+        The least factor in [1, 4] by which REFINE multiplies the triangles (and about the
+        unknowns): above 1 it refines the marked triangles, then the triangles at the peaks
+        of their estimate, once and again until the mesh has grown by ``growth``
+        (:func:`ngdual.afem.refinement.refine_graded`). Default :data:`GROWTH` = 1 (the
+        marked triangles alone, as in the thesis), with a ``tol`` :data:`GROWTH_TOL` = 1.5
+        (a step that grows the unknowns little costs almost as much as one that grows them
+        much).
     steps : int, optional
         Number of SOLVE-ESTIMATE steps (``steps - 1`` refinements); default :data:`STEPS`
         = 5; with ``tol`` the largest number of steps, default :data:`STEPS_TOL` = 30.
@@ -143,12 +168,13 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
     start = time.perf_counter()   # as solve_scene's timings["total"]: checks and mesh too
     scene = with_discretisation(scene, order, multipliers)
     check_adapt_arguments(scene, marking, theta, steps, level, asymmetry, reference, on_step,
-                          allow_large, goal, tol, window)
+                          allow_large, goal, tol, window, growth)
     marking = MARKING if marking is None else marking
     theta, steps, level = loop_defaults(tol, theta, steps, level)
+    growth = growth_default(tol, growth)
     budget.check_scene(scene, level, "level", allow_large)
-    run = _Run(StopRules(scene, goal_for(goal, window), tol, steps, allow_large), tol, steps,
-               reference, on_step, start)
+    run = _Run(StopRules(scene, goal_for(goal, window), tol, steps, allow_large, growth), tol,
+               steps, reference, on_step, start)
     mesh = build_mesh(scene.geometry, level)
     coarse, warm = BoundaryMeshes.for_scene(scene, mesh), None
     for _ in range(steps):
@@ -168,7 +194,8 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
             break
         # REFINE
         with run.timed("refine"):
-            mesh, coarse = refine_with_boundary(scene, mesh, coarse, marked)
+            mesh, coarse = refine_with_boundary(scene, mesh, coarse, marked, indicators,
+                                                growth)
             warm = _warm_start(solution)
     return run.history
 

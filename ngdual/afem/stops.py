@@ -178,13 +178,18 @@ class MemoryBudget:
     """The solve after the next refinement would need more memory than this process may use
     (:func:`ngdual.budget.solve_memory` against :func:`ngdual.budget.available_memory`; the
     bisection of the marked triangles and its closure make at most about 4 new triangles per
-    marked one), unless ``allow_large``: the loop stops before that refinement."""
+    marked one, and a least ``growth`` grows the triangles by about that factor,
+    :func:`~ngdual.afem.refinement.refine_graded`), unless ``allow_large``: the loop stops
+    before that refinement."""
 
-    def __init__(self, scene: Scene, tol: float | None, steps: int, allow_large: bool):
+    def __init__(self, scene: Scene, tol: float | None, steps: int, allow_large: bool,
+                 growth: float):
         self.scene, self.tol, self.steps, self.allow_large = scene, tol, steps, allow_large
+        self.growth = growth
 
     def __call__(self, step: Step) -> Stop | None:
-        elements = step.solution.problem.fes.mesh.ne + 4.0 * int(np.sum(step.marked))
+        ne = step.solution.problem.fes.mesh.ne
+        elements = max(ne + 4.0 * int(np.sum(step.marked)), self.growth * ne)
         disc = self.scene.discretisation
         need = budget.solve_memory(elements, self.scene.solver.method, disc.order, disc.family)
         have = budget.available_memory()
@@ -219,11 +224,12 @@ class StopRules:
     """The rules of one run of the loop, in the order they are asked."""
 
     def __init__(self, scene: Scene, goal: Goal, tol: float | None, steps: int,
-                 allow_large: bool):
+                 allow_large: bool, growth: float):
         self.goal = goal
         self.after_estimate_rules = (NoContact(goal), Singular(tol), Reached(tol, goal, scene),
                                      Stalled(tol, goal), StepsSpent(steps))
-        self.after_mark_rules = (Resolution(scene), MemoryBudget(scene, tol, steps, allow_large))
+        self.after_mark_rules = (Resolution(scene), MemoryBudget(scene, tol, steps, allow_large,
+                                                                   growth))
 
     def after_estimate(self, history: list[dict], solution: Solution, estimated: Estimate,
                        measured: Measure) -> tuple[Step, Stop | None]:

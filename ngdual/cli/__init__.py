@@ -41,7 +41,16 @@ import os
 import sys
 
 from ..extras import MissingExtraError
-from ..loop_defaults import LEVEL_TOL, MARKING, STEPS, STEPS_TOL, THETA, THETA_TOL
+from ..loop_defaults import (
+    GROWTH_TOL,
+    LEVEL_TOL,
+    MARKING,
+    MAX_GROWTH,
+    STEPS,
+    STEPS_TOL,
+    THETA,
+    THETA_TOL,
+)
 from ..marking import STRATEGIES
 from ..scene import SceneError
 from .output import (
@@ -114,6 +123,12 @@ def parser() -> argparse.ArgumentParser:
     ad.add_argument("--theta", type=float, default=None,
                     help=f"marking parameter in [0, 1] (default {THETA:g}, the thesis'; with "
                          f"--tol {THETA_TOL:g}, which grows the unknowns faster)")
+    ad.add_argument("--growth", type=float, default=None,
+                    help=f"the least factor in [1, {MAX_GROWTH:g}] by which a step multiplies "
+                         "the triangles: the marked ones refined, then those at the peaks of "
+                         "their estimate, again until the mesh has grown by G (default 1, "
+                         f"the marked triangles alone, as in the thesis; with --tol "
+                         f"{GROWTH_TOL:g})")
     ad.add_argument("--steps", type=int, default=None,
                     help=f"number of solves (default {STEPS}); with --tol the largest number "
                          f"(default {STEPS_TOL})")
@@ -290,19 +305,34 @@ def parser() -> argparse.ArgumentParser:
                     help="Poisson ratio (default: 0.3 for hertz, 0.49 for cattaneo-mindlin)")
     pp.add_argument("--law", choices=["coulomb", "tresca"], default=None,
                     help="friction law of cattaneo-mindlin (default: coulomb)")
-    adp = bench.add_parser("adaptive", help="the cost of every adaptive step (Doerfler) "
-                                            "against one linear solve of its mesh",
+    adp = bench.add_parser("adaptive", help="every step of adaptive runs at orders 0, 1, 2: "
+                                            "unknowns, growth, the solve and the fixed cost "
+                                            "of the step",
                            parents=[sized, json_out])
     adp.add_argument("--scene", default="hertz-cylinder",
                      help="a TOML scene or a shipped scene (default: hertz-cylinder)")
     adp.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                      dest="overrides", help="override a scene entry, e.g. "
                                             "--set contact.ends=consistent")
+    adp.add_argument("--orders", type=int, nargs="+", default=[0, 1, 2], metavar="K",
+                     help="the orders k of PEERS_k, one run each (default: 0 1 2)")
+    adp.add_argument("--goal", choices=["stress", "pressure"], default="pressure",
+                     help="what the indicators estimate (default: pressure)")
+    adp.add_argument("--tol", type=float, default=0.01,
+                     help="the goal's relative tolerance (default 0.01); 0 for a run of "
+                          "--steps steps without one")
     adp.add_argument("--level", type=int, default=None,
-                     help="level of the initial mesh (default: the scene's)")
-    adp.add_argument("--steps", type=int, default=8, help="adaptive steps (default 8)")
-    adp.add_argument("--theta", type=float, default=0.5,
-                     help="Doerfler's bulk parameter (default 0.5)")
+                     help=f"level of the initial mesh (default: {LEVEL_TOL} with a tol, else "
+                          "the scene's)")
+    adp.add_argument("--steps", type=int, default=None,
+                     help=f"adaptive steps (default {STEPS}; with a tol the largest number, "
+                          f"{STEPS_TOL})")
+    adp.add_argument("--theta", type=float, default=None,
+                     help=f"Doerfler's bulk parameter (default {THETA:g}; with a tol "
+                          f"{THETA_TOL:g})")
+    adp.add_argument("--growth", type=float, default=None,
+                     help=f"the least growth of the unknowns per step, in [1, {MAX_GROWTH:g}] "
+                          f"(default 1; with a tol {GROWTH_TOL:g})")
     be.set_defaults(func=cmd_bench)
     ve = sub.add_parser("verify", help="errors against exact solutions: manufactured contact "
                                        "problems and the Hertz, flat-punch and "

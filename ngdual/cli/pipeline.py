@@ -5,6 +5,7 @@ from __future__ import annotations
 import sys
 import warnings
 
+from ..loop_defaults import MAX_GROWTH
 from ..scene import SceneError, check_level, load_scene, read_toml, shipped_scenes
 from ..solution import PhysicsWarning
 from .output import (
@@ -174,7 +175,7 @@ def cmd_adapt(args) -> int:
 def _adapt(args) -> int:
 
     from .. import budget, plot, post
-    from ..afem import adapt, loop_defaults, reference_norms
+    from ..afem import adapt, growth_default, loop_defaults, reference_norms
     from ..io import check_output_dir, versions, write_json
     from ..mesh import mesh_arrays
     from ..solution import ConvergenceError
@@ -184,6 +185,8 @@ def _adapt(args) -> int:
         number_flag(args.theta, "--theta", 0, 1)
     if args.steps is not None:
         number_flag(args.steps, "--steps", 1, 10_000, integer=True)
+    if args.growth is not None:
+        number_flag(args.growth, "--growth", 1, MAX_GROWTH)
     if args.tol is not None and not 0 < args.tol < float("inf"):
         raise SceneError("--tol", f"must be a finite number > 0, got {args.tol}")
     if args.window is not None and args.goal != "pressure":
@@ -199,10 +202,11 @@ def _adapt(args) -> int:
     scene = load_scene(args.scene, args.set)
     out = check_output_dir(args.out, "--out")
     theta, steps, level = loop_defaults(args.tol, args.theta, args.steps, level)
+    growth = growth_default(args.tol, args.growth)
     budget.check_scene(scene, level, "--level", args.allow_large)
     for reference in args.reference_levels or []:
         budget.check_scene(scene, reference, "--reference-levels", args.allow_large)
-    run = {"scene": scene.name, "marking": args.marking, "theta": theta,
+    run = {"scene": scene.name, "marking": args.marking, "theta": theta, "growth": growth,
            "steps": steps, "level": level, "asymmetry": args.asymmetry,
            "goal": args.goal, "tol": args.tol, "window": args.window,
            "parameters": scene.to_dict(), "versions": versions(), "history": []}
@@ -259,7 +263,7 @@ def _adapt(args) -> int:
         adapt(scene, args.marking, theta, steps, level, args.asymmetry,
               run.get("reference_norms"), on_step, allow_large=args.allow_large,
               goal=args.goal, tol=args.tol,
-              window=None if args.window is None else tuple(args.window))
+              window=None if args.window is None else tuple(args.window), growth=growth)
     except ConvergenceError as err:
         return not_converged(err)
     except StrictFailure as err:

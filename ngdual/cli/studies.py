@@ -186,15 +186,33 @@ def _primal_peer_settings(args) -> dict:
 
 def _adaptive_settings(args) -> dict:
     from .. import budget
-    from ..scene import check_level, load_scene
+    from ..afem import loop_defaults
+    from ..loop_defaults import MAX_GROWTH
+    from ..scene import ORDERS, check_level, load_scene
 
     level = check_level(args.level, "--level", optional=True)
-    number_flag(args.steps, "--steps", 1, 100, integer=True)
-    number_flag(args.theta, "--theta", 0, 1)
+    wrong = sorted(set(args.orders) - set(ORDERS))
+    if wrong:
+        raise SceneError("--orders", f"the order k of PEERS_k is one of "
+                                     f"{', '.join(map(str, ORDERS))}, got "
+                                     f"{', '.join(map(str, wrong))}")
+    number_flag(args.tol, "--tol", 0, 1e3)
+    tol = args.tol or None
+    if args.steps is not None:
+        number_flag(args.steps, "--steps", 1, 100, integer=True)
+    if args.theta is not None:
+        number_flag(args.theta, "--theta", 0, 1)
+    if args.growth is not None:
+        number_flag(args.growth, "--growth", 1, MAX_GROWTH)
     scene = load_scene(args.scene, args.overrides)
-    budget.check_scene(scene, level, "--level", args.allow_large)
-    return {"scene": args.scene, "overrides": args.overrides, "level": level,
-            "steps": args.steps, "theta": args.theta, "allow_large": args.allow_large}
+    if args.goal == "pressure" and not scene.labels("contact"):
+        raise SceneError("--goal", f"scene {scene.name!r} has no contact boundary: no "
+                                   "pressure to aim at; use --goal stress")
+    budget.check_scene(scene, loop_defaults(tol, None, None, level)[2], "--level",
+                       args.allow_large)
+    return {"scene": args.scene, "overrides": args.overrides, "orders": args.orders,
+            "goal": args.goal, "tol": tol, "level": level, "steps": args.steps,
+            "theta": args.theta, "growth": args.growth, "allow_large": args.allow_large}
 
 
 BENCH_SETTINGS = {"limit-ratio": _limit_ratio_settings, "levels": _levels_settings,
