@@ -1,6 +1,8 @@
 """Accuracy on demand (issue 50): ``nd.solve(scene, tol=...)`` chooses the method by the rule
 of :mod:`ngdual.accuracy` and reports what it did; the tolerance is reached by the estimate."""
 
+import json
+
 import pytest
 
 import ngdual as nd
@@ -21,6 +23,16 @@ def test_the_rule_chooses_order_family_and_goal(name, overrides, order, family, 
     method = fastest_method(nd.load_scene(name, overrides))
     assert (method.order, method.multipliers, method.goal) == (order, family, goal)
     assert method.reason
+
+
+def test_a_pressure_singular_at_an_end_of_gamma_c_is_measured_on_its_middle_half():
+    """The flat punch's edges meet free sides running straight on: p ~ d^(-1/2) is not in
+    L2 there, and the study measures the core |x| < a/2; so does the rule."""
+    assert fastest_method(nd.load_scene("flat-punch")).window == (-0.125, 0.125)
+    assert fastest_method(nd.load_scene("hertz-cylinder")).window is None
+    solution = nd.solve(nd.load_scene("flat-punch"), tol=0.05)
+    assert solution.accuracy["reached"] and "on -0.125 <= x <= 0.125" in \
+        solution.accuracy["method"]
 
 
 def test_an_order_asked_for_wins_over_the_rule():
@@ -45,3 +57,24 @@ def test_a_bad_tolerance_is_a_scene_error_naming_it(tol):
     with pytest.raises(SceneError) as info:
         nd.solve(nd.load_scene("hertz-cylinder"), tol=tol)
     assert info.value.field == "tol"
+
+
+def test_the_command_line_solves_to_a_tolerance_and_says_how(tmp_path, capsys):
+    from ngdual.cli import main
+
+    out = tmp_path / "out"
+    assert main(["solve", "hertz-cylinder", "--tol", "0.05", "--out", str(out),
+                 "--no-plots"]) == 0
+    printed = capsys.readouterr().out
+    assert "accuracy  adaptive, pressure goal, k = 1" in printed and "an adapted mesh" in printed
+    record = json.loads((out / "result.json").read_text())
+    assert record["accuracy"]["reached"] and record["accuracy"]["tol"] == 0.05
+
+
+@pytest.mark.parametrize("tol", ["0", "2", "nan"])
+def test_a_bad_tolerance_on_the_command_line_exits_2_writing_nothing(tmp_path, tol, capsys):
+    from ngdual.cli import main
+
+    out = tmp_path / "out"
+    assert main(["solve", "hertz-cylinder", "--tol", tol, "--out", str(out)]) == 2
+    assert "--tol" in capsys.readouterr().err and not out.exists()

@@ -24,6 +24,7 @@ import numpy as np
 
 from .. import budget
 from ..estimator import Estimate
+from ..forms.spaces import variant_of
 from ..goal import Goal, Measure
 from ..goal.base import points_text
 from ..mesh import mesh_arrays
@@ -190,8 +191,9 @@ class MemoryBudget:
     def __call__(self, step: Step) -> Stop | None:
         ne = step.solution.problem.fes.mesh.ne
         elements = max(ne + 4.0 * int(np.sum(step.marked)), self.growth * ne)
-        disc = self.scene.discretisation
-        need = budget.solve_memory(elements, self.scene.solver.method, disc.order, disc.family)
+        variant = variant_of(self.scene)
+        need = budget.solve_memory(elements, self.scene.solver.method, variant.order,
+                                   variant.family)
         have = budget.available_memory()
         if need <= have or self.allow_large:
             return None

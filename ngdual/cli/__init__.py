@@ -53,6 +53,7 @@ from ..loop_defaults import (
 )
 from ..marking import STRATEGIES
 from ..scene import SceneError
+from .cost import add_cost
 from .output import (
     EXIT_BAD_INPUT,
     EXIT_BROKEN_PIPE,
@@ -101,6 +102,11 @@ def parser() -> argparse.ArgumentParser:
     s.add_argument("--strict", action="store_true",
                    help=f"fail with exit status {EXIT_WARNINGS}, writing nothing, when a "
                         "physics check fails (the warning lines after the result table)")
+    s.add_argument("--tol", type=float, default=None, metavar="TOL",
+                   help="solve to this relative error of the contact pressure (of the stress "
+                        "without contact), e.g. 0.01, by the fastest method: adaptive from "
+                        "the coarsest level (or --level), stopping by the estimate; the "
+                        "result says which method was chosen and why")
     s.set_defaults(func=cmd_solve)
     sc = sub.add_parser("scenes", help="list the shipped scenes", parents=[common])
     sc.set_defaults(func=cmd_scenes)
@@ -348,6 +354,7 @@ def parser() -> argparse.ArgumentParser:
                          "observed order misses k + 1 (the general contact case: its "
                          "prediction, k + 1/2 at even k >= 2) or the contact set is wrong")
     ve.set_defaults(func=cmd_verify)
+    add_cost(sub, common)
     return p
 
 

@@ -37,18 +37,32 @@ def cmd_solve(args) -> int:
     from ..verification.benchmark import NAMES, benchmark_traces
 
     level = check_level(args.level, "--level", optional=True)
+    if args.tol is not None:
+        number_flag(args.tol, "--tol", 1e-6, 0.5)
     scene = load_scene(args.scene, args.set)
     out = check_output_dir(args.out, "--out")
-    size = budget.check_scene(scene, level, "--level", args.allow_large)
-    if size.elements > LARGE_MESH:
-        print(f"ngdual: {size.describe()}: meshing and solving take a while", file=sys.stderr)
-    status = PhaseStatus(sys.stderr.isatty() or size.elements > LARGE_MESH)
+    if args.tol is None or level is not None:
+        size = budget.check_scene(scene, level, "--level", args.allow_large)
+        large = size.elements > LARGE_MESH
+        if large:
+            print(f"ngdual: {size.describe()}: meshing and solving take a while",
+                  file=sys.stderr)
+    else:  # the adaptive loop stops before a step that would not fit (stopped_by memory)
+        large = False
+    status = PhaseStatus(sys.stderr.isatty() or large)
     iterations = progress_bar("Uzawa" if scene.solver.method == "uzawa" else "Newton")
     try:
         with warnings.catch_warnings():  # printed after the result table instead
             warnings.simplefilter("ignore", PhysicsWarning)
-            solution = solve_scene(scene, level, progress=iterations,
-                                   allow_large=args.allow_large, status=status)
+            if args.tol is None:
+                solution = solve_scene(scene, level, progress=iterations,
+                                       allow_large=args.allow_large, status=status)
+            else:
+                from ..accuracy import solve_to_tolerance
+
+                status(f"solving to a relative error of {args.tol:g}")
+                solution = solve_to_tolerance(scene, args.tol, level=level,
+                                              allow_large=args.allow_large)
     except ConvergenceError as err:
         status.done()
         return not_converged(err)
@@ -70,7 +84,10 @@ def cmd_solve(args) -> int:
     if args.vtk:
         print("wrote " + ", ".join(post.write_vtk(solution, str(out / "solution"))))
     if not args.no_plots:
-        print("wrote " + ", ".join(str(p) for p in solution_figures(solution, out)))
+        where = None if solution.accuracy is None else \
+            f"adaptive step {solution.accuracy['solves']}"
+        print("wrote " + ", ".join(str(p) for p in solution_figures(solution, out,
+                                                                    where=where)))
     return 0 if solution.converged else EXIT_NOT_CONVERGED
 
 

@@ -37,6 +37,12 @@ class Variant:
     family: str = "coarse"
 
     @property
+    def traces(self) -> bool:
+        """Whether the multipliers are the traces of RT_k themselves, P_k on every fine edge
+        (the facet family; the spaces' ``traces``)."""
+        return self.family == "facet"
+
+    @property
     def thesis(self) -> bool:
         """Whether this is the thesis' triple (3.61): PEERS_0 with the P1 hats on h~ (and nu
         on h^ with friction)."""

@@ -92,7 +92,7 @@ class PressureGoal(Goal):
         """At a kink of Gamma_C in W the estimate with the thesis' multipliers is too small by
         a constant (:data:`KINK_EFFECTIVITY`): an estimate below tol leaves the error above
         it. (The facet multipliers' estimate has a term for the kink.)"""
-        if variant_of(scene).family == "facet":
+        if variant_of(scene).traces:
             return None
         kinks = np.array([point for point, kind, _ in contact_junctions(scene) if kind == "kink"],
                          dtype=float).reshape(-1, 2)
