@@ -49,7 +49,6 @@ from .domain import (
 from .errors import SceneError, SceneTypeError
 from .load import (
     apply_overrides,
-    given_keys,
     load_scene,
     read_toml,
     scene_from_dict,
@@ -86,6 +85,7 @@ from .tables import (
 from .validate import (
     check_level,
     ensure_valid,
+    given_keys,
     validate,
 )
 from .values import (

@@ -135,15 +135,6 @@ def _build(name: str, data: dict) -> Scene:
     return scene
 
 
-def given_keys(scene: Scene, section: str) -> set[str]:
-    """The keys of ``section`` the user set: in the scene's document (TOML, overrides), or,
-    for a scene built in Python, those that differ from the default."""
-    obj, given = getattr(scene, section), scene.__dict__.get("_given", frozenset())
-    default = type(obj)()
-    return {f.name for f in dataclasses.fields(obj)
-            if f"{section}.{f.name}" in given or getattr(obj, f.name) != getattr(default, f.name)}
-
-
 def load_scene(source: str | Path, overrides: list[str] | None = None) -> Scene:
     """Load a scene by file path or shipped name, apply overrides and validate it.
 

@@ -189,7 +189,7 @@ def _validate_discretisation(scene: Scene) -> None:
                          "of that degree: use discretisation.multipliers = \"facet\" (or "
                          "\"auto\") for friction at order k")
     if disc.family == "facet":
-        if scene.friction.law == "coulomb" and "normal_stress" in _given(scene, "friction"):
+        if scene.friction.law == "coulomb" and "normal_stress" in given_keys(scene, "friction"):
             problems.add("friction.normal_stress", "chooses the |sigma_n| of the thesis' "
                          "Coulomb bound on the h^ edges; the facet multipliers bound every "
                          "Bernstein coefficient by mu_f times its own normal moment, so it "
@@ -291,7 +291,7 @@ def _validate_benchmark(scene: Scene) -> None:
                                   and len(bench.center) == 2
                                   and all(finite(v) for v in bench.center)):
         problems.add("benchmark.center", f"must be a point [x, y], got {show(bench.center)}")
-    for key in sorted(_given(scene, "benchmark") - set(reads)):
+    for key in sorted(given_keys(scene, "benchmark") - set(reads)):
         problems.add(f"benchmark.{key}", f"does nothing with benchmark.kind = {bench.kind!r}, "
                      "which reads " + (", ".join(reads[1:]) or "nothing") + "; remove it")
     if bench.kind != "none" and not scene.has_contact:
@@ -315,7 +315,7 @@ FRICTION_READS = {"none": ("law",), "tresca": ("law", "bound"),
                   "coulomb": ("law", "mu", "normal_stress")}
 
 
-def _given(scene: Scene, section: str) -> set[str]:
+def given_keys(scene: Scene, section: str) -> set[str]:
     """The keys of ``section`` the user set: in the scene's document (TOML, overrides), or,
     for a scene built in Python, those that differ from the default."""
     obj, given = getattr(scene, section), scene.__dict__.get("_given", frozenset())
@@ -332,14 +332,14 @@ def _settings_without_effect(scene: Scene) -> list[tuple[str, str]]:
     """
     found = []
     method = scene.solver.method
-    for key in sorted(_given(scene, "solver") - set(SOLVER_READS[method])):
+    for key in sorted(given_keys(scene, "solver") - set(SOLVER_READS[method])):
         found.append((f"solver.{key}", f"does nothing with solver.method = {method!r}: the "
                       "active-set solver iterates to round-off and reads only metric and "
                       "max_iter; remove it, or set solver.method = \"uzawa\" for the "
                       "thesis' Algorithms 3.38 / 3.41"))
     law = scene.friction.law if scene.friction.law in FRICTION_LAWS else "none"
     users = {"mu": "coulomb", "normal_stress": "coulomb", "bound": "tresca"}
-    for key in sorted(_given(scene, "friction") - set(FRICTION_READS[law])):
+    for key in sorted(given_keys(scene, "friction") - set(FRICTION_READS[law])):
         found.append((f"friction.{key}", f"does nothing with friction.law = {law!r}: only "
                       f"{users[key]!r} friction uses it; remove it, or set friction.law = "
                       f"\"{users[key]}\""))
