@@ -86,18 +86,22 @@ def fastest_method(scene: Scene, order: int | None = None,
         chosen = Variant(FASTEST_ORDER, FASTEST_FAMILY)
         reason = "the fastest robust order of the work-precision study"
     if window is not None:
-        reason += "; the pressure may be singular at an end of Gamma_C: its middle half"
+        reason += "; the pressure is measured on the middle half of Gamma_C (module docstring)"
     return Method(chosen.order, chosen.family, goal, reason, window)
 
 
 def pressure_window(scene: Scene) -> tuple[float, float] | None:
     """The part of Gamma_C whose pressure error the goal measures: all of it (None), or,
-    where an end of Gamma_C meets a free side running straight on or turning re-entrant
-    (a flat punch's edge: the pressure ~ d^(-1/2) is not in L2 if the contact zone reaches
-    it, :func:`ngdual.goal.singular_free_ends`), the middle half of Gamma_C's abscissae,
-    as the work-precision study measures the punch's core |x| < a/2."""
+    where the pressure may not be in L2 at an end of Gamma_C, the middle half of Gamma_C's
+    abscissae, as the work-precision study measures the punch's core |x| < a/2: at an end
+    that meets a free side running straight on or turning re-entrant (a flat punch's edge:
+    p ~ d^(-1/2) if the contact zone reaches it, :func:`ngdual.goal.singular_free_ends`),
+    and at a clamped end with the thesis' end values (``contact.ends = "thesis"``: lambda = 0
+    against g - u_D.n, sigma ~ 1/r there, the thesis' Example 3.46)."""
+    thesis_ends = scene.contact.ends == "thesis"
     ends = [point for point, kind, angle in contact_junctions(scene)
-            if kind == "neumann" and angle <= KINK_ANGLE]
+            if (kind == "neumann" and angle <= KINK_ANGLE)
+            or (kind == "dirichlet" and thesis_ends)]
     if not ends:
         return None
     x = contact_samples(scene)[0][:, 0]

@@ -35,6 +35,15 @@ def test_a_pressure_singular_at_an_end_of_gamma_c_is_measured_on_its_middle_half
         solution.accuracy["method"]
 
 
+def test_a_thesis_scene_keeps_order_0_and_measures_away_from_its_clamped_ends():
+    """Example 3.46's thesis end values leave sigma ~ 1/r at the clamped ends of Gamma_C:
+    the pressure error there is infinite, its middle half is measured and reached."""
+    solution = nd.solve(nd.load_scene("thesis-3.46-frictionless"), tol=0.05)
+    acc = solution.accuracy
+    assert acc["reached"] and (acc["order"], acc["multipliers"]) == (0, "coarse")
+    assert acc["window"] == (-2.0, 2.0)
+
+
 def test_an_order_asked_for_wins_over_the_rule():
     method = fastest_method(nd.load_scene("hertz-cylinder"), order=2)
     assert (method.order, method.multipliers, method.reason) == (2, "facet", "as asked")
