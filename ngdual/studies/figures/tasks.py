@@ -30,6 +30,10 @@ from .plan import (
     Plan,
 )
 
+# the least growth per step of the study's adaptive runs: 1, the Doerfler sets the study was
+# measured with (a tolerance run's default is ngdual.loop_defaults.GROWTH_TOL)
+STUDY_GROWTH = 1.0
+
 
 def _cost(level: int, friction: bool) -> float:
     return (4.0 if friction else 1.5) ** level / 50
@@ -139,6 +143,9 @@ def truth_adapt(plan: Plan, problem: str, goal: str, order: int = 0) -> Task:
                           "goal": goal, "tol": tp.reference_tol,
                           "window": (list(window) if window and goal == "pressure"
                                      else None),
+                          # Doerfler's own sets, as the study's runs and references were
+                          # measured (session 11); a part of the task's id
+                          "growth": STUDY_GROWTH,
                           **({"reference_order": REFERENCE_ORDER,
                               "reference_dofs": REFERENCE_ORDER_DOFS}
                              if goal == "stress" and order < REFERENCE_ORDER else {}),
@@ -178,7 +185,8 @@ def paired_timing(plan: Plan, uniform: Task, adaptive: Task, unknowns: list[int]
     u, a = uniform.params, adaptive.params
     return Task("paired", {"uniform": {k: u[k] for k in ("scene", "level", "overrides")},
                            "adaptive": {"scene": a["scene"], "overrides": a["overrides"],
-                                        **{k: a[k] for k in LOOP_KEYS}},
+                                        **{k: a[k] for k in (*LOOP_KEYS, "growth")
+                                           if k in a}},
                            "unknowns": [int(n) for n in unknowns],
                            "rounds": PAIRED_ROUNDS if plan.timing_repeats > 1 else 1},
                 f"{u['scene']} paired: {uniform.label} / {adaptive.label} to {unknowns[-1]}",

@@ -23,6 +23,8 @@ def loop_arguments(params: dict) -> dict:
     """The keyword arguments of :func:`ngdual.afem.adapt` in an adaptive task's
     parameters (:data:`LOOP_KEYS`; the window, a list in JSON, as a tuple)."""
     loop = {k: params[k] for k in LOOP_KEYS}
+    if "growth" in params:  # the least growth per step (ngdual.afem.adapt); else its default
+        loop["growth"] = params["growth"]
     if loop["window"] is not None:
         loop["window"] = tuple(loop["window"])
     return loop
