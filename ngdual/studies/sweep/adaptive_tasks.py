@@ -39,7 +39,8 @@ def adapt_task(scene: str, marking: str, theta: float, steps: int, level: int,
                max_elements: int | None = None, goal: str = "stress",
                tol: float | None = None, window: list[float] | None = None,
                reference_order: int | None = None, reference_dofs: int = 0,
-               repeat: int = 1, share_s: float | None = None) -> tuple[dict, dict]:
+               repeat: int = 1, share_s: float | None = None,
+               growth: float | None = None) -> tuple[dict, dict]:
     """An adaptive run (:func:`ngdual.afem.adapt` with its ``goal``, ``tol`` and ``window``):
     its history, with extras for Section 4.2.
 
@@ -111,7 +112,8 @@ def adapt_task(scene: str, marking: str, theta: float, steps: int, level: int,
             raise _Budget
 
     loop = loop_arguments({"marking": marking, "theta": theta, "steps": steps, "level": level,
-                           "goal": goal, "tol": tol, "window": window})
+                           "goal": goal, "tol": tol, "window": window,
+                           **({} if growth is None else {"growth": growth})})
     try:
         with _tolerance_kept_quiet():
             adapt(load_scene_with(scene, overrides), on_step=on_step, **loop)
