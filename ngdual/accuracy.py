@@ -34,6 +34,7 @@ from dataclasses import asdict, dataclass
 
 from .afem import adapt
 from .forms.spaces import Variant, declared_variant, variant_of
+from .goal.pressure import free_straight_ends
 from .scene import (
     Scene,
     SceneError,
@@ -42,7 +43,6 @@ from .scene import (
     contact_samples,
     ensure_valid,
 )
-from .scene.contact import KINK_ANGLE
 from .solution import PhysicsWarning, Solution
 from .solvers.dispatch import solve_scene, with_discretisation
 
@@ -98,11 +98,9 @@ def pressure_window(scene: Scene) -> tuple[float, float] | None:
     p ~ d^(-1/2) if the contact zone reaches it, :func:`ngdual.goal.singular_free_ends`),
     and at a clamped end with the thesis' end values (``contact.ends = "thesis"``: lambda = 0
     against g - u_D.n, sigma ~ 1/r there, the thesis' Example 3.46)."""
-    thesis_ends = scene.contact.ends == "thesis"
-    ends = [point for point, kind, angle in contact_junctions(scene)
-            if (kind == "neumann" and angle <= KINK_ANGLE)
-            or (kind == "dirichlet" and thesis_ends)]
-    if not ends:
+    clamped = scene.contact.ends == "thesis" and any(
+        kind == "dirichlet" for _, kind, _ in contact_junctions(scene))
+    if not (clamped or len(free_straight_ends(scene))):
         return None
     x = contact_samples(scene)[0][:, 0]
     lo, hi = float(x.min()), float(x.max())

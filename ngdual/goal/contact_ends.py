@@ -35,6 +35,7 @@ import ngsolve as ngs
 import numpy as np
 
 from ..mesh import boundary_segments
+from ..scene import contact_junctions
 
 # the edges of the patch of an end of the contact zone, whose last vertex in contact is z:
 # on the contact side of z, and beyond it (where p_h may spread past the end)
@@ -318,3 +319,41 @@ def _edge_polynomials(p: ngs.CoefficientFunction, mesh: ngs.Mesh, gamma_c, order
     nodes = 0.5 - 0.5 * np.cos(np.pi * (np.arange(order + 1) + 0.5) / (order + 1))
     return np.linalg.solve(np.vander(nodes, order + 1, increasing=True),
                            edge_values(p, mesh, gamma_c, nodes).T).T
+
+
+# lambda_n below this share of its largest value on Gamma_C is contact
+CONTACT_SHARE = 1e-6
+
+
+def kink_points(scene) -> np.ndarray:
+    """The kinks of Gamma_C, where two contact sides meet at an angle: points (n, 2)."""
+    return np.array([point for point, kind, _ in contact_junctions(scene) if kind == "kink"],
+                    dtype=float).reshape(-1, 2)
+
+
+def in_contact(lam_n: np.ndarray) -> np.ndarray:
+    """Which vertices are in contact: lambda_n at most CONTACT_SHARE of its largest value."""
+    return lam_n <= CONTACT_SHARE * np.max(np.abs(lam_n), initial=0.0)
+
+
+def kink_opening(gamma_c, opening: np.ndarray, lam_n: np.ndarray, starts: np.ndarray,
+           weight: np.ndarray) -> np.ndarray:
+    """The kink term of the thesis' multipliers: weight_e [d(opening)/dt]^2 / 2 on both fine
+    edges at every last contact node.
+
+    ``opening`` = g_h - lambda_n = u_n^h at the vertices; a last contact node is an interior
+    vertex of a chain in contact (:func:`in_contact`) next to one that separates.
+    """
+    slope = (opening[starts + 1] - opening[starts]) / gamma_c.lengths
+    contact = in_contact(lam_n)
+    out = np.zeros(len(starts))
+    first = 0
+    for chain in gamma_c.coarse.chains:
+        for e in range(first + 1, first + chain.n_edges):   # vertex between e - 1 and e
+            here = starts[e]
+            if contact[here] and not (contact[here - 1] and contact[here + 1]):
+                jump = (slope[e] - slope[e - 1])**2
+                out[e - 1] += 0.5 * jump * weight[e - 1]
+                out[e] += 0.5 * jump * weight[e]
+        first += chain.n_edges
+    return out

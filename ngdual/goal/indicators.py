@@ -74,10 +74,17 @@ from scipy.spatial import cKDTree
 
 from ..estimator import BoundaryEdges, Estimate
 from ..mesh import mesh_arrays
-from ..scene import SceneError, contact_junctions
+from ..scene import SceneError
 from ..solution import Solution
 from ..trace import contact_traces, pressure_field
-from .contact_ends import edge_values, end_distances, kink_distances
+from .contact_ends import (
+    edge_values,
+    end_distances,
+    in_contact,
+    kink_distances,
+    kink_opening,
+    kink_points,
+)
 
 __all__ = ["CALIBRATION", "CALIBRATION_ORDER_K", "CALIBRATION_WINDOW_ORDER_K", "END_CONSTANT",
            "TERMS", "PressureEstimate", "calibration", "goal_estimate", "in_window"]
@@ -118,8 +125,6 @@ JUMP_WEIGHT = 4.0
 # square-root and logarithmic profiles is the error there, with no constant
 # (:mod:`ngdual.goal.contact_ends`).
 END_CONSTANT = 1.0
-# lambda_n below this share of its largest value on Gamma_C is contact
-CONTACT_SHARE = 1e-6
 
 
 @dataclass
@@ -247,13 +252,13 @@ def goal_estimate(solution: Solution, estimated: Estimate,
         # the ends of the contact zone by the distance of p_h to the square-root profiles;
         # the jumps on their patches are part of that distance
         end, in_patch = end_distances(pressure, mesh, gamma_c, spaces.order,
-                                      _in_contact(lam_n))
+                                      in_contact(lam_n))
         apex, at_apex = kink_distances(pressure, mesh, gamma_c, spaces.order,
-                                       _kink_points(scene))
+                                       kink_points(scene))
         kink, jumps = np.zeros(len(length)), np.where(in_patch | at_apex, 0.0, jumps)
     else:
         end = apex = np.zeros(len(length))
-        kink = _kinks(gamma_c, gap - lam_n, lam_n, starts, e_star * e_star * htilde)
+        kink = kink_opening(gamma_c, gap - lam_n, lam_n, starts, e_star * e_star * htilde)
     on_edges = {
         "residual": residual,   # the tension of p_h at order k
         "complementarity": _complementarity(length, np.maximum(p_mean, 0), lam_mean,
@@ -382,36 +387,3 @@ def _edge_starts(gamma_c) -> np.ndarray:
         out.append(np.arange(first, first + chain.n_edges))
         first += chain.n_edges + 1
     return np.concatenate(out)
-
-
-def _kink_points(scene) -> np.ndarray:
-    """The kinks of Gamma_C, where two contact sides meet at an angle: points (n, 2)."""
-    return np.array([point for point, kind, _ in contact_junctions(scene) if kind == "kink"],
-                    dtype=float).reshape(-1, 2)
-
-
-def _in_contact(lam_n: np.ndarray) -> np.ndarray:
-    """Which vertices are in contact: lambda_n at most CONTACT_SHARE of its largest value."""
-    return lam_n <= CONTACT_SHARE * np.max(np.abs(lam_n), initial=0.0)
-
-
-def _kinks(gamma_c, opening: np.ndarray, lam_n: np.ndarray, starts: np.ndarray,
-           weight: np.ndarray) -> np.ndarray:
-    """weight_e [d(opening)/dt]^2 / 2 on both fine edges at every last contact node.
-
-    ``opening`` = g_h - lambda_n = u_n^h at the vertices; a last contact node is an interior
-    vertex of a chain in contact (:func:`_in_contact`) next to one that separates.
-    """
-    slope = (opening[starts + 1] - opening[starts]) / gamma_c.lengths
-    contact = _in_contact(lam_n)
-    out = np.zeros(len(starts))
-    first = 0
-    for chain in gamma_c.coarse.chains:
-        for e in range(first + 1, first + chain.n_edges):   # vertex between e - 1 and e
-            here = starts[e]
-            if contact[here] and not (contact[here - 1] and contact[here + 1]):
-                jump = (slope[e] - slope[e - 1])**2
-                out[e - 1] += 0.5 * jump * weight[e - 1]
-                out[e] += 0.5 * jump * weight[e]
-        first += chain.n_edges
-    return out

@@ -22,7 +22,8 @@ from ..scene import Scene, contact_junctions
 from ..scene.contact import KINK_ANGLE
 from ..solution import Solution
 from .base import Goal, Measure, points_text, thesis_ends_reason
-from .indicators import CONTACT_SHARE, goal_estimate, in_window
+from .contact_ends import CONTACT_SHARE, kink_points
+from .indicators import goal_estimate, in_window
 
 # The pressure goal's effectivity where Gamma_C has a kink, at which the pressure is
 # log-singular, with the thesis' multipliers (their hat projection has no term for the apex
@@ -94,8 +95,7 @@ class PressureGoal(Goal):
         it. (The facet multipliers' estimate has a term for the kink.)"""
         if variant_of(scene).traces:
             return None
-        kinks = np.array([point for point, kind, _ in contact_junctions(scene) if kind == "kink"],
-                         dtype=float).reshape(-1, 2)
+        kinks = kink_points(scene)
         kinks = kinks[in_window(kinks[:, 0], self.window)]
         if not len(kinks):
             return None
@@ -122,6 +122,14 @@ def contact_vertices(solution: Solution) -> tuple[np.ndarray, np.ndarray]:
     return points, lam_n <= CONTACT_SHARE * scale
 
 
+def free_straight_ends(scene: Scene) -> np.ndarray:
+    """The ends of Gamma_C (points, (n, 2)) where a free or loaded side begins running
+    straight on or turning re-entrant: where the pressure is not in L2 if the contact zone
+    reaches them (:func:`singular_free_ends`)."""
+    return np.array([point for point, kind, angle in contact_junctions(scene)
+                     if kind == "neumann" and angle <= KINK_ANGLE], dtype=float).reshape(-1, 2)
+
+
 def singular_free_ends(solution: Solution,
                        window: tuple[float, float] | None = None) -> np.ndarray:
     """The ends of Gamma_C where the contact pressure is not in L2: an array of points (n, 2),
@@ -140,9 +148,7 @@ def singular_free_ends(solution: Solution,
     goal to reach (with friction the exponent moves off 1/2 with the friction coefficient,
     to either side; the test is the frictionless one). Contact at an end: its vertex is in
     the contact set (:func:`contact_vertices`)."""
-    ends = np.array([point for point, kind, angle in contact_junctions(solution.problem.scene)
-                     if kind == "neumann" and angle <= KINK_ANGLE],
-                    dtype=float).reshape(-1, 2)
+    ends = free_straight_ends(solution.problem.scene)
     ends = ends[in_window(ends[:, 0], window)]
     if not len(ends):
         return ends

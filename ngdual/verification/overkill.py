@@ -52,6 +52,7 @@ import math
 import ngsolve as ngs
 import numpy as np
 
+from ..goal import in_window as goal_in_window
 from ..mesh import mesh_arrays
 
 # reference coordinates of the P2 nodes: vertices 0, 1, 2 of NGSolve's reference triangle
@@ -176,18 +177,15 @@ def gauss_samples(x0, x1, subdivisions: int = 1) -> tuple[np.ndarray, np.ndarray
 
 def in_window(x: np.ndarray, window) -> np.ndarray:
     """Which abscissae ``x`` lie in ``window``: |x| <= window for a number, lo <= x <= hi
-    for a pair (lo, hi), all for None.
+    for a pair (lo, hi), all for None (the goal's :func:`ngdual.goal.in_window`, which
+    also takes a half-width here).
 
     >>> in_window(np.array([-2.0, 0.5, 1.5]), 1.0), in_window(np.array([0.5, 1.5]), (1, 2))
     (array([False,  True, False]), array([False,  True]))
     """
-    x = np.asarray(x)
-    if window is None:
-        return np.ones(x.shape, bool)
-    if np.ndim(window) == 0:
-        return np.abs(x) <= window
-    lo, hi = window
-    return (x >= lo) & (x <= hi)
+    if window is not None and np.ndim(window) == 0:
+        window = (-window, window)
+    return goal_in_window(np.asarray(x), window)
 
 
 def pressure_error(x, w, p, reference: dict, window=None) -> dict:
