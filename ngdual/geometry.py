@@ -191,16 +191,34 @@ def signed_area(poly: np.ndarray) -> float:
 
 
 def self_intersection(poly: np.ndarray) -> np.ndarray | None:
-    """A point where two non-adjacent edges of the closed polygon meet (None if it is simple)."""
-    a, b = poly, np.roll(poly, -1, axis=0)
-    n = len(poly)
-    for i in range(n):
-        for j in range(i + 2, n):
-            if i == 0 and j == n - 1:
-                continue
-            hit = _segments_meet(a[i], b[i], a[j], b[j])
-            if hit is not None:
-                return hit
+    """A point where two non-adjacent edges of the closed polygon meet (None if it is simple).
+
+    Every pair of edges is screened at once (a pair that may meet: crossing within the
+    tolerances of :func:`_segments_meet`, or parallel and collinear); the screened pairs are
+    decided by :func:`_segments_meet` in the order (i, j), so the first meeting is returned."""
+    a = np.asarray(poly, dtype=float)
+    b = np.roll(a, -1, axis=0)
+    n = len(a)
+    i, j = np.triu_indices(n, 2)
+    keep = ~((i == 0) & (j == n - 1))
+    i, j = i[keep], j[keep]
+    d1, d2, rp = b[i] - a[i], b[j] - a[j], a[j] - a[i]
+
+    def cross(x, y):
+        return x[:, 0] * y[:, 1] - x[:, 1] * y[:, 0]
+
+    denom = cross(d1, d2)
+    scale = np.maximum(np.einsum("ij,ij->i", d1, d1), np.einsum("ij,ij->i", d2, d2))
+    parallel = np.abs(denom) <= 1e-14 * scale
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t, u = cross(rp, d2) / denom, cross(rp, d1) / denom
+    lo, hi = -1e-12, 1 + 1e-12
+    crossing = ~parallel & (t >= lo) & (t <= hi) & (u >= lo) & (u <= hi)
+    collinear = parallel & (np.abs(cross(rp, d1)) <= 1e-12 * scale)
+    for k in np.flatnonzero(crossing | collinear):
+        hit = _segments_meet(a[i[k]], b[i[k]], a[j[k]], b[j[k]])
+        if hit is not None:
+            return hit
     return None
 
 
