@@ -542,7 +542,7 @@ def read_table(path) -> list[dict]:
 
 def replot(table_csv, out) -> list:
     """The time-to-accuracy figures again from a saved ``work_precision_table.csv`` (the
-    study takes 45 minutes; its table is enough for them), into ``out/figures``."""
+    study takes an hour; its table is enough for them), into ``out/figures``."""
     from pathlib import Path
 
     with plot.slides():

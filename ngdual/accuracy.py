@@ -9,13 +9,13 @@ demand) derived from the work-precision study of the six problems
 * the goal: the pressure goal where the scene has a contact boundary (what a contact
   engineer asks for), the stress goal (4.50) otherwise;
 * the multipliers: the facet family (the coarse family of order k never paid: 5 % pressure
-  on Example 3.46 in 13 s at k = 1 against 0.21 s with the facet one);
+  on Example 3.46 in 12 s at k = 1 against 0.18 s with the facet one);
 * the order: k = 1, the fastest robust order. At 1 % pressure with the pressure goal it
   is the fastest order on three problems (the flat punch, Hertz, the wedge) and within
-  1.6 times the fastest on the other three (Example 3.46 without friction 0.44 s against
-  0.28 s at k = 2; with Coulomb friction 0.52 against 0.49 s; Cattaneo-Mindlin 1.65 against
-  1.24 s); k = 2 is up to 1.9 times slower than the fastest (the punch) and order 0 2.3
-  to 15 times (Hertz 2.06 s, the punch 1.09 s);
+  1.6 times the fastest on the other three (Example 3.46 without friction 0.39 s against
+  0.24 s at k = 2; with Coulomb friction 0.53 against 0.39 s; Cattaneo-Mindlin 1.16 against
+  0.88 s); k = 2 is up to 1.9 times slower than the fastest (the punch) and order 0 1.9
+  to 15 times (Hertz 1.72 s, the punch 0.87 s);
 * the loop: Doerfler marking with the tolerance runs' parameter and least growth of the
   unknowns per step (:data:`ngdual.loop_defaults.THETA_TOL`, ``GROWTH_TOL``), from the
   coarsest level (``LEVEL_TOL``), stopping by the goal's estimate.
