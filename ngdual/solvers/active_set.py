@@ -19,7 +19,9 @@ One solver for every order k and multiplier family:
 The result is the discrete solution of (3.62) itself, checked on the assembled system: the
 residuals of its rows and of the contact and friction conditions against the scales of
 the problem (:mod:`ngdual.solvers.convergence`, the one convergence test of every solver);
-if any exceeds ``TOLERANCE`` a :class:`ConvergenceError` names each with its value. G and b
+if any exceeds ``TOLERANCE`` (the Coulomb bound's: its normal stress's round-off, where
+larger; :func:`~ngdual.solvers.convergence.exceeding`) a :class:`ConvergenceError` names each
+with its value. G and b
 carry the round-off of the Cholesky factors, which a nearly incompressible body amplifies
 (Cattaneo-Mindlin, nu = 0.4999, k = 1, level 2: the slip residual 2.0e-9 against 1e-9):
 where the residuals on K are not round-off, b takes the difference between the moments on
@@ -54,10 +56,10 @@ from ..tolerances import COULOMB_FIXED_POINT_TOL
 from .cholesky import SchurCholesky
 from .conforming import checked_solution, conforming_active_set
 from .contact_problem import Condensed, EdgeStress, solve_contact
-from .convergence import TOLERANCE, EdgeFriction, Scales, moments, residuals
+from .convergence import EdgeFriction, Scales, exceeding, moments, residuals
 from .hybrid import HybridSystem
 from .linear import blas_threads
-from .semismooth import EPS
+from .semismooth import EPS, SAFETY
 from .settings import ActiveSetSettings, Model
 from .start import ContactStart
 
@@ -157,6 +159,9 @@ def _solve(problem: DiscreteProblem, settings: ActiveSetSettings, tol: float, or
     cond = (Condensed(G, b, np.arange(n_c)) if isinstance(friction, MomentFriction)
             else _edge_stress(problem, hybrid, chol, y, friction, G, b))
     first = start.at(problem.spaces.contact.node_points()) if start is not None else None
+    # the Coulomb bound cannot meet its map better than its normal stress's round-off: the
+    # fixed point's own floor (convergence.exceeding)
+    floors = {"coulomb_bound": SAFETY * cond.stress_roundoff} if law == "coulomb" else {}
     contact_start = time.perf_counter()
     for refinement in range(CONTACT_REFINEMENTS + 1):                           # step 3
         state, F, history, iterations = solve_contact(
@@ -167,7 +172,7 @@ def _solve(problem: DiscreteProblem, settings: ActiveSetSettings, tol: float, or
         edges = None if isinstance(friction, MomentFriction) or F is None \
             else EdgeFriction(friction, state.nu)
         found = residuals(problem, x, law, model.mu_f, F, edges)
-        if refinement == CONTACT_REFINEMENTS or max(found.values()) <= TOLERANCE:
+        if refinement == CONTACT_REFINEMENTS or not exceeding(found, floors):
             break
         # the moments on K are exact for these multipliers, those of the Schur complement
         # carry the round-off of the Cholesky factors: b takes the difference
@@ -180,7 +185,7 @@ def _solve(problem: DiscreteProblem, settings: ActiveSetSettings, tol: float, or
                     "active-set", history,
                     {**iterations, "condensed": n_c, "contact_refinements": refinement,
                      "qp_fallback": int(state.fallback)},
-                    seconds, found)
+                    seconds, found, floors)
 
 
 def _edge_stress(problem: DiscreteProblem, hybrid: HybridSystem, chol: SchurCholesky,
@@ -228,7 +233,8 @@ def _seconds(problem: DiscreteProblem, hybrid: HybridSystem, chol: SchurCholesky
 def _checked(problem: DiscreteProblem, model: Model, hybrid: HybridSystem,
              chol: SchurCholesky, y: np.ndarray, x: np.ndarray, law: str, F,
              edges: EdgeFriction | None, roundoff: float, method: str, history: list,
-             iterations: dict, seconds: dict, found: dict | None = None) -> Solution:
+             iterations: dict, seconds: dict, found: dict | None = None,
+             floors: dict | None = None) -> Solution:
     """The solution x once its residuals on K are round-off
     (:func:`~ngdual.solvers.conforming.checked_solution`; the thesis' nu on the h^ mesh
     reported as it is), with the round-off level ``roundoff`` of its contact problem and
@@ -237,7 +243,7 @@ def _checked(problem: DiscreteProblem, model: Model, hybrid: HybridSystem,
     level = max(roundoff, EPS * _material_condition(model),
                 _roundoff_probe(problem, hybrid, chol, y, x))
     solution = checked_solution(problem, x, law, model.mu_f, F if edges is None else None,
-                                method, iterations, history, seconds, found)
+                                method, iterations, history, seconds, found, floors)
     solution.roundoff = level
     if edges is not None:
         forms = edges.forms

@@ -65,7 +65,7 @@ from ..friction import MomentFriction, build_friction_forms, tresca_moments
 from ..solution import ConvergenceError, Solution
 from ..tolerances import COULOMB_FIXED_POINT_TOL
 from .contact_problem import Condensed, solve_contact
-from .convergence import TOLERANCE, moments, residuals
+from .convergence import TOLERANCE, exceeding, moments, residuals
 from .linear import Factorization
 from .semismooth import EPS, SAFETY
 from .settings import ActiveSetSettings
@@ -185,22 +185,26 @@ def conforming_active_set(problem: DiscreteProblem, settings: ActiveSetSettings,
 
 def checked_solution(problem: DiscreteProblem, x: np.ndarray, law: str, mu_f: float,
                      F: np.ndarray | None, method: str, iterations: dict, history: list,
-                     seconds: dict, found: dict | None = None) -> Solution:
+                     seconds: dict, found: dict | None = None,
+                     floors: dict | None = None) -> Solution:
     """The solution x of (3.62) with the facet multipliers, once its residuals on
     ``problem.K`` (:func:`residuals`; ``found``: those of this x, computed by the caller)
-    are round-off; the friction multiplier nu and the bound reported per fine edge (the h^
+    are round-off (:func:`~ngdual.solvers.convergence.exceeding`, with the residuals' own
+    ``floors``); the friction multiplier nu and the bound reported per fine edge (the h^
     edges of ``FacetFrictionForms``).
 
     Raises
     ------
     ConvergenceError
-        Naming every residual above ``TOLERANCE``.
+        Naming every residual above ``TOLERANCE`` (or its floor).
     """
     found = residuals(problem, x, law, mu_f, F) if found is None else found
-    bad = {k: v for k, v in found.items() if not v <= TOLERANCE}
+    bad = exceeding(found, floors)
     if bad:
+        floors = floors or {}
         raise ConvergenceError("the active-set solution does not satisfy (3.62) to round-off: "
-                               + ", ".join(f"{k} = {v:.1e} > {TOLERANCE:.0e}"
+                               + ", ".join(f"{k} = {v:.1e} > "
+                                           f"{max(TOLERANCE, floors.get(k, 0.0)):.2g}"
                                            for k, v in bad.items()), history)
     nu = forms = edge_bound = nu_l2 = None
     if F is not None:
