@@ -9,7 +9,7 @@ import time
 from pathlib import Path
 
 from ..scene import ORDERS, SceneError
-from .output import EXIT_NOT_CONVERGED, number_flag
+from .output import EXIT_NOT_CONVERGED, number_flag, runs_in_process
 
 
 def add_cost(sub, common: argparse.ArgumentParser) -> None:
@@ -50,7 +50,6 @@ def cmd_cost(args) -> int:
     time-to-accuracy tables; write DIR/cost.json and DIR/work_precision.png. Exit status 1
     when no reference run finished a step."""
     from .. import plot
-    from ..extras import MissingExtraError, require
     from ..io import check_output_dir, write_json
     from ..scene import load_scene
     from ..studies.cost import NoReference, cost
@@ -74,16 +73,7 @@ def cmd_cost(args) -> int:
         raise SceneError("--window", f"must be LO < HI, got {args.window}")
     check_measurable(load_scene(args.scene, args.set))
     out = check_output_dir(args.out, "--out")
-    in_process = args.threads
-    if args.workers is not None:
-        require("dask.distributed", "studies")
-    elif not in_process:
-        try:
-            require("dask.distributed", "studies")
-        except MissingExtraError:
-            print("ngdual: dask (the studies extra) is not installed: the methods run one "
-                  "after another in this process (--threads)", file=sys.stderr)
-            in_process = True
+    in_process = runs_in_process(args.threads, args.workers is not None, "methods")
     try:
         result = cost(args.scene, args.budget, out, sorted(set(args.orders)), args.set,
                       args.window, args.workers, not in_process)

@@ -68,6 +68,28 @@ def number_flag(value, flag: str, low: float, high: float, integer: bool = False
     return value
 
 
+def runs_in_process(threads: bool, dask_asked: bool, what: str) -> bool:
+    """Whether the ``what`` (tasks, methods) of a study command run one after another in
+    this process rather than on dask workers: with ``--threads``, or where dask (the studies
+    extra) is not installed, which is said on stderr. Where dask was asked for
+    (``dask_asked``: ``--workers``, ``--scheduler``) and is missing, a MissingExtraError
+    refuses the command before it writes anything."""
+    from ..extras import MissingExtraError, require
+
+    if dask_asked:
+        require("dask.distributed", "studies")
+        return threads
+    if threads:
+        return True
+    try:
+        require("dask.distributed", "studies")
+    except MissingExtraError:
+        print(f"ngdual: dask (the studies extra) is not installed: the {what} run one after "
+              "another in this process (--threads)", file=sys.stderr)
+        return True
+    return False
+
+
 def level_flags(levels, flag: str) -> list[int]:
     return [check_level(level, flag) for level in levels]
 

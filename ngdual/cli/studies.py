@@ -9,28 +9,25 @@ import sys
 from pathlib import Path
 
 from ..scene import SceneError
-from .output import EXIT_BAD_INPUT, EXIT_NOT_CONVERGED, level_flags, number_flag
+from .output import (
+    EXIT_BAD_INPUT,
+    EXIT_NOT_CONVERGED,
+    level_flags,
+    number_flag,
+    runs_in_process,
+)
 
 
 def cmd_figures(args) -> int:
     """Regenerate the figures and tables of Sections 3.4 and 4.2 into DIR (see figures/)."""
     from .. import budget
-    from ..extras import MissingExtraError, require
     from ..io import check_output_dir
     from ..scene import Geometry
     from ..studies.figures import DEFAULT_MAX_LEVEL, THESIS_MAX_LEVEL, run_figures
     from ..studies.figures.run import select_scripts
 
-    in_process = args.threads
-    if args.scheduler or args.workers is not None:  # asked for dask: refused before writing
-        require("dask.distributed", "studies")
-    elif not in_process:
-        try:
-            require("dask.distributed", "studies")
-        except MissingExtraError:
-            print("ngdual: dask (the studies extra) is not installed: the tasks run one after "
-                  "another in this process (--threads)", file=sys.stderr)
-            in_process = True
+    in_process = runs_in_process(args.threads,
+                                 bool(args.scheduler) or args.workers is not None, "tasks")
 
     max_level = DEFAULT_MAX_LEVEL if args.max_level is None else args.max_level
     number_flag(max_level, "--max-level", 2, THESIS_MAX_LEVEL, integer=True)
