@@ -49,9 +49,11 @@ class Condensed:
     def n_c(self) -> int:
         return len(self.J)
 
-    @property
+    @functools.cached_property
     def roundoff(self) -> float:
-        """eps max(kappa_1(G), dim G): the relative accuracy of the small problem."""
+        """eps max(kappa_1(G), dim G): the relative accuracy of the small problem (G is
+        fixed once built: its Cholesky-based estimate is computed once, not at each of the
+        contact solve's, the fixed point's and the convergence test's reads)."""
         return EPS * max(condition_number(self.G), float(len(self.b)), 1.0)
 
     @property
