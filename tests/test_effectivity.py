@@ -27,15 +27,15 @@ from ngdual.studies.effectivity import (
 )
 
 BY_NAME = {u.name: u for u in UNSEEN}
-# two scenes of the study whose references are cheap (2 and 10 s): a Hertz box half the
+# two scenes of the study whose references are cheap (about 4 s each): a Hertz box half the
 # size of hertz-cylinder's and Cattaneo-Mindlin with mu_f = 0.5
 FAST = ("hertz-small", "cattaneo-mu0.5")
 
 
 @pytest.fixture(scope="module")
 def references():
-    """The references of the FAST scenes: the pressure goal of order 2 for six solves (55 104
-    and 169 977 unknowns; own accuracy measured 0.019 % and 0.040 %)."""
+    """The references of the FAST scenes: the pressure goal of order 2 for six solves (about
+    110 000 unknowns; own accuracy measured 0.04 % and 0.09 %)."""
     return {name: reference(BY_NAME[name], tol=1e-6, solves=6) for name in FAST}
 
 

@@ -81,11 +81,10 @@ def adapt(scene: Scene, marking: str | None = None, theta: float | None = None,
         ``tol`` :data:`THETA_TOL` (faster growth of the unknowns).
     growth : float, optional
         The least factor in [1, 4] by which REFINE multiplies the triangles (and about the
-        unknowns): above 1 it refines the marked triangles, then deeper (the marked ones
-        again at order k >= 1, the triangles at the peaks of their estimate at order 0)
-        until the mesh has grown by ``growth``
+        unknowns): above 1 it refines the marked triangles, then the triangles at the peaks
+        of their estimate, once and again until the mesh has grown by ``growth``
         (:func:`ngdual.afem.refinement.refine_graded`). Default :data:`GROWTH` = 1 (the
-        marked triangles alone, as in the thesis), with a ``tol`` :data:`GROWTH_TOL` = 2
+        marked triangles alone, as in the thesis), with a ``tol`` :data:`GROWTH_TOL` = 1.5
         (a step that grows the unknowns little costs almost as much as one that grows them
         much).
     steps : int, optional

@@ -14,7 +14,6 @@ import ngsolve as ngs
 import numpy as np
 
 from ..boundary import BoundaryMeshes, nearest_vertex
-from ..forms.spaces import variant_of
 from ..geometry import length_scale
 from ..loop_defaults import MAX_GROWTH
 from ..marking import peak_vertices
@@ -55,73 +54,36 @@ def refine(mesh: ngs.Mesh, marked: np.ndarray) -> ngs.Mesh:
 
 def refine_graded(scene: Scene, mesh: ngs.Mesh, marked: np.ndarray, indicators: np.ndarray,
                   growth: float) -> ngs.Mesh:
-    """The marked triangles of ``mesh`` refined, then refined deeper until the triangles have
-    grown by ``growth``.
+    """The marked triangles of ``mesh`` refined, then the triangles at the peaks of their
+    estimate refined again until the triangles have grown by ``growth``.
 
-    After :func:`refine` of the marked triangles, a round refines again (at most
-    :data:`GRADING_ROUNDS` rounds, while the mesh has fewer than ``growth`` times the
-    triangles of ``mesh``, never below :data:`RESOLUTION`)
+    After :func:`refine` of the marked triangles, the triangles at the peak vertices
+    (:func:`ngdual.marking.peak_vertices`: where the marked triangles' eta_T^2 add up to at
+    least a quarter of the most at any vertex) are refined once, and again while the mesh
+    has fewer than ``growth`` times the triangles of ``mesh``, at most
+    :data:`GRADING_ROUNDS` times and never below :data:`RESOLUTION`. The unknowns of
+    PEERS_k are about proportional to the triangles, so they grow by about ``growth`` too.
 
-    * at order k >= 1 the marked triangles' descendants (their children, then theirs): each
-      marked triangle is bisected up to 1 + GRADING_ROUNDS times, the REFINE of the AFEM
-      convergence theory that bisects every marked element b >= 1 times (Cascón, Kreuzer,
-      Nochetto and Siebert 2008). There the goal's estimate sits at a few points (the ends
-      of the contact zone, a corner, the wedge's apex) and Dörfler's set is a handful of
-      triangles around them (0.3-5 % of the triangles);
-    * at order 0 the triangles at the peaks of the marked estimate
-      (:func:`ngdual.marking.peak_vertices`: the vertices where the marked triangles'
-      eta_T^2 add up to at least a quarter of the most at any vertex). There the estimate
-      spreads over Gamma_C, Dörfler's set is a band (15-65 % of the triangles) and
-      refining all of it again grows the mesh where the error is already small (the
-      pressure goal to 1 %: hertz-cylinder 219 221 unknowns against 81 496 at the peaks,
-      Example 3.46 with Coulomb friction 1.7 million against 0.6 million).
-
-    The unknowns of PEERS_k are about proportional to the triangles, so they grow by about
-    ``growth`` too (docs/theory/estimator.md, "Steps that pay").
+    Where the marked estimate sits at a point (a corner singularity, an end of the contact
+    zone), Dörfler's set is a handful of triangles there and one bisection per step grows
+    the mesh by a few percent; a graded step shrinks the triangles at the point by up to
+    2^-3 and takes the grading several plain steps would, in one solve. Where it is spread
+    (over Gamma_C at order 0), most vertices of the marked set are peaks and the step
+    refines it twice (docs/theory/estimator.md, "Steps that pay").
     """
+    peaks = peak_vertices(mesh_arrays(mesh)[1], indicators, marked)
     fine = refine(mesh, marked)
-    if variant_of(scene).order == 0:
-        peaks, origin = peak_vertices(mesh_arrays(mesh)[1], indicators, marked), None
-    else:
-        origin = _ancestors(fine, mesh.ne)
     for done in range(GRADING_ROUNDS):
-        # (at order 0 the peaks are refined once more whatever the growth)
-        if (done or origin is not None) and fine.ne >= growth * mesh.ne:
+        if done and fine.ne >= growth * mesh.ne:
             break
-        again = _at_peaks(fine, peaks) if origin is None else marked[origin]
-        if not again.any() or below_resolution(scene, element_diameters(fine), again):
+        _, triangles = mesh_arrays(fine)
+        at_peak = np.zeros(fine.nv, dtype=bool)
+        at_peak[:len(peaks)] = peaks   # refine keeps the vertex numbers
+        around = at_peak[triangles].any(axis=1)
+        if not around.any() or below_resolution(scene, element_diameters(fine), around):
             break
-        finer = refine(fine, again)
-        if origin is not None:
-            origin = origin[_ancestors(finer, fine.ne)]
-        fine = finer
+        fine = refine(fine, around)
     return fine
-
-
-def _at_peaks(fine: ngs.Mesh, peaks: np.ndarray) -> np.ndarray:
-    """The triangles of ``fine`` at a vertex of ``peaks`` (of the mesh ``fine`` refines:
-    :func:`refine` keeps the vertex numbers)."""
-    _, triangles = mesh_arrays(fine)
-    at_peak = np.zeros(fine.nv, dtype=bool)
-    at_peak[:len(peaks)] = peaks
-    return at_peak[triangles].any(axis=1)
-
-
-def _ancestors(fine: ngs.Mesh, coarse_triangles: int) -> np.ndarray:
-    """For every triangle of ``fine``, made by :func:`refine` from a mesh of
-    ``coarse_triangles`` triangles, the triangle of that mesh it lies in.
-
-    netgen's bisection keeps the numbers of the coarse triangles (a bisected one keeps its
-    number for one child) and appends the new ones, each with its parent
-    (``parentsurfaceelements``, in 2D the triangles); following the parents down to a
-    number below ``coarse_triangles`` gives the coarse triangle."""
-    parent = np.asarray(fine.ngmesh.parentsurfaceelements.NumPy())["i"].astype(np.int64)
-    origin = np.arange(fine.ne)
-    while np.any(new := origin >= coarse_triangles):
-        origin[new] = parent[origin[new]]
-        if np.any(origin < 0):
-            raise RuntimeError("netgen's refinement lost the parent of a new triangle")
-    return origin
 
 
 def check_growth(growth) -> float:

@@ -131,9 +131,8 @@ def parser() -> argparse.ArgumentParser:
                          f"--tol {THETA_TOL:g}, which grows the unknowns faster)")
     ad.add_argument("--growth", type=float, default=None,
                     help=f"the least factor in [1, {MAX_GROWTH:g}] by which a step multiplies "
-                         "the triangles: the marked ones refined, then deeper (the marked "
-                         "ones again at order k >= 1, those at the peaks of their estimate "
-                         "at order 0) until the mesh has grown by G (default 1, "
+                         "the triangles: the marked ones refined, then those at the peaks of "
+                         "their estimate, again until the mesh has grown by G (default 1, "
                          f"the marked triangles alone, as in the thesis; with --tol "
                          f"{GROWTH_TOL:g})")
     ad.add_argument("--steps", type=int, default=None,

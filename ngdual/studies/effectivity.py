@@ -46,10 +46,8 @@ ORDERS = (0, 1, 2)
 # the tolerances of the runs measured: the run to the finest holds the steps of the others
 TOLS = (0.05, 0.02)
 # the overkill: the pressure goal of order 2 to this relative estimate, in at most this
-# many solves, each with at least this growth of the triangles (not the tolerance runs'
-# GROWTH_TOL = 2, whose eight solves would pass a million unknowns: about 1.25-2.8 times
-# the unknowns of the one before)
-REFERENCE_ORDER, REFERENCE_TOL, REFERENCE_SOLVES, REFERENCE_GROWTH = 2, 2e-4, 8, 1.25
+# many solves (each about 1.8 times the unknowns of the one before)
+REFERENCE_ORDER, REFERENCE_TOL, REFERENCE_SOLVES = 2, 2e-4, 8
 # the band the effectivity must lie in (issue 50)
 BAND = (0.5, 2.0)
 # a solve's error is resolved by the reference where it is at least this many times the
@@ -165,9 +163,8 @@ def reference(unseen: Unseen, tol: float = REFERENCE_TOL, order: int = REFERENCE
     """The overkill pressure of ``unseen`` and its own accuracy.
 
     The pressure goal of ``order`` run to ``tol`` in at most ``solves`` solves
-    (:func:`ngdual.adapt`, least growth :data:`REFERENCE_GROWTH`). Returns its last solve's
-    pressure (``p_nodes``, ``p``: :func:`ngdual.verification.overkill.solution_samples`),
-    ``accuracy``, the distance of
+    (:func:`ngdual.adapt`). Returns its last solve's pressure (``p_nodes``, ``p``:
+    :func:`ngdual.verification.overkill.solution_samples`), ``accuracy``, the distance of
     the last solve's pressure to the one before relative to its norm on the goal's window,
     and the run's ``ndof``, ``solves``, ``relative_estimate``, ``stopped_by`` and
     ``seconds``.
@@ -184,8 +181,7 @@ def reference(unseen: Unseen, tol: float = REFERENCE_TOL, order: int = REFERENCE
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         history = adapt(unseen.load(), goal="pressure", tol=tol, order=order,
-                        window=unseen.window, on_step=keep, steps=solves,
-                        growth=REFERENCE_GROWTH)
+                        window=unseen.window, on_step=keep, steps=solves)
     if len(held) < 2:
         raise ValueError(f"the reference of {unseen.name} stopped after one solve: it has no "
                          f"accuracy; lower its tol ({tol:g})")
