@@ -30,7 +30,7 @@ RESOLUTION = 1e-7
 # ones (:func:`refine_graded`): a peak's triangles shrink by up to 2^-3 in one step. A third
 # round never ran on the work-precision study's problems at tol = 0.01; at 0.001 it took the
 # wedge's apex (order 1, the pressure goal) to the resolution at step 8 without reaching the
-# tolerance, where two rounds reach it in 8 solves (docs/theory/estimator.md, "Steps that
+# tolerance, as two rounds do (the apex's kink; docs/theory/estimator.md, "Steps that
 # pay").
 GRADING_ROUNDS = 2
 
