@@ -65,7 +65,7 @@ from ..friction import MomentFriction, build_friction_forms, tresca_moments
 from ..solution import ConvergenceError, Solution
 from ..tolerances import COULOMB_FIXED_POINT_TOL
 from .contact_problem import Condensed, solve_contact
-from .convergence import TOLERANCE, exceeding, moments, residuals
+from .convergence import accepted, exceeding, moments, residuals
 from .linear import Factorization
 from .semismooth import EPS, SAFETY
 from .settings import ActiveSetSettings
@@ -201,10 +201,8 @@ def checked_solution(problem: DiscreteProblem, x: np.ndarray, law: str, mu_f: fl
     found = residuals(problem, x, law, mu_f, F) if found is None else found
     bad = exceeding(found, floors)
     if bad:
-        floors = floors or {}
         raise ConvergenceError("the active-set solution does not satisfy (3.62) to round-off: "
-                               + ", ".join(f"{k} = {v:.1e} > "
-                                           f"{max(TOLERANCE, floors.get(k, 0.0)):.2g}"
+                               + ", ".join(f"{k} = {v:.1e} > {accepted(k, floors):.2g}"
                                            for k, v in bad.items()), history)
     nu = forms = edge_bound = nu_l2 = None
     if F is not None:

@@ -57,8 +57,13 @@ def exceeding(found: dict, floors: dict | None = None) -> dict:
     >>> exceeding({"stationarity": 2e-9, "coulomb_bound": 2e-9}, {"coulomb_bound": 1e-8})
     {'stationarity': 2e-09}
     """
-    floors = floors or {}
-    return {k: v for k, v in found.items() if not v <= max(TOLERANCE, floors.get(k, 0.0))}
+    return {k: v for k, v in found.items() if not v <= accepted(k, floors)}
+
+
+def accepted(name: str, floors: dict | None = None) -> float:
+    """The largest value of the residual ``name`` accepted as round-off: ``TOLERANCE``, or its
+    floor in ``floors`` where that is larger (:func:`exceeding`)."""
+    return max(TOLERANCE, (floors or {}).get(name, 0.0))
 
 
 def displacement_scale(problem: DiscreteProblem, x: np.ndarray) -> float:
