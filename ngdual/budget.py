@@ -167,8 +167,9 @@ def _memory_limits() -> dict[str, float]:
 
 
 def _machine_available() -> float:
-    """Bytes of memory the machine has available: psutil's estimate (psutil comes with the
-    studies extra), else the kernel's MemAvailable, else the physical size."""
+    """Bytes of memory the machine has available: psutil's estimate (a core dependency; an
+    environment without it falls back to the kernel's MemAvailable, else the physical
+    size)."""
     try:
         import psutil
 

@@ -187,6 +187,21 @@ def edge_dofs(space: ngs.FESpace, pairs) -> list[tuple[int, ...]]:
     return out
 
 
+def triangles_at(mesh: ngs.Mesh, labels: list[str]) -> np.ndarray:
+    """The triangles with an edge on the boundary parts ``labels``, by number (sorted).
+
+    >>> mesh = thesis_mesh(1)       # 32 triangles, eight edges on the bottom
+    >>> len(triangles_at(mesh, ["bottom"])), len(triangles_at(mesh, []))
+    (8, 0)
+    """
+    found: set[int] = set()
+    if labels:
+        for segment in mesh.Boundaries("|".join(labels)).Elements():
+            for edge in segment.edges:
+                found.update(el.nr for el in mesh[edge].elements)
+    return np.array(sorted(found), dtype=np.int64)
+
+
 def mesh_arrays(mesh: ngs.Mesh) -> tuple[np.ndarray, np.ndarray]:
     """Vertex coordinates (n, 2) and the vertex numbers of every triangle (ne, 3).
 

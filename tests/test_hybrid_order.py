@@ -9,6 +9,7 @@ at k = 0 (facet), 1, 2 without friction and with Tresca and Coulomb friction, He
 slow: Hertz at k = 2 and level 2 of Example 3.46 with Coulomb friction at k = 2.
 """
 
+import ngsolve as ngs
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -16,6 +17,7 @@ import scipy.sparse as sp
 from ngdual.forms import assemble, broken_peers, conforming_peers
 from ngdual.mesh import build_mesh
 from ngdual.scene import load_scene
+from ngdual.solvers import hybrid as hybrid_module
 from ngdual.solvers import solve_scene
 from ngdual.solvers.active_set import active_set_solve
 from ngdual.solvers.conforming import conforming_active_set
@@ -23,6 +25,7 @@ from ngdual.solvers.convergence import TOLERANCE
 from ngdual.solvers.hybrid import HybridSystem, _element_schur
 from ngdual.solvers.linear import solve_linear
 from ngdual.solvers.settings import solver_settings
+from ngdual.sparse import to_scipy
 from ngdual.verification.manufactured import manufactured_case
 
 ROUND_OFF = 1e-10  # relative difference of the two solvers' unknowns (measured: 3e-14-2e-11)
@@ -177,6 +180,25 @@ def test_the_element_schur_complements_sum_to_the_sparse_product(order):
     for chunk in (2048, 37):
         batched = _element_schur(hybrid.B_inv, hybrid.A_LI, chunk).toarray()
         assert np.max(np.abs(batched - sparse)) <= 1e-14 * np.max(np.abs(sparse))
+
+
+@pytest.mark.parametrize("order", [0, 1, 2])
+def test_ngsolves_static_condensation_is_the_element_schur_complement(order):
+    """On eta and mu, NGSolve's static condensation of every triangle and the batched
+    element Schur complements from the broken matrix's blocks, two independent
+    eliminations, give the same matrix to round-off."""
+    problem, _ = _problem("thesis-3.46-coulomb", order, 2)
+    hybrid = HybridSystem(problem, friction=True)
+    mesh, n_local = problem.spaces.mesh, hybrid._n_local
+    every = ngs.BitArray(mesh.ne)
+    every.Set()
+    form = hybrid_module._condensed_form(problem.broken, order, every)
+    condensed = -to_scipy(form.mat)[n_local:][:, n_local:]
+    n_g = condensed.shape[0]
+    B_inv, A_LI = hybrid._blocks.of(
+        hybrid_module._local_dofs(problem.broken.fes, np.arange(mesh.ne), n_local))
+    blocks = _element_schur(B_inv, A_LI)[:n_g][:, :n_g]
+    assert abs(condensed - blocks).max() <= 1e-12 * abs(blocks).max()
 
 
 def test_the_element_schur_complements_keep_explicit_zeros_out_of_the_way():

@@ -49,7 +49,8 @@ def assemble(scene: Scene, mesh: ngs.Mesh, coarse: BoundaryMeshes | None = None
     spaces = Spaces.build(scene, mesh, coarse)
     names = list(spaces.components)
     fes = ngs.FESpace([spaces.components[n] for n in names])
-    broken = broken_peers(spaces, scene.material.lame)
+    broken = broken_peers(spaces, scene.material.lame,
+                          scene.labels("neumann") + scene.labels("contact"))
     d, rhs = coupling_forms(scene, fes, names, spaces)
     for form in (d, rhs):
         if form is not None:

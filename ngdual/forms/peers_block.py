@@ -3,13 +3,14 @@ element with broken Raviart-Thomas rows (:class:`BrokenPeers`) or on the conform
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import ngsolve as ngs
 import numpy as np
 import scipy.sparse as sp
 
 from .. import peers
+from ..mesh import triangles_at
 from ..sparse import to_scipy
 from .integrators import differentiated_integrands, parallel_tasks
 from .rules import volume_rules
@@ -17,7 +18,8 @@ from .spaces import Spaces
 
 
 def peers_form(trial: dict, test: dict, lame: tuple[float, float], order: int = 0,
-               family: str = "peers") -> ngs.comp.SumOfIntegrals:
+               family: str = "peers", elements: ngs.BitArray | None = None
+               ) -> ngs.comp.SumOfIntegrals:
     """The PEERS block of (3.62) on T_h, with its exact volume rule
     (:func:`~ngdual.forms.rules.volume_rules`):
 
@@ -37,11 +39,14 @@ def peers_form(trial: dict, test: dict, lame: tuple[float, float], order: int = 
     order, family : int, str
         The order k and the family of the spaces (:func:`ngdual.peers.family_spaces`), which
         fix the degree of the rule.
+    elements : ngsolve.BitArray, optional
+        The triangles to integrate over (NGSolve's ``definedonelements``); default all.
     """
     lam, mu = lame
     sig, tau = (peers.stress_rows(f["r1"], f["r2"], f.get("b1"), f.get("b2"))
                 for f in (trial, test))
-    dx = ngs.dx(intrules=volume_rules(order, family))
+    dx = ngs.dx(intrules=volume_rules(order, family)) if elements is None else ngs.dx(
+        intrules=volume_rules(order, family), definedonelements=elements)
     # three integrals, each compiled on its own: the element matrices of a~, b, s are summed
     # in this order in every assembly. Each is written on the rows of sigma and tau, not on
     # the 2x2 matrices of peers.triple: the same element matrices bit for bit, and the whole
@@ -76,12 +81,19 @@ class BrokenPeers:
         zeros included).
     conforming : numpy.ndarray
         The conforming PEERS unknown that every broken unknown restricts (E as an index map).
+    lame : tuple of float
+        Lame's constants (lambda, mu) of the form.
+    coupled : numpy.ndarray
+        The triangles with an edge on Gamma_N or Gamma_C (by number), whose broken functions
+        the boundary multipliers couple.
     """
 
     fes: ngs.FESpace
     form: ngs.BilinearForm
     matrix: sp.csr_matrix
     conforming: np.ndarray
+    lame: tuple[float, float] = (0.0, 0.0)
+    coupled: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
 
     def summed(self, size: int) -> sp.csr_matrix:
         """K = E^T K_b E, the PEERS block of (3.62), as the leading block of a ``size`` x
@@ -115,10 +127,12 @@ class BrokenPeers:
         return np.bincount(self.conforming, values, minlength=len(count)) / count
 
 
-def broken_peers(spaces: Spaces, lame: tuple[float, float]) -> BrokenPeers:
+def broken_peers(spaces: Spaces, lame: tuple[float, float], coupled: list[str] = ()
+                 ) -> BrokenPeers:
     """Assemble the PEERS block of (3.62) of order ``spaces.order`` with broken
     Raviart-Thomas rows (:class:`BrokenPeers`): ``HDiv(order=k, RT=True, discontinuous=True)``,
-    every triangle with its own RT_k functions."""
+    every triangle with its own RT_k functions; ``coupled`` are the labels of the boundary
+    parts whose multipliers couple them (Gamma_N, Gamma_C)."""
     mesh, order = spaces.mesh, spaces.order
     broken_rt = ngs.HDiv(mesh, order=0, discontinuous=True) if order == 0 else ngs.HDiv(
         mesh, order=order, RT=True, discontinuous=True)
@@ -138,7 +152,8 @@ def broken_peers(spaces: Spaces, lame: tuple[float, float]) -> BrokenPeers:
         own = edge if name in ("r1", "r2") else np.arange(comps[name].ndof)
         conforming.append(offset + own)
         offset += spaces.components[name].ndof
-    return BrokenPeers(fes, a, to_scipy(a.mat, copy=False), np.concatenate(conforming))
+    return BrokenPeers(fes, a, to_scipy(a.mat, copy=False), np.concatenate(conforming),
+                       tuple(lame), triangles_at(mesh, list(coupled)))
 
 
 def conforming_peers(spaces: Spaces, lame: tuple[float, float], size: int) -> sp.csr_matrix:

@@ -44,19 +44,19 @@ def fill_reducing_order(H: sp.spmatrix, method: str = "amd") -> np.ndarray:
         graph.sort_indices()
         perm, _ = pymetis.nested_dissection(pymetis.CSRAdjacency(graph.indptr, graph.indices))
         return np.asarray(perm, dtype=int)
+    lower = sp.tril(H).tocoo()
+    return _amd(lower.row, lower.col, n)
+
+
+def _amd(rows: np.ndarray, cols: np.ndarray, n: int) -> np.ndarray:
+    """SuiteSparse's AMD ordering (through cvxopt) of the symmetric n x n pattern whose lower
+    triangle has the entries (``rows``, ``cols``)."""
     import cvxopt
     import cvxopt.amd
 
-    lower = sp.tril(H).tocoo()
-    A = cvxopt.spmatrix(cvxopt.matrix(lower.data.astype(float)),
-                        cvxopt.matrix(lower.row.astype(int)), cvxopt.matrix(lower.col.astype(int)),
-                        H.shape)
+    A = cvxopt.spmatrix(cvxopt.matrix(np.ones(len(rows))), cvxopt.matrix(rows.astype(int)),
+                        cvxopt.matrix(cols.astype(int)), (n, n))
     return np.asarray(cvxopt.amd.order(A), dtype=int).ravel()
-
-
-def _major_index(indptr: np.ndarray) -> np.ndarray:
-    """The column of every entry of a CSC matrix (the row for CSR), from its pointers."""
-    return np.repeat(np.arange(len(indptr) - 1), np.diff(indptr))
 
 
 def _superlu_gstrs(L: sp.csc_matrix):
@@ -112,7 +112,7 @@ class SchurCholesky:
         import cvxopt
         import cvxopt.cholmod as cholmod
 
-        H = sp.csr_matrix(H)
+        H = sp.coo_matrix(H)
         n, m = H.shape[0], len(last)
         self.n, self.m = n, m
         times = {}
@@ -120,17 +120,26 @@ class SchurCholesky:
         keep = np.ones(n, dtype=bool)
         keep[last] = False
         rest = np.flatnonzero(keep)
-        sub = fill_reducing_order(H[rest][:, rest], ordering)
+        if ordering == "amd":   # the lower triangle of H[rest][:, rest], without forming it
+            number = np.cumsum(keep) - 1
+            inside = keep[H.row] & keep[H.col] & (H.row >= H.col)
+            sub = _amd(number[H.row[inside]], number[H.col[inside]], len(rest))
+        else:
+            sub = fill_reducing_order(H.tocsr()[rest][:, rest], ordering)
         self.perm = np.concatenate([rest[sub], np.asarray(last, dtype=int)])
         times["order"] = time.perf_counter() - start
 
         start = time.perf_counter()
-        # H symmetric: the rows of triu(P H P^T) (CSR) are the columns of its lower triangle
-        upper = sp.triu(H[self.perm][:, self.perm], format="csr")
-        upper.sort_indices()
-        A = cvxopt.spmatrix(cvxopt.matrix(upper.data), cvxopt.matrix(upper.indices.astype(int)),
-                            cvxopt.matrix(_major_index(upper.indptr)), (n, n))
-        del upper
+        # H symmetric: its entries on and below the diagonal of P H P^T, the lower triangle
+        # CHOLMOD reads
+        place = np.empty(n, dtype=np.int64)
+        place[self.perm] = np.arange(n)
+        rows, cols = place[H.row], place[H.col]
+        lower = rows >= cols
+        A = cvxopt.spmatrix(cvxopt.matrix(H.data[lower].astype(float)),
+                            cvxopt.matrix(rows[lower].astype(int)),
+                            cvxopt.matrix(cols[lower].astype(int)), (n, n))
+        del rows, cols, lower
         saved = dict(cholmod.options)
         # the ordering is ours (nmethods = 1) and must not be postordered, so that the
         # unknowns I stay last and the factor's trailing block is the Schur complement
