@@ -10,12 +10,20 @@ demand) derived from the work-precision study of the six problems
   engineer asks for), the stress goal (4.50) otherwise;
 * the multipliers: the facet family (the coarse family of order k never paid: 5 % pressure
   on Example 3.46 in 12 s at k = 1 against 0.18 s with the facet one);
-* the order: k = 1, the fastest robust order. At 1 % pressure with the pressure goal it
-  is the fastest order on three problems (the flat punch, Hertz, the wedge) and within
-  1.6 times the fastest on the other three (Example 3.46 without friction 0.39 s against
-  0.24 s at k = 2; with Coulomb friction 0.53 against 0.39 s; Cattaneo-Mindlin 1.16 against
-  0.88 s); k = 2 is up to 1.9 times slower than the fastest (the punch) and order 0 1.9
-  to 15 times (Hertz 1.72 s, the punch 0.87 s);
+* the order, by where the contact pressure is singular (:func:`fixed_singularities`):
+  k = 2 where its only singularities are the free ends of the contact zone (a convex body
+  on a foundation: Hertz, Cattaneo-Mindlin), k = 1 where Gamma_C has a fixed singular
+  point (a kink, a junction with Gamma_D, an end where the boundary runs straight on or
+  turns re-entrant: the wedge's apex, the clamped ends of Example 3.46, the flat punch's
+  edges), and k = 1 without contact. Measured on the six problems of the study, the
+  tolerance runs of the pressure goal to 5, 1 and 0.3 % (docs/theory/order.md, Accuracy on
+  demand): k = 2 is 1.5-1.7 times faster than k = 1 on Hertz and Cattaneo-Mindlin to 1 and
+  0.3 %, k = 1 twice as fast as k = 2 on the wedge to 5 and 1 % and 1.2-1.6 times on
+  Example 3.46 and the punch to 0.3 %; where both orders reach the tolerance the rule's
+  worst choice is 1.5 times the faster order (Example 3.46 with Coulomb friction to 5 %),
+  either order alone 1.7 (k = 1) or 2.1 (k = 2) times. At the wedge's apex to 0.3 % k = 1
+  stops at the loop's resolution (its estimate at 2.2 %) where k = 2 reaches it: below 1 %
+  at a kink ask for ``order=2``;
 * the loop: Doerfler marking with the tolerance runs' parameter and least growth of the
   unknowns per step (:data:`ngdual.loop_defaults.THETA_TOL`, ``GROWTH_TOL``), from the
   coarsest level (``LEVEL_TOL``), stopping by the goal's estimate.
@@ -43,10 +51,12 @@ from .scene import (
     contact_samples,
     ensure_valid,
 )
+from .scene.contact import KINK_ANGLE
 from .solution import PhysicsWarning, Solution
 from .solvers.dispatch import solve_scene, with_discretisation
 
-FASTEST_ORDER = 1          # the rule's order beyond the thesis (module docstring)
+FASTEST_ORDER = 1          # the rule's order at fixed singularities, without contact
+SMOOTH_ORDER = 2           # ... where the pressure is singular only at free ends
 FASTEST_FAMILY = "facet"
 
 
@@ -72,7 +82,9 @@ def fastest_method(scene: Scene, order: int | None = None,
                    multipliers: str | None = None) -> Method:
     """The method :func:`solve_to_tolerance` runs on ``scene`` (module docstring): the
     order and the family given here, else those the scene declares, else the thesis'
-    order 0 for a thesis scene, else :data:`FASTEST_ORDER` with the facet family."""
+    order 0 for a thesis scene, else the facet family with :data:`SMOOTH_ORDER` where the
+    contact pressure has no fixed singular point (:func:`fixed_singularities`) and
+    :data:`FASTEST_ORDER` where it has one or the scene has no contact."""
     goal = "pressure" if scene.has_contact else "stress"
     window = pressure_window(scene) if scene.has_contact else None
     declared = declared_variant(scene)
@@ -82,12 +94,37 @@ def fastest_method(scene: Scene, order: int | None = None,
         chosen, reason = declared, "the scene's [discretisation]"
     elif _thesis(scene):
         chosen, reason = variant_of(scene), "a thesis scene keeps the thesis' order 0"
-    else:
+    elif not scene.has_contact:
         chosen = Variant(FASTEST_ORDER, FASTEST_FAMILY)
-        reason = "the fastest robust order of the work-precision study"
+        reason = "the order of the work-precision study without contact"
+    else:
+        fixed = fixed_singularities(scene)
+        chosen = Variant(FASTEST_ORDER if fixed else SMOOTH_ORDER, FASTEST_FAMILY)
+        reason = ("the pressure is singular at fixed points of Gamma_C: " + "; ".join(fixed)
+                  if fixed else "the pressure is singular only at the free ends of the "
+                                "contact zone, where the higher order pays")
     if window is not None:
         reason += "; the pressure is measured on the middle half of Gamma_C (module docstring)"
     return Method(chosen.order, chosen.family, goal, reason, window)
+
+
+def fixed_singularities(scene: Scene) -> list[str]:
+    """The points of Gamma_C where the contact pressure may be singular whatever the load,
+    in words ("a kink at (0, 0)"): its kinks (a wedge's apex), its junctions with Gamma_D
+    (a clamped end) and its ends where a free or loaded side runs straight on or turns
+    re-entrant (a flat punch's edge, :func:`ngdual.goal.free_straight_ends`). Elsewhere the
+    pressure is singular only where the contact zone ends, a point the adaptive loop finds
+    and grades towards, and the higher order pays (module docstring)."""
+    found = []
+    for point, kind, angle in contact_junctions(scene):
+        where = f"({point[0]:.4g}, {point[1]:.4g})"
+        if kind == "kink":
+            found.append(f"a kink at {where}")
+        elif kind == "dirichlet":
+            found.append(f"a junction with Gamma_D at {where}")
+        elif kind == "neumann" and angle <= KINK_ANGLE:   # as free_straight_ends
+            found.append(f"a free side running straight on at {where}")
+    return found
 
 
 def pressure_window(scene: Scene) -> tuple[float, float] | None:
@@ -128,7 +165,7 @@ def solve(scene: Scene, level: int | None = None,
     >>> import ngdual as nd
     >>> solution = nd.solve(nd.load_scene("hertz-cylinder"), tol=0.05)  # doctest: +SKIP
     >>> solution.accuracy["method"]                                     # doctest: +SKIP
-    'adaptive, pressure goal, k = 1, facet'
+    'adaptive, pressure goal, k = 2, facet'
     """
     if tol is None:
         return solve_scene(scene, level, progress, allow_large, status, order=order,

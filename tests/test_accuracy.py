@@ -6,14 +6,17 @@ import json
 import pytest
 
 import ngdual as nd
-from ngdual.accuracy import FASTEST_ORDER, fastest_method
+from ngdual.accuracy import FASTEST_ORDER, SMOOTH_ORDER, fastest_method, fixed_singularities
 from ngdual.post import result_record
 from ngdual.scene import SceneError
 
 
 @pytest.mark.parametrize("name, overrides, order, family, goal", [
-    ("hertz-cylinder", [], FASTEST_ORDER, "facet", "pressure"),
-    ("cattaneo-mindlin", [], FASTEST_ORDER, "facet", "pressure"),
+    ("hertz-cylinder", [], SMOOTH_ORDER, "facet", "pressure"),      # free ends only
+    ("cattaneo-mindlin", [], SMOOTH_ORDER, "facet", "pressure"),
+    ("wedge", [], FASTEST_ORDER, "facet", "pressure"),               # a kink
+    ("flat-punch", [], FASTEST_ORDER, "facet", "pressure"),          # edges running straight
+    ("punch-on-foundation", [], FASTEST_ORDER, "facet", "pressure"),  # clamped ends
     ("thesis-3.46-coulomb", [], 0, "coarse", "pressure"),         # the thesis keeps order 0
     ("hertz-cylinder", ["discretisation.order=2"], 2, "facet", "pressure"),   # declared
     ("thesis-3.46-frictionless", ["boundary.contact=[]", 'boundary.neumann=["top", "bottom"]'],
@@ -23,6 +26,29 @@ def test_the_rule_chooses_order_family_and_goal(name, overrides, order, family, 
     method = fastest_method(nd.load_scene(name, overrides))
     assert (method.order, method.multipliers, method.goal) == (order, family, goal)
     assert method.reason
+
+
+@pytest.mark.parametrize("name, overrides, expected", [
+    ("hertz-cylinder", [], []),
+    ("wedge", [], ["a kink at (0, 0)"]),
+    ("flat-punch", [], ["a free side running straight on at (-0.25, 0)",
+                        "a free side running straight on at (0.25, 0)"]),
+    ("punch-on-foundation", [], ["a junction with Gamma_D at (2, 0)",
+                                 "a junction with Gamma_D at (-2, 0)"]),
+    # the same cylinder with its free sides clamped: Gamma_C meets Gamma_D
+    ("hertz-cylinder", ['boundary.dirichlet=["left", "right", "top"]', "boundary.neumann=[]",
+                        'loads.displacement=["0", "-0.01"]'], "clamped"),
+])
+def test_the_fixed_singular_points_of_the_pressure_are_read_from_gamma_c(name, overrides,
+                                                                          expected):
+    """The order follows where the pressure may be singular whatever the load: a kink, a
+    junction with Gamma_D, an end where the boundary runs straight on; free ends of the
+    contact zone alone (Hertz) leave the higher order its rate."""
+    found = fixed_singularities(nd.load_scene(name, overrides))
+    if expected == "clamped":
+        assert found and all(f.startswith("a junction with Gamma_D") for f in found)
+    else:
+        assert sorted(found) == sorted(expected)
 
 
 def test_a_pressure_singular_at_an_end_of_gamma_c_is_measured_on_its_middle_half():
@@ -55,7 +81,7 @@ def test_a_solve_to_a_tolerance_reaches_it_and_says_how():
     acc = solution.accuracy
     assert acc["reached"] and acc["stopped_by"] == "tol"
     assert acc["relative_estimate"] <= 0.05 and acc["tol"] == 0.05
-    assert acc["order"] == FASTEST_ORDER and acc["method"].startswith("adaptive, pressure goal")
+    assert acc["order"] == SMOOTH_ORDER and acc["method"].startswith("adaptive, pressure goal")
     assert acc["solves"] == len(acc["unknowns_per_step"]) >= 1
     assert acc["unknowns"] == acc["unknowns_per_step"][-1]
     assert result_record(solution)["accuracy"]["tol"] == 0.05
@@ -75,7 +101,7 @@ def test_the_command_line_solves_to_a_tolerance_and_says_how(tmp_path, capsys):
     assert main(["solve", "hertz-cylinder", "--tol", "0.05", "--out", str(out),
                  "--no-plots"]) == 0
     printed = capsys.readouterr().out
-    assert "accuracy  adaptive, pressure goal, k = 1" in printed and "an adapted mesh" in printed
+    assert "accuracy  adaptive, pressure goal, k = 2" in printed and "an adapted mesh" in printed
     record = json.loads((out / "result.json").read_text())
     assert record["accuracy"]["reached"] and record["accuracy"]["tol"] == 0.05
 

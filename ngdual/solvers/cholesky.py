@@ -19,6 +19,9 @@ from __future__ import annotations
 
 import time
 
+import cvxopt
+import cvxopt.amd
+import cvxopt.cholmod as cholmod
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
@@ -51,9 +54,6 @@ def fill_reducing_order(H: sp.spmatrix, method: str = "amd") -> np.ndarray:
 def _amd(rows: np.ndarray, cols: np.ndarray, n: int) -> np.ndarray:
     """SuiteSparse's AMD ordering (through cvxopt) of the symmetric n x n pattern whose lower
     triangle has the entries (``rows``, ``cols``)."""
-    import cvxopt
-    import cvxopt.amd
-
     A = cvxopt.spmatrix(cvxopt.matrix(np.ones(len(rows))), cvxopt.matrix(rows.astype(int)),
                         cvxopt.matrix(cols.astype(int)), (n, n))
     return np.asarray(cvxopt.amd.order(A), dtype=int).ravel()
@@ -109,9 +109,6 @@ class SchurCholesky:
     """
 
     def __init__(self, H: sp.spmatrix, last: np.ndarray, ordering: str = "amd"):
-        import cvxopt
-        import cvxopt.cholmod as cholmod
-
         H = sp.coo_matrix(H)
         n, m = H.shape[0], len(last)
         self.n, self.m = n, m
