@@ -149,7 +149,7 @@ class HybridSystem:
         # the global unknowns: eta, mu_1, mu_2, the other multipliers, the contact ones
         self.interface = np.concatenate([eta, n_b + np.arange(2 * n_mu + n_m)])
         self._sizes = (n_b, n_p, n_mu, multipliers)
-        condensed = to_scipy(form.mat, copy=False)[n_local:][:, n_local:]
+        condensed = _interface_block(form.mat, n_local)
         # the triangles at Gamma_N and Gamma_C: C_T^T B_T^{-1} C_T from their blocks here,
         # so that their element solves are the same arithmetic in H, rhs and unknowns
         self._blocks = _Blocks(matrix, n_local, (ranges["r1"], ranges["r2"]),
@@ -163,9 +163,9 @@ class HybridSystem:
                         [coupled[eta].T, None, boundary[multipliers][:, multipliers]]],
                        format="csr")
         # -(the condensed matrix) on eta and mu, with the multipliers' empty rows
+        data, indices, indptr = condensed
         others_part = sp.csr_matrix(
-            (-condensed.data, condensed.indices,
-             np.concatenate([condensed.indptr, np.full(n_m, condensed.indptr[-1])])),
+            (-data, indices, np.concatenate([indptr, np.full(n_m, indptr[-1])])),
             shape=(n_i, n_i))
         H = others_part + own - A_II
         self.H = (0.5 * (H + H.T)).tocsr()
@@ -389,6 +389,19 @@ def _condensed_form(broken: BrokenPeers, order: int, elements: ngs.BitArray
         with parallel_tasks(mesh):
             form.Assemble()
     return form
+
+
+def _interface_block(matrix, n_local: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(data, columns, row starts) of the block of NGSolve's condensed ``matrix`` on the
+    unknowns from ``n_local`` on (eta, mu), read from its CSR arrays without a copy of the
+    whole: the condensation leaves the rows of the element-local unknowns empty and the
+    other rows without their columns."""
+    values, columns, starts = (np.asarray(a) for a in matrix.CSR())
+    first = int(starts[n_local])
+    indices = columns[first:].astype(np.int64) - n_local
+    if first or (len(indices) and indices.min() < 0):
+        raise RuntimeError("NGSolve's condensed matrix couples the element-local unknowns")
+    return values[first:].copy(), indices, starts[n_local:].astype(np.int64) - first
 
 
 def _edge_coupling(broken_rt: ngs.FESpace, facet: ngs.FESpace, order: int) -> sp.csr_matrix:
