@@ -117,7 +117,10 @@ class BrokenPeers:
         element entry's magnitude times m. With m = |x| this is, row by row, the size of the
         terms whose sum is (K x)_i, and at least (|K| |x|)_i (an entry of K is the sum of at
         most two element entries)."""
-        return np.bincount(self.conforming, abs(self.matrix) @ magnitudes[self.conforming],
+        m = self.matrix   # |K_b| on K_b's own index arrays (abs() would copy them too)
+        magnitude = sp.csr_matrix((np.abs(m.data), m.indices, m.indptr), shape=m.shape,
+                                  copy=False)
+        return np.bincount(self.conforming, magnitude @ magnitudes[self.conforming],
                            minlength=size)
 
     def to_conforming(self, values: np.ndarray) -> np.ndarray:
