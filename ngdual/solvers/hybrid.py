@@ -277,12 +277,17 @@ class HybridSystem:
 
 def _local_dofs(fes: ngs.FESpace, elements: np.ndarray, n_local: int) -> np.ndarray:
     """(triangles, local unknowns): the element-local unknowns of ``fes`` (those below
-    ``n_local``) of every triangle of ``elements``, in increasing order."""
-    rows = [sorted(d for d in fes.GetDofNrs(ngs.ElementId(ngs.VOL, nr)) if 0 <= d < n_local)
-            for nr in elements.tolist()]
-    if len({len(r) for r in rows}) > 1:
+    ``n_local``) of every triangle of ``elements``, in increasing order (no rows, as many
+    columns as the mesh's first triangle has, without ``elements``: a scene without
+    Gamma_N and Gamma_C)."""
+    def own(nr: int) -> list[int]:
+        return sorted(d for d in fes.GetDofNrs(ngs.ElementId(ngs.VOL, nr)) if 0 <= d < n_local)
+
+    rows = [own(nr) for nr in elements.tolist()]
+    size = len(rows[0]) if rows else len(own(0))
+    if any(len(r) != size for r in rows):
         raise RuntimeError("the triangles do not have the same number of local unknowns")
-    return np.array(rows, dtype=np.int64).reshape(len(rows), -1)
+    return np.array(rows, dtype=np.int64).reshape(len(rows), size)
 
 
 def _check_no_global_block(matrix: sp.csr_matrix, n_local: int) -> None:
