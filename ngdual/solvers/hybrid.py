@@ -97,9 +97,14 @@ class HybridSystem:
     contact_index : numpy.ndarray
         The positions of the contact unknowns in x_I (the last ones): lambda_n, then
         lambda_t with friction, in the order of ``problem.lam_n`` and ``problem.index("lam_t")``.
+    local, B_inv, A_LI : numpy.ndarray, scipy.sparse.bsr_matrix, scipy.sparse.csr_matrix
+        The triangles at Gamma_N and Gamma_C, eliminated from their blocks: their
+        element-local unknowns (one row per triangle), the inverses of their blocks and the
+        couplings of those unknowns to x_I (the other triangles are NGSolve's).
     seconds : dict
-        ``broken`` (the edge coupling and the couplings of the multipliers to the broken
-        rows) and ``condense`` (the elimination of the element-local unknowns).
+        ``broken`` (the couplings of the multipliers to the broken rows, the triangles at
+        Gamma_N and Gamma_C) and ``condense`` (the elimination of the element-local
+        unknowns: NGSolve's condensation, the edge coupling, the blocks, H).
     """
 
     def __init__(self, problem: DiscreteProblem, friction: bool):
