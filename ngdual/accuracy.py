@@ -112,9 +112,9 @@ def fixed_singularities(scene: Scene) -> list[str]:
     """The points of Gamma_C where the contact pressure may be singular whatever the load,
     in words ("a kink at (0, 0)"): its kinks (a wedge's apex), its junctions with Gamma_D
     (a clamped end) and its ends where a free or loaded side runs straight on or turns
-    re-entrant (a flat punch's edge, :func:`ngdual.goal.pressure.free_straight_ends`). Elsewhere the
-    pressure is singular only where the contact zone ends, a point the adaptive loop finds
-    and grades towards, and the higher order pays (module docstring)."""
+    re-entrant (a flat punch's edge, :func:`ngdual.goal.pressure.free_straight_ends`).
+    Elsewhere the pressure is singular only where the contact zone ends, a point the
+    adaptive loop finds and grades towards, and the higher order pays (module docstring)."""
     found = []
     for point, kind, angle in contact_junctions(scene):
         where = f"({point[0]:.4g}, {point[1]:.4g})"

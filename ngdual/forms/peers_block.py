@@ -3,7 +3,7 @@ element with broken Raviart-Thomas rows (:class:`BrokenPeers`) or on the conform
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import ngsolve as ngs
 import numpy as np
@@ -92,8 +92,8 @@ class BrokenPeers:
     form: ngs.BilinearForm
     matrix: sp.csr_matrix
     conforming: np.ndarray
-    lame: tuple[float, float] = (0.0, 0.0)
-    coupled: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    lame: tuple[float, float]
+    coupled: np.ndarray
 
     def summed(self, size: int) -> sp.csr_matrix:
         """K = E^T K_b E, the PEERS block of (3.62), as the leading block of a ``size`` x
