@@ -51,7 +51,6 @@ from .scene import (
     contact_samples,
     ensure_valid,
 )
-from .scene.contact import KINK_ANGLE
 from .solution import PhysicsWarning, Solution
 from .solvers.dispatch import solve_scene, with_discretisation
 
@@ -115,16 +114,10 @@ def fixed_singularities(scene: Scene) -> list[str]:
     re-entrant (a flat punch's edge, :func:`ngdual.goal.pressure.free_straight_ends`).
     Elsewhere the pressure is singular only where the contact zone ends, a point the
     adaptive loop finds and grades towards, and the higher order pays (module docstring)."""
-    found = []
-    for point, kind, angle in contact_junctions(scene):
-        where = f"({point[0]:.4g}, {point[1]:.4g})"
-        if kind == "kink":
-            found.append(f"a kink at {where}")
-        elif kind == "dirichlet":
-            found.append(f"a junction with Gamma_D at {where}")
-        elif kind == "neumann" and angle <= KINK_ANGLE:   # as free_straight_ends
-            found.append(f"a free side running straight on at {where}")
-    return found
+    what = {"kink": "a kink", "dirichlet": "a junction with Gamma_D"}
+    found = [(what[kind], point) for point, kind, _ in contact_junctions(scene) if kind in what]
+    found += [("a free side running straight on", point) for point in free_straight_ends(scene)]
+    return [f"{name} at ({point[0]:.4g}, {point[1]:.4g})" for name, point in found]
 
 
 def pressure_window(scene: Scene) -> tuple[float, float] | None:
