@@ -47,8 +47,9 @@ def fill_reducing_order(H: sp.spmatrix, method: str = "amd") -> np.ndarray:
         graph.sort_indices()
         perm, _ = pymetis.nested_dissection(pymetis.CSRAdjacency(graph.indptr, graph.indices))
         return np.asarray(perm, dtype=int)
-    lower = sp.tril(H).tocoo()
-    return _amd(lower.row, lower.col, n)
+    H = sp.coo_matrix(H)
+    lower = H.row >= H.col
+    return _amd(H.row[lower], H.col[lower], n)
 
 
 def _amd(rows: np.ndarray, cols: np.ndarray, n: int) -> np.ndarray:
@@ -117,12 +118,12 @@ class SchurCholesky:
         keep = np.ones(n, dtype=bool)
         keep[last] = False
         rest = np.flatnonzero(keep)
-        if ordering == "amd":   # the lower triangle of H[rest][:, rest], without forming it
-            number = np.cumsum(keep) - 1
-            inside = keep[H.row] & keep[H.col] & (H.row >= H.col)
-            sub = _amd(number[H.row[inside]], number[H.col[inside]], len(rest))
-        else:
-            sub = fill_reducing_order(H.tocsr()[rest][:, rest], ordering)
+        # H[rest][:, rest] from H's triplets (two fancy indexings of a CSR matrix cost more)
+        number = np.cumsum(keep) - 1
+        inside = keep[H.row] & keep[H.col]
+        sub = fill_reducing_order(sp.coo_matrix(
+            (H.data[inside], (number[H.row[inside]], number[H.col[inside]])),
+            shape=(len(rest), len(rest))), ordering)
         self.perm = np.concatenate([rest[sub], np.asarray(last, dtype=int)])
         times["order"] = time.perf_counter() - start
 
