@@ -12,7 +12,7 @@ import pytest
 from ngdual import forms
 from ngdual.mesh import build_mesh
 from ngdual.scene import load_scene
-from ngdual.solvers import hybrid
+from ngdual.solvers import condensation
 from ngdual.solvers.hybrid import HybridSystem
 
 
@@ -27,7 +27,7 @@ def test_parallel_and_serial_assembly_agree_bit_for_bit(monkeypatch):
     mesh = build_mesh(scene.geometry, 5)
     assert mesh.ne >= forms.PARALLEL_ELEMENTS
     parallel = assembled(scene, mesh)
-    for module in (forms.peers_block, hybrid):
+    for module in (forms.peers_block, condensation):
         monkeypatch.setattr(module, "parallel_tasks", lambda mesh: contextlib.nullcontext())
     serial = assembled(scene, mesh)
     for p, s in zip(parallel, serial):

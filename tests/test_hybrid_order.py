@@ -17,12 +17,12 @@ import scipy.sparse as sp
 from ngdual.forms import assemble, broken_peers, conforming_peers
 from ngdual.mesh import build_mesh
 from ngdual.scene import load_scene
-from ngdual.solvers import hybrid as hybrid_module
-from ngdual.solvers import solve_scene
+from ngdual.solvers import condensation, solve_scene
 from ngdual.solvers.active_set import active_set_solve
+from ngdual.solvers.condensation import element_schur
 from ngdual.solvers.conforming import conforming_active_set
 from ngdual.solvers.convergence import TOLERANCE
-from ngdual.solvers.hybrid import HybridSystem, _element_schur
+from ngdual.solvers.hybrid import HybridSystem
 from ngdual.solvers.linear import solve_linear
 from ngdual.solvers.settings import solver_settings
 from ngdual.sparse import to_scipy
@@ -187,7 +187,7 @@ def test_the_element_schur_complements_sum_to_the_sparse_product(order):
     hybrid = HybridSystem(problem, friction=True)
     sparse = (hybrid.A_LI.T @ (hybrid.B_inv @ hybrid.A_LI)).toarray()
     for chunk in (2048, 37):
-        batched = _element_schur(hybrid.B_inv, hybrid.A_LI, chunk).toarray()
+        batched = element_schur(hybrid.B_inv, hybrid.A_LI, chunk).toarray()
         assert np.max(np.abs(batched - sparse)) <= 1e-14 * np.max(np.abs(sparse))
 
 
@@ -201,12 +201,16 @@ def test_ngsolves_static_condensation_is_the_element_schur_complement(order):
     mesh, n_local = problem.spaces.mesh, hybrid._n_local
     every = ngs.BitArray(mesh.ne)
     every.Set()
-    form = hybrid_module._condensed_form(problem.broken, order, every)
+    form = condensation.condensed_form(problem.broken, order, every)
     condensed = -to_scipy(form.mat)[n_local:][:, n_local:]
     n_g = condensed.shape[0]
-    B_inv, A_LI = hybrid._blocks.of(
-        hybrid_module._local_dofs(problem.broken.fes, np.arange(mesh.ne), n_local))
-    blocks = _element_schur(B_inv, A_LI)[:n_g][:, :n_g]
+    at = hybrid._blocks   # the blocks of every triangle, with every triangle's edge coupling
+    blocks = condensation.ElementBlocks(
+        at.matrix, n_local, at.rt_ranges, condensation.edge_coupling(
+            problem.broken.fes.components[0], form.space.components[-1], order), at.coupled)
+    B_inv, A_LI = blocks.of(
+        condensation.local_dofs(problem.broken.fes, np.arange(mesh.ne), n_local))
+    blocks = element_schur(B_inv, A_LI)[:n_g][:, :n_g]
     assert abs(condensed - blocks).max() <= 1e-12 * abs(blocks).max()
 
 
@@ -228,4 +232,4 @@ def test_the_element_schur_complements_keep_explicit_zeros_out_of_the_way():
                         np.concatenate([A.tocoo().col, cols]))), shape=A.shape)
     assert A.nnz == np.count_nonzero(dense) + 3
     expected = dense.T @ (B_inv @ dense)
-    assert np.allclose(_element_schur(B_inv, A).toarray(), expected, rtol=0, atol=1e-13)
+    assert np.allclose(element_schur(B_inv, A).toarray(), expected, rtol=0, atol=1e-13)

@@ -38,19 +38,20 @@ solves and one step of iterative refinement against the residual of ``problem.K`
 (:meth:`HybridSystem.solve`) give every unknown.
 
 The elimination is NGSolve's static condensation (``BilinearForm(condense=True)``,
-:func:`_condensed_form`) on every triangle but those with an edge on Gamma_N or Gamma_C:
-it inverts the element blocks and forms C_T^T B_T^{-1} C_T on eta and mu in C++, in its
-task manager where a core idles (:func:`ngdual.forms.parallel_tasks`), and its
-``inner_solve`` and ``harmonic_extension`` are the element solves. The triangles at Gamma_N
-and Gamma_C, whose unknowns the boundary multipliers also couple, are eliminated here from
-their blocks of the broken matrix (:class:`_Blocks`: a batched LAPACK inverse and dense
-products, :func:`_element_schur`). A triangle is eliminated one way only, so H, r and the
-element solves share its arithmetic: the equations of K hold to their round-off (mixing
-two inverses of one ill-conditioned block, Cattaneo-Mindlin's nu = 0.4999, left residuals
-of 1e-8 in the multipliers' rows). The two ways give the same H to round-off
-(tests/test_hybrid_order.py); on hertz-cylinder's last tolerance step (PEERS_1, 1 685
-triangles) the condensation took 0.15 s with numpy on every triangle, NGSolve's takes
-0.07 s on one thread and 0.04 s on two.
+:func:`ngdual.solvers.condensation.condensed_form`) on every triangle but those with an
+edge on Gamma_N or Gamma_C: it inverts the element blocks and forms C_T^T B_T^{-1} C_T on
+eta and mu in C++, in its task manager where a core idles
+(:func:`ngdual.forms.parallel_tasks`), and its ``inner_solve`` and ``harmonic_extension``
+are the element solves. The triangles at Gamma_N and Gamma_C, whose unknowns the boundary
+multipliers also couple, are eliminated here from their blocks of the broken matrix
+(:class:`ngdual.solvers.condensation.ElementBlocks`: a batched LAPACK inverse and dense
+products). A triangle is eliminated one way only, so H, r and the element solves share its
+arithmetic: the equations of K hold to their round-off (mixing two inverses of one
+ill-conditioned block, Cattaneo-Mindlin's nu = 0.4999, left residuals of 1e-8 in the
+multipliers' rows). The two ways give the same H to round-off (tests/test_hybrid_order.py);
+on hertz-cylinder's last tolerance step (PEERS_1, 1 685 triangles) the condensation took
+0.15 s with numpy on every triangle, NGSolve's takes 0.07 s on one thread and 0.04 s on
+two.
 
 The thesis hybridises differently (Section 3.5: the fine Gamma_C traces zeta last, their
 Schur complement S, G = M^T S M with M the hats' edge means); H here has the multipliers'
@@ -69,12 +70,16 @@ import scipy.sparse as sp
 
 from .. import peers
 from ..forms import DiscreteProblem
-from ..forms.integrators import differentiated_integrands, parallel_tasks
-from ..forms.peers_block import BrokenPeers, peers_form
-from ..sparse import to_scipy
 from .cholesky import SchurCholesky
-
-SCHUR_CHUNK = 2048  # triangles per batch of _element_schur (PEERS_2: 48 MB of blocks)
+from .condensation import (
+    ElementBlocks,
+    check_no_global_block,
+    condensed_form,
+    edge_coupling,
+    element_schur,
+    interface_block,
+    local_dofs,
+)
 
 
 class HybridSystem:
@@ -120,7 +125,7 @@ class HybridSystem:
         self._n_local = n_local = ranges["eta"].start
         matrix = broken.matrix if broken.matrix.has_sorted_indices else \
             broken.matrix.sorted_indices()
-        _check_no_global_block(matrix, n_local)
+        check_no_global_block(matrix, n_local)
         contact = problem.lam_n if not friction else np.concatenate(
             [problem.lam_n, problem.index("lam_t")])
         others = np.setdiff1d(np.arange(n_p, problem.n), contact)
@@ -133,36 +138,37 @@ class HybridSystem:
         self._Q = Q
         # the triangles at Gamma_N and Gamma_C, whose unknowns the multipliers couple
         mesh, elements = fes.mesh, broken.coupled
-        self.local = _local_dofs(fes, elements, n_local)
+        self.local = local_dofs(fes, elements, n_local)
         coupled_rows = np.flatnonzero(np.diff(coupled.indptr[:n_local + 1]))
         if not np.isin(coupled_rows, self.local).all():
             raise RuntimeError("a multiplier couples a triangle away from Gamma_N, Gamma_C")
         self.seconds = {"broken": time.perf_counter() - start}
 
         start = time.perf_counter()
-        # the other triangles: NGSolve's static condensation onto eta and mu
-        others_only = ngs.BitArray(mesh.ne)
-        others_only.Set()
+        at_boundary = ngs.BitArray(mesh.ne)
+        at_boundary.Clear()
         for nr in elements.tolist():
-            others_only.Clear(nr)
-        self._form = form = _condensed_form(broken, spaces.order, others_only)
+            at_boundary.Set(nr)
+        # the other triangles: NGSolve's static condensation onto eta and mu
+        self._form = form = condensed_form(broken, spaces.order, ~at_boundary)
         facet = form.space.components[-1]
         n_mu, n_m = facet.ndof, len(multipliers)
         eta = np.arange(n_local, n_b)
-        n_g = len(eta) + 2 * n_mu     # eta, mu_1, mu_2: what NGSolve's condensation keeps
+        # eta, mu_1, mu_2: what NGSolve's condensation keeps
+        self._n_g = n_g = len(eta) + 2 * n_mu
         n_i = n_g + n_m
         # the global unknowns: eta, mu_1, mu_2, the other multipliers, the contact ones
         self.interface = np.concatenate([eta, n_b + np.arange(2 * n_mu + n_m)])
         self._sizes = (n_b, n_p, n_mu, multipliers)
-        condensed = _interface_block(form.mat, n_local)
+        condensed = interface_block(form.mat, n_local)
         # the triangles at Gamma_N and Gamma_C: C_T^T B_T^{-1} C_T from their blocks here,
         # so that their element solves are the same arithmetic in H, rhs and unknowns
-        self._blocks = _Blocks(matrix, n_local, (ranges["r1"], ranges["r2"]),
-                               _edge_coupling(fes.components[peers.PEERS.index("r1")], facet,
-                                              spaces.order), coupled)
+        # (their rows of the edge coupling are the only ones read: functional reads no other)
+        self._blocks = ElementBlocks(matrix, n_local, (ranges["r1"], ranges["r2"]),
+                                     edge_coupling(fes.components[peers.PEERS.index("r1")],
+                                                   facet, spaces.order, at_boundary), coupled)
         self.B_inv, self.A_LI = self._blocks.of(self.local)
-        own = _element_schur(self.B_inv, self.A_LI) if len(self.local) else \
-            sp.csr_matrix((n_i, n_i))
+        own = element_schur(self.B_inv, self.A_LI)
         A_II = sp.bmat([[sp.csr_matrix((n_g - 2 * n_mu, n_g - 2 * n_mu)), None, coupled[eta]],
                         [None, sp.csr_matrix((2 * n_mu, 2 * n_mu)), None],
                         [coupled[eta].T, None, boundary[multipliers][:, multipliers]]],
@@ -201,18 +207,21 @@ class HybridSystem:
         result.data = operator * given
         return result.FV().NumPy().copy()
 
+    def _local_load(self, f: np.ndarray) -> np.ndarray:
+        """The element-local part of the load ``f`` on the condensed form's unknowns
+        (broken, mu_1, mu_2), zero elsewhere."""
+        given = np.zeros(self._n_local + self._n_g)
+        given[:self._n_local] = f[:self._n_local]
+        return given
+
     def rhs(self, F: np.ndarray) -> np.ndarray:
         """r = C^T B^{-1} f_L - f_I of H x_I = r for the right-hand side F of ``problem.K``:
         NGSolve's condensation for the triangles away from Gamma_N, Gamma_C, their own
         blocks for the others."""
-        n_b, n_p, n_mu, multipliers = self._sizes
         f = self._load(F)
-        n_local = self._n_local
-        given = np.zeros(n_b + 2 * n_mu)
-        given[:n_local] = f[:n_local]
         r = self.A_LI.T @ (self.B_inv @ f[self.local.ravel()]) - f[self.interface]
-        r[:n_b - n_local + 2 * n_mu] -= self._condensation(self._form.harmonic_extension_trans,
-                                                           given)[n_local:]
+        r[:self._n_g] -= self._condensation(self._form.harmonic_extension_trans,
+                                            self._local_load(f))[self._n_local:]
         return r
 
     def unknowns(self, w: np.ndarray, F: np.ndarray) -> np.ndarray:
@@ -222,12 +231,10 @@ class HybridSystem:
         and Gamma_C), the broken Raviart-Thomas rows mapped to the conforming ones."""
         n_b, n_p, n_mu, multipliers = self._sizes
         f = self._load(F)
-        n_local, n_g = self._n_local, n_b - self._n_local + 2 * n_mu
-        given = np.zeros(n_b + 2 * n_mu)
-        given[:n_local] = f[:n_local]
-        local = self._condensation(self._form.inner_solve, given)
-        given[:n_local], given[n_local:] = 0.0, w[:n_g]
-        local += self._condensation(self._form.harmonic_extension, given)
+        n_local = self._n_local
+        local = self._condensation(self._form.inner_solve, self._local_load(f))
+        local += self._condensation(self._form.harmonic_extension,
+                                    np.concatenate([np.zeros(n_local), w[:self._n_g]]))
         L = self.local.ravel()
         local[L] = self.B_inv @ (f[L] - self.A_LI @ w)
         z = np.zeros(len(self.interface) + n_local)
@@ -280,202 +287,8 @@ class HybridSystem:
         return x + self.unknowns(dw, R)
 
 
-def _local_dofs(fes: ngs.FESpace, elements: np.ndarray, n_local: int) -> np.ndarray:
-    """(triangles, local unknowns): the element-local unknowns of ``fes`` (those below
-    ``n_local``) of every triangle of ``elements``, in increasing order (no rows, as many
-    columns as the mesh's first triangle has, without ``elements``: a scene without
-    Gamma_N and Gamma_C)."""
-    def own(nr: int) -> list[int]:
-        return sorted(d for d in fes.GetDofNrs(ngs.ElementId(ngs.VOL, nr)) if 0 <= d < n_local)
-
-    rows = [own(nr) for nr in elements.tolist()]
-    size = len(rows[0]) if rows else len(own(0))
-    if any(len(r) != size for r in rows):
-        raise RuntimeError("the triangles do not have the same number of local unknowns")
-    return np.array(rows, dtype=np.int64).reshape(len(rows), size)
-
-
-def _check_no_global_block(matrix: sp.csr_matrix, n_local: int) -> None:
-    """The PEERS form has no term between two global unknowns (a~ + b + s: eta meets tau
-    alone), so the condensations need no K_II; refuse a broken matrix that has one."""
-    tail = slice(matrix.indptr[n_local], None)
-    if np.any(matrix.data[tail][matrix.indices[tail] >= n_local]):
-        raise RuntimeError("the broken PEERS matrix couples eta with eta")
-
-
-class _Blocks:
-    """The element blocks of chosen triangles, read from the broken matrix's rows (each
-    holds its triangle's local unknowns first, in increasing order, then its eta): the
-    inverses B_T^{-1} and the couplings C_T to the global unknowns (eta, mu, the
-    multipliers)."""
-
-    def __init__(self, matrix: sp.csr_matrix, n_local: int, rt_ranges: tuple,
-                 mu: sp.csr_matrix, coupled: sp.csr_matrix):
-        self.matrix, self.n_local, self.rt_ranges = matrix, n_local, rt_ranges
-        self.mu, self.coupled = mu, coupled
-
-    def of(self, local: np.ndarray) -> tuple[sp.bsr_matrix, sp.csr_matrix]:
-        """(B^{-1}, C) of the triangles whose local unknowns are the rows of ``local``."""
-        matrix, n_local = self.matrix, self.n_local
-        L = local.ravel()
-        size = local.shape[1]
-        M_L = matrix[L]
-        lengths = np.diff(M_L.indptr)
-        place = np.arange(M_L.nnz) - np.repeat(M_L.indptr[:-1], lengths)
-        inside = place < size
-        if not (np.array_equal(M_L.indices[inside], np.repeat(local, size, axis=0).ravel())
-                and np.all(M_L.indices[~inside] >= n_local)):
-            raise RuntimeError("the element-local unknowns couple across triangles")
-        B_inv = _block_inverse(M_L.data[inside].reshape(-1, size, size))
-        K_LI = sp.csr_matrix((M_L.data[~inside], M_L.indices[~inside] - n_local,
-                              np.concatenate([[0], np.cumsum(lengths - size)])),
-                             shape=(len(L), matrix.shape[0] - n_local))
-        rows = []
-        for r in self.rt_ranges:   # the broken RT_k rows' coupling to their mu
-            own = np.flatnonzero((L >= r.start) & (L < r.stop))
-            rows.append(sp.csr_matrix((np.ones(len(own)), (own, L[own] - r.start)),
-                                      shape=(len(L), r.stop - r.start)) @ self.mu)
-        return B_inv, sp.hstack([K_LI, *rows, self.coupled[L]], format="csr")
-
-
 def _first_copies(conforming: np.ndarray, n_p: int) -> np.ndarray:
     """For every conforming PEERS unknown the first broken unknown that restricts it."""
     first = np.empty(n_p, dtype=np.int64)
     first[conforming[::-1]] = np.arange(len(conforming))[::-1]
     return first
-
-
-def _edge_term(mu, tau, order: int, elements: ngs.BitArray | None = None
-               ) -> ngs.comp.SumOfIntegrals:
-    """sum_T int_{dT} mu (tau . n_T) ds, exact for the P_k multipliers mu and the broken
-    RT_k functions tau (a degree 2k integrand on every edge), over the triangles of
-    ``elements`` (default all)."""
-    n = ngs.specialcf.normal(2)
-    rule = {ngs.SEGM: ngs.IntegrationRule(ngs.SEGM, 2 * order)}
-    dx = ngs.dx(element_boundary=True, intrules=rule) if elements is None else ngs.dx(
-        element_boundary=True, intrules=rule, definedonelements=elements)
-    return mu * (tau * n) * dx
-
-
-def _multiplier_space(mesh: ngs.Mesh, order: int) -> ngs.FESpace:
-    """The P_k multipliers mu of the interior edges: ``FacetFESpace(order=k)`` without the
-    boundary edges' functions (a boundary edge has one triangle, nothing to glue)."""
-    facet = ngs.FacetFESpace(mesh, order=order, dirichlet=".*")
-    return ngs.Compress(facet, active_dofs=facet.FreeDofs())
-
-
-def _condensed_form(broken: BrokenPeers, order: int, elements: ngs.BitArray
-                    ) -> ngs.BilinearForm:
-    """The hybridised PEERS_k form a~ + b + s + sum_T int_{dT} mu . tau n_T ds on the broken
-    space and two rows of multipliers mu (:func:`_multiplier_space`), assembled by NGSolve
-    with static condensation (``condense=True``): every triangle's block of element-local
-    unknowns (the broken RT_k rows, the bubbles, u) is inverted and eliminated in C++,
-    ``form.mat`` is the Schur complement on eta and mu, and ``inner_solve``,
-    ``harmonic_extension`` and its transpose give the element solves. Only the triangles
-    of ``elements`` are integrated: the others' local unknowns stay out of every block.
-
-    The interior dofs of eta (its H1 order k + 1 has them from k = 2 on) are NGSolve's
-    LOCAL_DOF; they are made INTERFACE_DOF here, global as they are in the broken matrix,
-    whose element-local unknowns are those numbered below eta.
-    """
-    mesh = broken.fes.mesh
-    facet = _multiplier_space(mesh, order)
-    fes = ngs.FESpace(list(broken.fes.components) + [facet, facet])
-    eta = fes.Range(peers.PEERS.index("eta"))
-    inner = np.flatnonzero(~np.array(fes.components[peers.PEERS.index("eta")]
-                                     .FreeDofs(coupling=True), dtype=bool))
-    for dof in (eta.start + inner).tolist():
-        fes.SetCouplingType(dof, ngs.COUPLING_TYPE.INTERFACE_DOF)
-    names = list(peers.PEERS) + ["mu1", "mu2"]
-    trial, test = (dict(zip(names, f)) for f in (fes.TrialFunction(), fes.TestFunction()))
-    form = ngs.BilinearForm(fes, condense=True)
-    with differentiated_integrands():
-        form += peers_form({n: trial[n] for n in peers.PEERS},
-                           {n: test[n] for n in peers.PEERS}, broken.lame, order,
-                           elements=elements)
-        for mu, r in (("mu1", "r1"), ("mu2", "r2")):
-            form += (_edge_term(trial[mu], test[r], order, elements)
-                     + _edge_term(test[mu], trial[r], order, elements))
-        with parallel_tasks(mesh):
-            form.Assemble()
-    return form
-
-
-def _interface_block(matrix, n_local: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(data, columns, row starts) of the block of NGSolve's condensed ``matrix`` on the
-    unknowns from ``n_local`` on (eta, mu), read from its CSR arrays without a copy of the
-    whole: the condensation leaves the rows of the element-local unknowns empty and the
-    other rows without their columns."""
-    values, columns, starts = (np.asarray(a) for a in matrix.CSR())
-    first = int(starts[n_local])
-    indices = columns[first:].astype(np.int64) - n_local
-    if first or (len(indices) and indices.min() < 0):
-        raise RuntimeError("NGSolve's condensed matrix couples the element-local unknowns")
-    return values[first:].copy(), indices, starts[n_local:].astype(np.int64) - first
-
-
-def _edge_coupling(broken_rt: ngs.FESpace, facet: ngs.FESpace, order: int) -> sp.csr_matrix:
-    """D[i, j] = sum_T int_{dT} mu_j (psi_i . n_T) ds for the broken RT_k functions psi_i and
-    the multipliers mu_j of the interior edges (``facet``, :func:`_multiplier_space`)."""
-    form = ngs.BilinearForm(trialspace=facet, testspace=broken_rt)
-    form += _edge_term(facet.TrialFunction(), broken_rt.TestFunction(), order)
-    form.Assemble()
-    return to_scipy(form.mat)
-
-
-def _block_inverse(blocks: np.ndarray) -> sp.bsr_matrix:
-    """The block-diagonal matrix of the inverses of ``blocks`` (triangles, size, size),
-    inverted in one batched LAPACK call."""
-    n, size, _ = blocks.shape
-    return sp.bsr_matrix((np.linalg.inv(blocks), np.arange(n), np.arange(n + 1)),
-                         shape=(n * size, n * size))
-
-
-def _element_schur(B_inv: sp.bsr_matrix, A_LI: sp.csr_matrix,
-                   chunk: int = SCHUR_CHUNK) -> sp.csr_matrix:
-    """C^T B^{-1} C for the block-diagonal B^{-1} (one block per triangle) and the coupling
-    C = ``A_LI`` of the element-local unknowns (rows, triangle by triangle) to the global
-    ones: the sum over the triangles of C_T^T B_T^{-1} C_T, each C_T the dense block of the
-    few global unknowns its triangle couples to. Computed ``chunk`` triangles at a time by
-    batched dense products (one matrix per triangle), which costs about half the two
-    sparse products B^{-1} C and C^T (B^{-1} C) (PEERS_2, 512 triangles, 25 065 unknowns:
-    0.023 s against 0.045 s); the sum of the element contributions is the same matrix up to
-    round-off."""
-    size = B_inv.blocksize[0]
-    n_tri, n_glob = B_inv.shape[0] // size, A_LI.shape[1]
-    A_LI = A_LI.tocsr()
-    A_LI.sum_duplicates()
-    # the global unknowns of every triangle: the union of its rows' columns, sorted
-    owner = sp.csr_matrix((np.ones(A_LI.shape[0]), (np.arange(A_LI.shape[0]) // size,
-                                                    np.arange(A_LI.shape[0]))),
-                          shape=(n_tri, A_LI.shape[0]))
-    # (ones, not |A_LI|: a product drops the sums that vanish, and NGSolve's pattern holds
-    # explicit zeros)
-    ones = sp.csr_matrix((np.ones(A_LI.nnz), A_LI.indices, A_LI.indptr), shape=A_LI.shape)
-    pattern = (owner @ ones).tocsr()
-    pattern.sort_indices()
-    counts = np.diff(pattern.indptr)
-    width = int(counts.max(initial=0))
-    slot = np.arange(pattern.nnz) - np.repeat(pattern.indptr[:-1], counts)
-    columns = np.full((n_tri, width), -1, dtype=np.int64)
-    columns[np.repeat(np.arange(n_tri), counts), slot] = pattern.indices
-    # the slot of every entry of A_LI in its triangle's list (the lists are sorted, and so
-    # are their keys triangle * n_glob + column over all triangles)
-    rows = np.repeat(np.arange(A_LI.shape[0]), np.diff(A_LI.indptr))
-    keys = np.repeat(np.arange(n_tri), counts) * n_glob + pattern.indices
-    where = np.searchsorted(keys, rows // size * n_glob + A_LI.indices)
-    entry_slot = slot[where]
-    inverse = B_inv.data
-    parts = []
-    for first in range(0, n_tri, chunk):
-        last = min(first + chunk, n_tri)
-        lo, hi = A_LI.indptr[first * size], A_LI.indptr[last * size]
-        C = np.zeros((last - first, size, width))
-        C[rows[lo:hi] // size - first, rows[lo:hi] % size, entry_slot[lo:hi]] = A_LI.data[lo:hi]
-        S = np.matmul(C.transpose(0, 2, 1), np.matmul(inverse[first:last], C))
-        cols = columns[first:last]
-        valid = (cols[:, :, None] >= 0) & (cols[:, None, :] >= 0)
-        parts.append((S[valid], np.broadcast_to(cols[:, :, None], S.shape)[valid],
-                      np.broadcast_to(cols[:, None, :], S.shape)[valid]))
-    data, i, j = (np.concatenate(p) for p in zip(*parts))
-    return sp.csr_matrix((data, (i, j)), shape=(n_glob, n_glob))
